@@ -1,0 +1,181 @@
+//! Instance, adapter, device and queue, created once and shared by the renderer and techniques.
+
+use std::sync::{Arc, Mutex};
+
+use crate::technique;
+
+/// Why no GPU device could be created.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No adapter on any enabled backend.
+    #[error(
+        "no graphics adapter found (backends: {backends}). Shadow Zoo needs a Vulkan, Metal or DX12 driver; \
+         on Linux without a GPU install the lavapipe software driver: \
+         `sudo apt-get install -y mesa-vulkan-drivers`"
+    )]
+    NoAdapter { backends: String },
+    /// `WGPU_ADAPTER_NAME` matched nothing.
+    #[error("WGPU_ADAPTER_NAME={wanted} matches no adapter; available: {available}")]
+    NoMatchingAdapter { wanted: String, available: String },
+    /// The adapter refused the device.
+    #[error("the adapter refused to create a device: {0}")]
+    Device(String),
+}
+
+/// The shared GPU objects.
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    uncaptured: Arc<Mutex<Vec<String>>>,
+}
+
+impl GpuContext {
+    /// Creates a headless context. The backend and adapter honour `WGPU_BACKEND` and
+    /// `WGPU_ADAPTER_NAME`; the device gets every feature that a registered technique needs or
+    /// would like and the adapter has, plus timestamp queries where available.
+    pub fn new_headless() -> Result<GpuContext, GpuError> {
+        pollster::block_on(Self::new_headless_async())
+    }
+
+    async fn new_headless_async() -> Result<GpuContext, GpuError> {
+        let descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let backends = descriptor.backends;
+        let instance = wgpu::Instance::new(descriptor);
+        let adapter = select_adapter(&instance, backends).await?;
+        let features = Self::wanted_features(&adapter);
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("shadow-zoo device"),
+                required_features: features,
+                required_limits: adapter.limits(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| GpuError::Device(e.to_string()))?;
+        Ok(Self::from_parts(instance, adapter, device, queue))
+    }
+
+    /// Features to request from `adapter`: the union of what techniques need, limited to what
+    /// the adapter has.
+    pub fn wanted_features(adapter: &wgpu::Adapter) -> wgpu::Features {
+        let mut wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
+        for registration in technique::registry() {
+            wanted |= (registration.required_features)() | (registration.optional_features)();
+        }
+        wanted & adapter.features()
+    }
+
+    /// Wraps objects created elsewhere (the viewer's eframe device, for example).
+    pub fn from_parts(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> GpuContext {
+        let uncaptured = Arc::new(Mutex::new(Vec::new()));
+        let sink = uncaptured.clone();
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            log::error!("wgpu: {error}");
+            if let Ok(mut errors) = sink.lock() {
+                errors.push(error.to_string());
+            }
+        }));
+        let info = adapter.get_info();
+        GpuContext {
+            instance,
+            adapter,
+            device,
+            queue,
+            info,
+            uncaptured,
+        }
+    }
+
+    /// One line naming the adapter, backend and driver.
+    pub fn describe(&self) -> String {
+        let i = &self.info;
+        format!(
+            "{} ({:?}, {:?} backend, driver {} {})",
+            i.name, i.device_type, i.backend, i.driver, i.driver_info
+        )
+    }
+
+    /// Whether GPU timestamps can be written at pass boundaries.
+    pub fn has_timestamps(&self) -> bool {
+        self.device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// Errors reported outside any error scope since the last call.
+    pub fn take_uncaptured_errors(&self) -> Vec<String> {
+        self.uncaptured
+            .lock()
+            .map(|mut e| std::mem::take(&mut *e))
+            .unwrap_or_default()
+    }
+
+    /// Blocks until all submitted work is done.
+    pub fn wait_idle(&self) {
+        if let Err(e) = self.device.poll(wgpu::PollType::wait_indefinitely()) {
+            log::error!("device poll failed: {e}");
+        }
+    }
+
+    /// Runs `f` inside a validation error scope and returns the first validation error.
+    pub fn validation_scope<T>(&self, f: impl FnOnce() -> T) -> (T, Option<String>) {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let value = f();
+        let error = pollster::block_on(scope.pop()).map(|e| e.to_string());
+        (value, error)
+    }
+}
+
+async fn select_adapter(
+    instance: &wgpu::Instance,
+    backends: wgpu::Backends,
+) -> Result<wgpu::Adapter, GpuError> {
+    let adapters = instance.enumerate_adapters(backends).await;
+    if adapters.is_empty() {
+        return Err(GpuError::NoAdapter {
+            backends: format!("{backends:?}"),
+        });
+    }
+    if let Ok(wanted) = std::env::var("WGPU_ADAPTER_NAME") {
+        let needle = wanted.to_lowercase();
+        let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+        return adapters
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&needle))
+            .ok_or(GpuError::NoMatchingAdapter {
+                wanted,
+                available: names.join(", "),
+            });
+    }
+    let rank = |a: &wgpu::Adapter| {
+        let info = a.get_info();
+        let device = match info.device_type {
+            wgpu::DeviceType::DiscreteGpu => 0,
+            wgpu::DeviceType::IntegratedGpu => 1,
+            wgpu::DeviceType::VirtualGpu => 2,
+            wgpu::DeviceType::Cpu => 3,
+            wgpu::DeviceType::Other => 4,
+        };
+        let backend = match info.backend {
+            wgpu::Backend::Vulkan | wgpu::Backend::Metal | wgpu::Backend::Dx12 => 0,
+            _ => 1,
+        };
+        (device, backend)
+    };
+    adapters
+        .into_iter()
+        .min_by_key(rank)
+        .ok_or(GpuError::NoAdapter {
+            backends: format!("{backends:?}"),
+        })
+}

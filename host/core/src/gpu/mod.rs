@@ -1,0 +1,13 @@
+//! Device, shaders, readback and per-pass timing.
+
+mod context;
+pub mod readback;
+mod recorder;
+mod shaders;
+
+pub use context::{GpuContext, GpuError};
+pub use recorder::{
+    FrameTimings, MAX_TIMED_PASSES, PassOwner, PassRecorder, PassTiming, TimestampQueries,
+    TimingSource,
+};
+pub use shaders::{ComposedShader, ShaderError, ShaderLibrary};

@@ -1,0 +1,128 @@
+//! Copying textures back to the CPU.
+
+use super::GpuContext;
+
+/// Reads one layer (and aspect) of a 2D texture as tightly packed rows of `bytes_per_texel`.
+pub fn read_texture(
+    gpu: &GpuContext,
+    texture: &wgpu::Texture,
+    layer: u32,
+    aspect: wgpu::TextureAspect,
+    bytes_per_texel: u32,
+) -> Vec<u8> {
+    let (width, height) = (texture.width(), texture.height());
+    let unpadded = width * bytes_per_texel;
+    let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback buffer"),
+        size: (padded * height) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback encoder"),
+        });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d {
+                x: 0,
+                y: 0,
+                z: layer,
+            },
+            aspect,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+    );
+    gpu.queue.submit([encoder.finish()]);
+    map_buffer(gpu, &buffer)
+        .chunks_exact(padded as usize)
+        .flat_map(|row| row[..unpadded as usize].to_vec())
+        .collect()
+}
+
+/// Maps a `MAP_READ` buffer, waits for it, and copies its contents out.
+pub fn map_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<u8> {
+    let slice = buffer.slice(..);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    gpu.wait_idle();
+    match receiver.recv() {
+        Ok(Ok(())) => {
+            let data = match slice.get_mapped_range() {
+                Ok(view) => view.to_vec(),
+                Err(e) => {
+                    log::error!("buffer mapping failed: {e}");
+                    return vec![0; buffer.size() as usize];
+                }
+            };
+            buffer.unmap();
+            data
+        }
+        other => {
+            log::error!("buffer mapping failed: {other:?}");
+            vec![0; buffer.size() as usize]
+        }
+    }
+}
+
+/// Converts little-endian f32 bytes.
+pub fn f32s(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
+/// Converts little-endian IEEE half-float bytes.
+pub fn f16s(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(2)
+        .map(|b| half_to_f32(u16::from_le_bytes([b[0], b[1]])))
+        .collect()
+}
+
+fn half_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exponent = ((h >> 10) & 0x1f) as i32;
+    let mantissa = (h & 0x3ff) as f32;
+    sign * match exponent {
+        0 => mantissa * 2f32.powi(-24),
+        31 if mantissa == 0.0 => f32::INFINITY,
+        31 => f32::NAN,
+        e => (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_floats_decode() {
+        assert_eq!(half_to_f32(0x3c00), 1.0);
+        assert_eq!(half_to_f32(0xc000), -2.0);
+        assert_eq!(half_to_f32(0x3555), 0.333_251_95);
+        assert_eq!(half_to_f32(0x0001), 2f32.powi(-24));
+        assert!(half_to_f32(0x7e00).is_nan());
+        assert_eq!(half_to_f32(0x7c00), f32::INFINITY);
+    }
+}

@@ -1,0 +1,269 @@
+//! WGSL sources: embedded at build time, optionally read from disk, composed with `#import`.
+//!
+//! A line `#import "common/frame.wgsl"` is replaced by that file's text (each file is included
+//! once per module). Errors are reported against the original file, line and column.
+
+use std::collections::HashSet;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+mod embedded {
+    include!(concat!(env!("OUT_DIR"), "/embedded_shaders.rs"));
+}
+
+/// A shader that failed to load, compose or validate.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ShaderError {
+    /// No such file in the library.
+    #[error("shader `{0}` not found")]
+    NotFound(String),
+    /// An `#import` could not be resolved.
+    #[error("shaders/{file}:{line}: {message}")]
+    Import {
+        file: String,
+        line: usize,
+        message: String,
+    },
+    /// WGSL parsing or validation failed.
+    #[error("shaders/{file}:{line}:{col}: {message}")]
+    Compile {
+        file: String,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    /// wgpu rejected the module or pipeline.
+    #[error("{label}: {message}")]
+    Pipeline { label: String, message: String },
+}
+
+/// A composed WGSL module and where each of its lines came from.
+#[derive(Debug, Clone)]
+pub struct ComposedShader {
+    pub name: String,
+    pub source: String,
+    /// For each line of `source` (0-based): (file, 1-based line in that file).
+    line_map: Vec<(Arc<str>, usize)>,
+}
+
+impl ComposedShader {
+    /// Maps a 1-based line of the composed source back to (file, line).
+    pub fn origin(&self, line: usize) -> (String, usize) {
+        self.line_map
+            .get(line.saturating_sub(1))
+            .map(|(f, l)| (f.to_string(), *l))
+            .unwrap_or_else(|| (self.name.clone(), line))
+    }
+}
+
+/// Where shader sources come from.
+#[derive(Debug, Clone, Default)]
+pub struct ShaderLibrary {
+    /// When set, files are read from this folder first (hot reload); embedded copies otherwise.
+    disk_root: Option<PathBuf>,
+}
+
+impl ShaderLibrary {
+    /// Sources compiled into the binary.
+    pub fn embedded() -> ShaderLibrary {
+        ShaderLibrary { disk_root: None }
+    }
+
+    /// Sources read from `root` when present there, embedded ones otherwise.
+    pub fn from_disk(root: PathBuf) -> ShaderLibrary {
+        ShaderLibrary {
+            disk_root: Some(root),
+        }
+    }
+
+    /// The `shaders/` folder this binary was built from, if it still exists.
+    pub fn build_time_root() -> Option<PathBuf> {
+        let root = PathBuf::from(embedded::SOURCE_ROOT);
+        root.is_dir().then_some(root)
+    }
+
+    /// Names of every embedded file.
+    pub fn names() -> impl Iterator<Item = &'static str> {
+        embedded::EMBEDDED.iter().map(|(n, _)| *n)
+    }
+
+    /// The text of one file.
+    pub fn source(&self, name: &str) -> Result<String, ShaderError> {
+        if let Some(root) = &self.disk_root
+            && let Ok(text) = std::fs::read_to_string(root.join(name))
+        {
+            return Ok(text);
+        }
+        embedded::EMBEDDED
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, s)| s.to_string())
+            .ok_or_else(|| ShaderError::NotFound(name.to_string()))
+    }
+
+    /// Resolves the imports of `name`.
+    pub fn compose(&self, name: &str) -> Result<ComposedShader, ShaderError> {
+        let mut out = ComposedShader {
+            name: name.to_string(),
+            source: String::new(),
+            line_map: Vec::new(),
+        };
+        let mut seen = HashSet::new();
+        self.append(name, &mut out, &mut seen, &mut Vec::new())?;
+        Ok(out)
+    }
+
+    fn append(
+        &self,
+        name: &str,
+        out: &mut ComposedShader,
+        seen: &mut HashSet<String>,
+        stack: &mut Vec<String>,
+    ) -> Result<(), ShaderError> {
+        if !seen.insert(name.to_string()) {
+            return Ok(());
+        }
+        let text = self.source(name)?;
+        let file: Arc<str> = Arc::from(name);
+        stack.push(name.to_string());
+        for (i, line) in text.lines().enumerate() {
+            if let Some(rest) = line.trim_start().strip_prefix("#import") {
+                let target = rest.trim().trim_matches('"');
+                if stack.iter().any(|s| s == target) {
+                    return Err(ShaderError::Import {
+                        file: name.to_string(),
+                        line: i + 1,
+                        message: format!("`{target}` imports itself"),
+                    });
+                }
+                self.append(target, out, seen, stack).map_err(|e| match e {
+                    ShaderError::NotFound(_) => ShaderError::Import {
+                        file: name.to_string(),
+                        line: i + 1,
+                        message: format!("cannot import `{target}`: no such shader"),
+                    },
+                    other => other,
+                })?;
+            } else {
+                out.source.push_str(line);
+                out.source.push('\n');
+                out.line_map.push((file.clone(), i + 1));
+            }
+        }
+        stack.pop();
+        Ok(())
+    }
+
+    /// Composes and validates `name` with naga, reporting errors at their original location.
+    pub fn validate(&self, name: &str) -> Result<(ComposedShader, naga::Module), ShaderError> {
+        let composed = self.compose(name)?;
+        let module = naga::front::wgsl::parse_str(&composed.source).map_err(|e| {
+            let location = e.location(&composed.source);
+            compile_error(&composed, location, e.message().to_string())
+        })?;
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        );
+        validator.validate(&module).map_err(|e| {
+            let location = e.location(&composed.source);
+            let mut message = e.as_inner().to_string();
+            let mut source: Option<&dyn std::error::Error> = std::error::Error::source(e.as_inner());
+            while let Some(inner) = source {
+                message.push_str(": ");
+                message.push_str(&inner.to_string());
+                source = inner.source();
+            }
+            compile_error(&composed, location, message)
+        })?;
+        Ok((composed, module))
+    }
+
+    /// Creates a labelled shader module from `name`, validated first so errors carry locations.
+    pub fn create_module(
+        &self,
+        device: &wgpu::Device,
+        name: &str,
+    ) -> Result<wgpu::ShaderModule, ShaderError> {
+        let (composed, _) = self.validate(name)?;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(name),
+            source: wgpu::ShaderSource::Wgsl(composed.source.into()),
+        });
+        match pollster::block_on(scope.pop()) {
+            None => Ok(module),
+            Some(e) => Err(ShaderError::Pipeline {
+                label: name.to_string(),
+                message: e.to_string(),
+            }),
+        }
+    }
+}
+
+fn compile_error(
+    composed: &ComposedShader,
+    location: Option<naga::SourceLocation>,
+    message: String,
+) -> ShaderError {
+    let (line, col) = location
+        .map(|l| (l.line_number as usize, l.line_position as usize))
+        .unwrap_or((1, 1));
+    let (file, line) = composed.origin(line);
+    ShaderError::Compile {
+        file,
+        line,
+        col,
+        message,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_embedded_shader_validates() {
+        let library = ShaderLibrary::embedded();
+        let names: Vec<_> = ShaderLibrary::names().collect();
+        assert!(names.contains(&"host/lighting.wgsl"), "{names:?}");
+        for name in names {
+            // Shared modules are checked through the shaders that import them.
+            if name.starts_with("common/") {
+                continue;
+            }
+            if let Err(e) = library.validate(name) {
+                panic!("{e}");
+            }
+        }
+    }
+
+    #[test]
+    fn errors_point_into_the_imported_file() {
+        let dir = std::env::temp_dir().join(format!("zoo-shaders-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("common")).unwrap();
+        std::fs::write(
+            dir.join("common/util.wgsl"),
+            "fn ok() -> f32 { return 1.0; }\nfn bad() -> f32 { return missing; }\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("main.wgsl"),
+            "// main\n#import \"common/util.wgsl\"\n@compute @workgroup_size(1) fn main() {}\n",
+        )
+        .unwrap();
+        std::fs::write(dir.join("loop.wgsl"), "#import \"loop.wgsl\"\n").unwrap();
+        std::fs::write(dir.join("missing.wgsl"), "\n#import \"common/nope.wgsl\"\n").unwrap();
+        let library = ShaderLibrary::from_disk(dir);
+        match library.validate("main.wgsl").unwrap_err() {
+            ShaderError::Compile {
+                file, line, col, ..
+            } => assert_eq!((file.as_str(), line, col), ("common/util.wgsl", 2, 26)),
+            other => panic!("unexpected {other}"),
+        }
+        let err = library.compose("loop.wgsl").unwrap_err().to_string();
+        assert_eq!(err, "shaders/loop.wgsl:1: `loop.wgsl` imports itself");
+        let err = library.compose("missing.wgsl").unwrap_err().to_string();
+        assert_eq!(err, "shaders/missing.wgsl:2: cannot import `common/nope.wgsl`: no such shader");
+    }
+}

@@ -1,0 +1,31 @@
+//! Shadow Zoo's core library: the [`ShadowTechnique`] contract every plugin implements, the
+//! link-time technique registry, scenes, the GPU context and the deferred renderer that shades
+//! every technique identically from the per-light visibility it produces.
+//!
+//! A plugin crate depends on this crate only. See `README.md` ("Writing a technique") for a
+//! complete minimal plugin.
+
+// Lets the macros name this crate as `zoo_host` from inside it too.
+#[allow(unused_extern_crates)]
+extern crate self as zoo_host;
+
+pub mod builtin;
+pub mod gpu;
+pub mod params;
+pub mod render;
+pub mod scene;
+pub mod technique;
+#[cfg(feature = "test-support")]
+pub mod test_support;
+
+pub use gpu::{GpuContext, PassRecorder, ShaderLibrary};
+pub use params::{ParamSpec, ParamValue, ParamValues, TechniqueParams};
+pub use render::{Renderer, View};
+pub use scene::{Camera, Light, LightKind, MAX_LIGHTS, Scene};
+pub use technique::{
+    Changes, DebugImage, PassInfo, RenderContext, ResourceInfo, ShadowTechnique, TechniqueError,
+    TechniqueRegistration, ViewMapping, find_technique, registry,
+};
+
+// Re-exported so plugins and the macros need no direct dependency on them.
+pub use {glam, inventory, serde, wgpu};

@@ -1,0 +1,552 @@
+//! Typed technique parameters and their schema.
+//!
+//! A technique declares its parameters once with [`technique_params!`]: that generates a serde
+//! struct (the RON settings format) and a [`ParamSpec`] per field (range, step and doc text) from
+//! which the viewer builds its panels and the CLI validates `--set KEY=VALUE`.
+//!
+//! ```
+//! zoo_host::param_choice! {
+//!     /// How the shadow map is filtered.
+//!     pub enum Filter { Nearest, Pcf3x3 }
+//! }
+//! zoo_host::technique_params! {
+//!     /// Parameters of an example technique.
+//!     pub struct ExampleParams {
+//!         /// Shadow-map resolution in texels.
+//!         map_size: u32 = 2048, range(256, 8192), step(256);
+//!         /// Constant depth bias in depth units.
+//!         bias: f32 = 0.002, range(0.0, 0.1), step(0.0005);
+//!         /// Cull front faces in the depth pass.
+//!         cull_front: bool = false;
+//!         /// Filter mode.
+//!         filter: Filter = Filter::Pcf3x3;
+//!     }
+//! }
+//! use zoo_host::params::TechniqueParams;
+//! let schema = ExampleParams::schema();
+//! assert_eq!(schema[0].key, "map_size");
+//! let mut values = ExampleParams::default().to_values();
+//! values.insert("bias".into(), zoo_host::params::ParamValue::Float(0.01));
+//! assert_eq!(ExampleParams::from_values(&values).unwrap().bias, 0.01);
+//! ```
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+/// One parameter value, as stored in settings and edited in the UI.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ParamValue {
+    /// A boolean switch.
+    Bool(bool),
+    /// An integer.
+    Int(i64),
+    /// A real number.
+    Float(f64),
+    /// The name of one choice of an enumeration.
+    Choice(String),
+}
+
+impl fmt::Display for ParamValue {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ParamValue::Bool(v) => write!(f, "{v}"),
+            ParamValue::Int(v) => write!(f, "{v}"),
+            ParamValue::Float(v) => write!(f, "{v}"),
+            ParamValue::Choice(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+/// Parameter values keyed by parameter name.
+pub type ParamValues = BTreeMap<String, ParamValue>;
+
+/// The type and allowed values of one parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamKind {
+    /// A boolean switch.
+    Bool,
+    /// An integer in `min..=max`, edited in steps of `step`.
+    Int { min: i64, max: i64, step: i64 },
+    /// A real number in `min..=max`, edited in steps of `step`.
+    Float { min: f64, max: f64, step: f64 },
+    /// One of a fixed list of names.
+    Choice { options: &'static [&'static str] },
+}
+
+/// Schema entry for one parameter: the UI and the settings files are generated from these.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamSpec {
+    /// Field name, used in RON settings and `--set KEY=VALUE`.
+    pub key: &'static str,
+    /// Doc text shown as a tooltip and in `--help` style listings.
+    pub doc: &'static str,
+    /// Type and range.
+    pub kind: ParamKind,
+    /// Default value.
+    pub default: ParamValue,
+}
+
+/// A parameter that could not be set.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamError {
+    /// No parameter of that name exists.
+    #[error("unknown parameter `{key}` (known: {known})")]
+    Unknown { key: String, known: String },
+    /// The value is outside the declared range.
+    #[error("parameter `{key}` = {value} is out of range {min}..={max}")]
+    OutOfRange {
+        key: String,
+        value: String,
+        min: String,
+        max: String,
+    },
+    /// The value has the wrong type or does not parse.
+    #[error("parameter `{key}`: {message}")]
+    Invalid { key: String, message: String },
+}
+
+impl ParamSpec {
+    /// Parses `text` (from `--set KEY=VALUE`) into a value of this parameter's type and checks
+    /// its range. Out-of-range values are rejected, not clamped.
+    pub fn parse(&self, text: &str) -> Result<ParamValue, ParamError> {
+        let text = text.trim();
+        let invalid = |message: String| ParamError::Invalid {
+            key: self.key.to_string(),
+            message,
+        };
+        let value = match &self.kind {
+            ParamKind::Bool => match text {
+                "true" | "on" | "1" | "yes" => ParamValue::Bool(true),
+                "false" | "off" | "0" | "no" => ParamValue::Bool(false),
+                _ => return Err(invalid(format!("expected true or false, got `{text}`"))),
+            },
+            ParamKind::Int { .. } => ParamValue::Int(
+                text.parse()
+                    .map_err(|_| invalid(format!("expected an integer, got `{text}`")))?,
+            ),
+            ParamKind::Float { .. } => ParamValue::Float(
+                text.parse()
+                    .map_err(|_| invalid(format!("expected a number, got `{text}`")))?,
+            ),
+            ParamKind::Choice { options } => {
+                match options.iter().find(|o| o.eq_ignore_ascii_case(text)) {
+                    Some(o) => ParamValue::Choice((*o).to_string()),
+                    None => {
+                        return Err(invalid(format!(
+                            "expected one of {}, got `{text}`",
+                            options.join(", ")
+                        )));
+                    }
+                }
+            }
+        };
+        self.check(&value)?;
+        Ok(value)
+    }
+
+    /// Checks the type and range of `value`.
+    pub fn check(&self, value: &ParamValue) -> Result<(), ParamError> {
+        let out_of_range = |min: String, max: String| ParamError::OutOfRange {
+            key: self.key.to_string(),
+            value: value.to_string(),
+            min,
+            max,
+        };
+        let wrong_type = |expected: &str| ParamError::Invalid {
+            key: self.key.to_string(),
+            message: format!("expected {expected}, got `{value}`"),
+        };
+        match (&self.kind, value) {
+            (ParamKind::Bool, ParamValue::Bool(_)) => Ok(()),
+            (ParamKind::Int { min, max, .. }, ParamValue::Int(v)) => {
+                if v < min || v > max {
+                    Err(out_of_range(min.to_string(), max.to_string()))
+                } else {
+                    Ok(())
+                }
+            }
+            (ParamKind::Float { min, max, .. }, ParamValue::Float(v)) => {
+                if !v.is_finite() || v < min || v > max {
+                    Err(out_of_range(min.to_string(), max.to_string()))
+                } else {
+                    Ok(())
+                }
+            }
+            (ParamKind::Float { .. }, ParamValue::Int(v)) => {
+                self.check(&ParamValue::Float(*v as f64))
+            }
+            (ParamKind::Choice { options }, ParamValue::Choice(c)) => {
+                if options.contains(&c.as_str()) {
+                    Ok(())
+                } else {
+                    Err(ParamError::Invalid {
+                        key: self.key.to_string(),
+                        message: format!("expected one of {}, got `{c}`", options.join(", ")),
+                    })
+                }
+            }
+            (ParamKind::Bool, _) => Err(wrong_type("true or false")),
+            (ParamKind::Int { .. }, _) => Err(wrong_type("an integer")),
+            (ParamKind::Float { .. }, _) => Err(wrong_type("a number")),
+            (ParamKind::Choice { .. }, _) => Err(wrong_type("a choice name")),
+        }
+    }
+
+    /// Returns `value` moved into range (what a slider does); wrong types give the default.
+    pub fn clamp(&self, value: &ParamValue) -> ParamValue {
+        match (&self.kind, value) {
+            (ParamKind::Int { min, max, .. }, ParamValue::Int(v)) => {
+                ParamValue::Int((*v).clamp(*min, *max))
+            }
+            (ParamKind::Float { min, max, .. }, ParamValue::Float(v)) if v.is_finite() => {
+                ParamValue::Float(v.clamp(*min, *max))
+            }
+            (ParamKind::Float { min, max, .. }, ParamValue::Int(v)) => {
+                ParamValue::Float((*v as f64).clamp(*min, *max))
+            }
+            _ if self.check(value).is_ok() => value.clone(),
+            _ => self.default.clone(),
+        }
+    }
+}
+
+/// Finds the spec of `key` in `schema`, or an error listing the known keys.
+pub fn find_spec<'a>(schema: &'a [ParamSpec], key: &str) -> Result<&'a ParamSpec, ParamError> {
+    schema
+        .iter()
+        .find(|s| s.key == key)
+        .ok_or_else(|| ParamError::Unknown {
+            key: key.to_string(),
+            known: if schema.is_empty() {
+                "none".to_string()
+            } else {
+                schema.iter().map(|s| s.key).collect::<Vec<_>>().join(", ")
+            },
+        })
+}
+
+/// Default values of every parameter in `schema`.
+pub fn defaults(schema: &[ParamSpec]) -> ParamValues {
+    schema
+        .iter()
+        .map(|s| (s.key.to_string(), s.default.clone()))
+        .collect()
+}
+
+/// Applies `KEY=VALUE` assignments to `values`, validating each against `schema`.
+pub fn apply_assignments(
+    schema: &[ParamSpec],
+    values: &mut ParamValues,
+    assignments: &[(String, String)],
+) -> Result<(), ParamError> {
+    for (key, text) in assignments {
+        let spec = find_spec(schema, key)?;
+        values.insert(key.clone(), spec.parse(text)?);
+    }
+    Ok(())
+}
+
+/// A field type usable in [`technique_params!`].
+pub trait ParamType: Sized {
+    /// The schema kind for this type, given the declared range and step.
+    fn kind(range: Option<(f64, f64)>, step: Option<f64>) -> ParamKind;
+    /// Converts to the generic value.
+    fn to_value(&self) -> ParamValue;
+    /// Converts from the generic value (already range-checked).
+    fn from_value(value: &ParamValue) -> Option<Self>;
+}
+
+impl ParamType for bool {
+    fn kind(_: Option<(f64, f64)>, _: Option<f64>) -> ParamKind {
+        ParamKind::Bool
+    }
+    fn to_value(&self) -> ParamValue {
+        ParamValue::Bool(*self)
+    }
+    fn from_value(value: &ParamValue) -> Option<Self> {
+        match value {
+            ParamValue::Bool(b) => Some(*b),
+            _ => None,
+        }
+    }
+}
+
+impl ParamType for f32 {
+    fn kind(range: Option<(f64, f64)>, step: Option<f64>) -> ParamKind {
+        let (min, max) = range.unwrap_or((f32::MIN as f64, f32::MAX as f64));
+        ParamKind::Float {
+            min,
+            max,
+            step: step.unwrap_or((max - min) / 100.0),
+        }
+    }
+    fn to_value(&self) -> ParamValue {
+        // Round-trip through the shortest decimal so 0.1f32 shows as 0.1, not 0.10000000149.
+        ParamValue::Float(self.to_string().parse().unwrap_or(*self as f64))
+    }
+    fn from_value(value: &ParamValue) -> Option<Self> {
+        match value {
+            ParamValue::Float(v) => Some(*v as f32),
+            ParamValue::Int(v) => Some(*v as f32),
+            _ => None,
+        }
+    }
+}
+
+macro_rules! int_param_type {
+    ($($t:ty),*) => {$(
+        impl ParamType for $t {
+            fn kind(range: Option<(f64, f64)>, step: Option<f64>) -> ParamKind {
+                let (min, max) = range.unwrap_or((<$t>::MIN as f64, <$t>::MAX as f64));
+                ParamKind::Int {
+                    min: min as i64,
+                    max: max as i64,
+                    step: step.unwrap_or(1.0).max(1.0) as i64,
+                }
+            }
+            fn to_value(&self) -> ParamValue {
+                ParamValue::Int(*self as i64)
+            }
+            fn from_value(value: &ParamValue) -> Option<Self> {
+                match value {
+                    ParamValue::Int(v) => <$t>::try_from(*v).ok(),
+                    _ => None,
+                }
+            }
+        }
+    )*};
+}
+int_param_type!(u32, i32);
+
+/// A parameter struct generated by [`technique_params!`].
+pub trait TechniqueParams: Default + Clone + Serialize + for<'de> Deserialize<'de> {
+    /// One spec per field, in declaration order.
+    fn schema() -> Vec<ParamSpec>;
+    /// The generic form of these values.
+    fn to_values(&self) -> ParamValues;
+    /// Builds the struct from generic values; missing keys take their defaults, unknown keys
+    /// and out-of-range values are errors.
+    fn from_values(values: &ParamValues) -> Result<Self, ParamError>;
+}
+
+/// Declares an enumeration usable as a choice parameter.
+#[macro_export]
+macro_rules! param_choice {
+    ($(#[doc = $doc:literal])* $vis:vis enum $name:ident { $($variant:ident),+ $(,)? }) => {
+        $(#[doc = $doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, $crate::serde::Serialize, $crate::serde::Deserialize)]
+        #[serde(crate = "zoo_host::serde")]
+        $vis enum $name { $($variant),+ }
+
+        impl $name {
+            /// Every variant's name, in declaration order.
+            pub const NAMES: &'static [&'static str] = &[$(stringify!($variant)),+];
+            /// This variant's name.
+            pub fn name(self) -> &'static str {
+                match self { $($name::$variant => stringify!($variant)),+ }
+            }
+        }
+
+        impl $crate::params::ParamType for $name {
+            fn kind(_: Option<(f64, f64)>, _: Option<f64>) -> $crate::params::ParamKind {
+                $crate::params::ParamKind::Choice { options: Self::NAMES }
+            }
+            fn to_value(&self) -> $crate::params::ParamValue {
+                $crate::params::ParamValue::Choice(self.name().to_string())
+            }
+            fn from_value(value: &$crate::params::ParamValue) -> Option<Self> {
+                match value {
+                    $($crate::params::ParamValue::Choice(c) if c == stringify!($variant) => Some($name::$variant),)+
+                    _ => None,
+                }
+            }
+        }
+    };
+}
+
+/// Declares a technique's parameter struct together with its schema.
+///
+/// Each field reads `/// doc` `name: Type = default, range(min, max), step(s);` where range and
+/// step are optional (they apply to numbers). See the [module docs](crate::params) for an example.
+#[macro_export]
+macro_rules! technique_params {
+    (
+        $(#[doc = $doc:literal])*
+        $vis:vis struct $name:ident {
+            $(
+                $(#[doc = $fdoc:literal])+
+                $field:ident : $ty:ty = $default:expr
+                $(, range($min:expr, $max:expr))?
+                $(, step($step:expr))?
+                ;
+            )*
+        }
+    ) => {
+        $(#[doc = $doc])*
+        #[derive(Debug, Clone, PartialEq, $crate::serde::Serialize, $crate::serde::Deserialize)]
+        #[serde(crate = "zoo_host::serde", default, deny_unknown_fields)]
+        $vis struct $name {
+            $( $(#[doc = $fdoc])+ pub $field: $ty, )*
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self { $($field: $default,)* }
+            }
+        }
+
+        impl $crate::params::TechniqueParams for $name {
+            fn schema() -> Vec<$crate::params::ParamSpec> {
+                let defaults = Self::default();
+                vec![$(
+                    $crate::params::ParamSpec {
+                        key: stringify!($field),
+                        doc: $crate::params::join_doc(&[$($fdoc),+]),
+                        kind: <$ty as $crate::params::ParamType>::kind(
+                            None $(.or(Some(($min as f64, $max as f64))))?,
+                            None $(.or(Some($step as f64)))?,
+                        ),
+                        default: $crate::params::ParamType::to_value(&defaults.$field),
+                    },
+                )*]
+            }
+
+            fn to_values(&self) -> $crate::params::ParamValues {
+                let mut values = $crate::params::ParamValues::new();
+                $(values.insert(
+                    stringify!($field).to_string(),
+                    $crate::params::ParamType::to_value(&self.$field),
+                );)*
+                values
+            }
+
+            fn from_values(values: &$crate::params::ParamValues) -> Result<Self, $crate::params::ParamError> {
+                let schema = Self::schema();
+                for (key, value) in values {
+                    $crate::params::find_spec(&schema, key)?.check(value)?;
+                }
+                let mut out = Self::default();
+                $(
+                    if let Some(value) = values.get(stringify!($field)) {
+                        out.$field = $crate::params::ParamType::from_value(value).ok_or_else(|| {
+                            $crate::params::ParamError::Invalid {
+                                key: stringify!($field).to_string(),
+                                message: format!("cannot convert `{value}`"),
+                            }
+                        })?;
+                    }
+                )*
+                Ok(out)
+            }
+        }
+    };
+}
+
+/// Joins doc-comment lines into one trimmed string (used by [`technique_params!`]).
+pub fn join_doc(lines: &[&'static str]) -> &'static str {
+    let text = lines
+        .iter()
+        .map(|l| l.trim())
+        .collect::<Vec<_>>()
+        .join(" ");
+    // Schemas are built a handful of times per run; leaking keeps `ParamSpec` `'static`.
+    Box::leak(text.into_boxed_str())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    crate::param_choice! {
+        /// Test choice.
+        pub enum Mode { Fast, Exact }
+    }
+
+    crate::technique_params! {
+        /// Test parameters.
+        pub struct TestParams {
+            /// Map size.
+            size: u32 = 1024, range(256, 8192), step(256);
+            /// Bias.
+            bias: f32 = 0.5, range(0.0, 1.0);
+            /// Switch.
+            on: bool = true;
+            /// Mode.
+            mode: Mode = Mode::Exact;
+        }
+    }
+
+    #[test]
+    fn schema_matches_declaration() {
+        let schema = TestParams::schema();
+        assert_eq!(
+            schema.iter().map(|s| s.key).collect::<Vec<_>>(),
+            ["size", "bias", "on", "mode"]
+        );
+        assert_eq!(
+            schema[0].kind,
+            ParamKind::Int {
+                min: 256,
+                max: 8192,
+                step: 256
+            }
+        );
+        assert_eq!(schema[0].doc, "Map size.");
+        assert_eq!(schema[3].default, ParamValue::Choice("Exact".into()));
+    }
+
+    #[test]
+    fn assignments_are_validated() {
+        let schema = TestParams::schema();
+        let mut values = defaults(&schema);
+        apply_assignments(
+            &schema,
+            &mut values,
+            &[("size".into(), "4096".into()), ("mode".into(), "fast".into())],
+        )
+        .unwrap();
+        let p = TestParams::from_values(&values).unwrap();
+        assert_eq!(p.size, 4096);
+        assert_eq!(p.mode, Mode::Fast);
+
+        let err = apply_assignments(&schema, &mut values, &[("size".into(), "99999".into())])
+            .unwrap_err();
+        assert!(err.to_string().contains("out of range 256..=8192"), "{err}");
+        let err = apply_assignments(&schema, &mut values, &[("nope".into(), "1".into())])
+            .unwrap_err();
+        assert!(err.to_string().contains("unknown parameter `nope`"), "{err}");
+        let err =
+            apply_assignments(&schema, &mut values, &[("on".into(), "maybe".into())]).unwrap_err();
+        assert!(err.to_string().contains("expected true or false"), "{err}");
+    }
+
+    #[test]
+    fn clamp_moves_values_into_range() {
+        let schema = TestParams::schema();
+        assert_eq!(schema[1].clamp(&ParamValue::Float(3.0)), ParamValue::Float(1.0));
+        assert_eq!(schema[0].clamp(&ParamValue::Int(1)), ParamValue::Int(256));
+        assert_eq!(
+            schema[3].clamp(&ParamValue::Choice("bogus".into())),
+            ParamValue::Choice("Exact".into())
+        );
+    }
+
+    #[test]
+    fn ron_settings_round_trip_and_reject_unknown_fields() {
+        let p = TestParams {
+            bias: 0.25,
+            ..Default::default()
+        };
+        let text = ron::to_string(&p).unwrap();
+        assert_eq!(ron::from_str::<TestParams>(&text).unwrap(), p);
+        assert!(ron::from_str::<TestParams>("(sise: 3)").is_err());
+        // Missing fields take defaults.
+        assert_eq!(
+            ron::from_str::<TestParams>("(on: false)").unwrap().size,
+            1024
+        );
+    }
+}

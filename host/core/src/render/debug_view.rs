@@ -1,0 +1,159 @@
+//! Shows a G-buffer channel, a visibility slot or a technique resource instead of the final image.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
+use crate::technique::ViewMapping;
+
+/// `ViewParams` in `host/debug_view.wgsl`.
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+struct ViewParams {
+    mode: u32,
+    channel: u32,
+    min_value: f32,
+    max_value: f32,
+    near: f32,
+    far: f32,
+    _pad: [f32; 2],
+}
+
+/// The sampled type of the texture being shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SourceKind {
+    Float,
+    Depth,
+    Uint,
+}
+
+/// A texture to show and how.
+pub struct DebugSource<'a> {
+    pub view: &'a wgpu::TextureView,
+    pub mapping: ViewMapping,
+    /// Linearise perspective depth with these (near, far) planes.
+    pub linearize: Option<(f32, f32)>,
+}
+
+/// Pipelines of the debug view, one per source kind.
+pub struct DebugViewPass {
+    float: wgpu::RenderPipeline,
+    depth: wgpu::RenderPipeline,
+    uint: wgpu::RenderPipeline,
+    params: wgpu::Buffer,
+}
+
+/// Format the debug view writes (the output texture viewed without sRGB encoding).
+pub const DEBUG_TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+impl DebugViewPass {
+    /// Builds the pipelines from `host/debug_view.wgsl`.
+    pub fn new(gpu: &GpuContext, shaders: &ShaderLibrary) -> Result<DebugViewPass, ShaderError> {
+        let device = &gpu.device;
+        let module = shaders.create_module(device, "host/debug_view.wgsl")?;
+        let pipeline = |entry: &str| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(&format!("debug view pipeline ({entry})")),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("fullscreen_vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &[Some(DEBUG_TARGET_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        Ok(DebugViewPass {
+            float: pipeline("fs_float"),
+            depth: pipeline("fs_depth"),
+            uint: pipeline("fs_uint"),
+            params: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("debug view params"),
+                size: size_of::<ViewParams>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        })
+    }
+
+    /// Records a pass that draws `source` into `target` (a non-sRGB view).
+    pub fn record(
+        &self,
+        gpu: &GpuContext,
+        recorder: &mut PassRecorder<'_>,
+        target: &wgpu::TextureView,
+        source: &DebugSource<'_>,
+    ) {
+        let (kind, params) = match source.mapping {
+            ViewMapping::Color { min, max } => (SourceKind::Float, (0, 0, min, max)),
+            ViewMapping::Channel { channel, min, max } => {
+                (SourceKind::Float, (1, channel.min(3), min, max))
+            }
+            ViewMapping::Depth { min, max } => (
+                SourceKind::Depth,
+                (if source.linearize.is_some() { 3 } else { 2 }, 0, min, max),
+            ),
+            ViewMapping::Integer => (SourceKind::Uint, (4, 0, 0.0, 1.0)),
+        };
+        let (near, far) = source.linearize.unwrap_or((0.0, 1.0));
+        let values = ViewParams {
+            mode: params.0,
+            channel: params.1,
+            min_value: params.2,
+            max_value: params.3,
+            near,
+            far,
+            _pad: [0.0; 2],
+        };
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&values));
+        let (pipeline, binding) = match kind {
+            SourceKind::Float => (&self.float, 1),
+            SourceKind::Depth => (&self.depth, 2),
+            SourceKind::Uint => (&self.uint, 3),
+        };
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("debug view bind group"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding,
+                    resource: wgpu::BindingResource::TextureView(source.view),
+                },
+            ],
+        });
+        let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("Debug view"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

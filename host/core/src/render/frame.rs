@@ -1,0 +1,273 @@
+//! Bind group 0: camera, lights and objects, laid out as in `shaders/common/frame.wgsl`.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, UVec2, Vec3};
+
+use super::visibility::SlotAssignment;
+use crate::gpu::GpuContext;
+use crate::scene::{Camera, Light, LightKind, Scene};
+
+/// `Camera` in WGSL.
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+pub struct CameraUniform {
+    pub view: [[f32; 4]; 4],
+    pub proj: [[f32; 4]; 4],
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub position: [f32; 3],
+    pub near: f32,
+    pub size: [f32; 2],
+    pub far: f32,
+    pub light_count: u32,
+    pub ambient: [f32; 3],
+    pub _pad: f32,
+}
+
+/// `Light` in WGSL.
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuLight {
+    pub position: [f32; 3],
+    pub kind: u32,
+    pub direction: [f32; 3],
+    pub range: f32,
+    pub radiance: [f32; 3],
+    pub radius: f32,
+    pub cos_outer: f32,
+    pub cos_inner: f32,
+    pub slot_layer: u32,
+    pub slot_channel: u32,
+}
+
+/// `Object` in WGSL.
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuObject {
+    pub model: [[f32; 4]; 4],
+    pub color: [f32; 4],
+    pub material: [f32; 4],
+}
+
+/// The view and projection of the current camera at the current size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraMatrices {
+    pub view: Mat4,
+    pub proj: Mat4,
+    pub view_proj: Mat4,
+}
+
+impl CameraMatrices {
+    /// Matrices of `camera` for an output of `size` pixels.
+    pub fn new(camera: &Camera, size: UVec2) -> CameraMatrices {
+        let view = camera.view();
+        let proj = camera.projection(size.x as f32 / size.y.max(1) as f32);
+        CameraMatrices {
+            view,
+            proj,
+            view_proj: proj * view,
+        }
+    }
+}
+
+impl GpuLight {
+    /// GPU form of `light` writing into `slot` = (layer, channel).
+    pub fn new(light: &Light, slot: (u32, u32)) -> GpuLight {
+        let outer = light.spot_angle;
+        let inner = outer * (1.0 - light.spot_softness);
+        GpuLight {
+            position: light.position.to_array(),
+            kind: match light.kind {
+                LightKind::Directional => 0,
+                LightKind::Point => 1,
+                LightKind::Spot => 2,
+            },
+            direction: light.direction.to_array(),
+            range: if light.range.is_finite() {
+                light.range
+            } else {
+                f32::MAX
+            },
+            radiance: light.radiance.to_array(),
+            radius: light.radius,
+            cos_outer: outer.cos(),
+            cos_inner: inner.cos(),
+            slot_layer: slot.0,
+            slot_channel: slot.1,
+        }
+    }
+}
+
+/// Buffers and bind group 0.
+pub struct FrameBindings {
+    pub layout: wgpu::BindGroupLayout,
+    pub bind_group: wgpu::BindGroup,
+    pub camera_buffer: wgpu::Buffer,
+    pub light_buffer: wgpu::Buffer,
+    pub object_buffer: wgpu::Buffer,
+    /// Matrices last uploaded.
+    pub matrices: CameraMatrices,
+}
+
+/// Layout of bind group 0 (`common/frame.wgsl`).
+pub fn frame_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let storage = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("frame bind group layout"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            storage(1),
+            storage(2),
+        ],
+    })
+}
+
+impl FrameBindings {
+    /// Creates the buffers for `scene` (its light count fixes the light buffer's size).
+    pub fn new(gpu: &GpuContext, scene: &Scene) -> FrameBindings {
+        let device = &gpu.device;
+        let layout = frame_layout(device);
+        let buffer = |label: &str, size: usize, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16) as u64,
+                usage: usage | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let camera_buffer = buffer(
+            "camera uniform",
+            size_of::<CameraUniform>(),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let object_buffer = buffer(
+            "objects storage",
+            size_of::<GpuObject>() * scene.objects.len(),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let light_capacity = scene.lights.len();
+        let objects: Vec<GpuObject> = scene
+            .objects
+            .iter()
+            .map(|o| GpuObject {
+                model: o.transform.to_cols_array_2d(),
+                color: o.color.extend(o.specular).to_array(),
+                material: [o.shininess, f32::from(u8::from(o.casts_shadows)), 0.0, 0.0],
+            })
+            .collect();
+        gpu.queue
+            .write_buffer(&object_buffer, 0, bytemuck::cast_slice(&objects));
+        let light_buffer = light_buffer(gpu, light_capacity);
+        let bind_group = bind_group(gpu, &layout, &camera_buffer, &light_buffer, &object_buffer);
+        FrameBindings {
+            layout,
+            bind_group,
+            camera_buffer,
+            light_buffer,
+            object_buffer,
+            matrices: CameraMatrices::new(&scene.camera, UVec2::ONE),
+        }
+    }
+
+    /// Resizes the light buffer for `count` lights.
+    pub fn set_light_capacity(&mut self, gpu: &GpuContext, count: usize) {
+        self.light_buffer = light_buffer(gpu, count);
+        self.bind_group = bind_group(
+            gpu,
+            &self.layout,
+            &self.camera_buffer,
+            &self.light_buffer,
+            &self.object_buffer,
+        );
+    }
+
+    /// Uploads the camera, ambient term and lights with their slots.
+    pub fn update(
+        &mut self,
+        gpu: &GpuContext,
+        camera: &Camera,
+        ambient: Vec3,
+        lights: &[Light],
+        slots: &SlotAssignment,
+        size: UVec2,
+    ) {
+        let m = CameraMatrices::new(camera, size);
+        let uniform = CameraUniform {
+            view: m.view.to_cols_array_2d(),
+            proj: m.proj.to_cols_array_2d(),
+            view_proj: m.view_proj.to_cols_array_2d(),
+            inv_view_proj: m.view_proj.inverse().to_cols_array_2d(),
+            position: camera.position.to_array(),
+            near: camera.near,
+            size: [size.x as f32, size.y as f32],
+            far: camera.far,
+            light_count: lights.len() as u32,
+            ambient: ambient.to_array(),
+            _pad: 0.0,
+        };
+        gpu.queue
+            .write_buffer(&self.camera_buffer, 0, bytemuck::bytes_of(&uniform));
+        let gpu_lights: Vec<GpuLight> = lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| GpuLight::new(l, slots.slot(i)))
+            .collect();
+        gpu.queue
+            .write_buffer(&self.light_buffer, 0, bytemuck::cast_slice(&gpu_lights));
+        self.matrices = m;
+    }
+}
+
+fn light_buffer(gpu: &GpuContext, count: usize) -> wgpu::Buffer {
+    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("lights storage"),
+        size: (size_of::<GpuLight>() * count.max(1)) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+fn bind_group(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    camera: &wgpu::Buffer,
+    lights: &wgpu::Buffer,
+    objects: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("frame bind group"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: camera.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: lights.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: objects.as_entire_binding(),
+            },
+        ],
+    })
+}

@@ -1,0 +1,138 @@
+//! The deferred lighting pass, identical for every technique.
+
+use super::frame::FrameBindings;
+use super::gbuffer::GBuffer;
+use super::visibility::{IndirectTarget, VisibilityTargets};
+use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
+
+/// Format of the final image.
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+
+/// Pipeline and layout of the lighting pass.
+pub struct LightingPass {
+    pipeline: wgpu::RenderPipeline,
+    inputs_layout: wgpu::BindGroupLayout,
+}
+
+impl LightingPass {
+    /// Builds the pipeline from `host/lighting.wgsl`.
+    pub fn new(
+        gpu: &GpuContext,
+        shaders: &ShaderLibrary,
+        frame: &FrameBindings,
+        gbuffer: &GBuffer,
+    ) -> Result<LightingPass, ShaderError> {
+        let device = &gpu.device;
+        let module = shaders.create_module(device, "host/lighting.wgsl")?;
+        let texture = |binding, view_dimension| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let inputs_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lighting inputs layout"),
+            entries: &[
+                texture(0, wgpu::TextureViewDimension::D2Array),
+                texture(1, wgpu::TextureViewDimension::D2),
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lighting pipeline layout"),
+            bind_group_layouts: &[
+                Some(&frame.layout),
+                Some(&gbuffer.layout),
+                Some(&inputs_layout),
+            ],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("lighting pipeline"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("fullscreen_vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: OUTPUT_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(LightingPass {
+            pipeline,
+            inputs_layout,
+        })
+    }
+
+    /// Bind group of the visibility and indirect inputs.
+    pub fn inputs(
+        &self,
+        gpu: &GpuContext,
+        visibility: &VisibilityTargets,
+        indirect: &IndirectTarget,
+    ) -> wgpu::BindGroup {
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lighting inputs"),
+            layout: &self.inputs_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&visibility.array_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&indirect.view),
+                },
+            ],
+        })
+    }
+
+    /// Records the lighting pass into `output`.
+    pub fn record(
+        &self,
+        recorder: &mut PassRecorder<'_>,
+        output: &wgpu::TextureView,
+        frame: &FrameBindings,
+        gbuffer: &GBuffer,
+        inputs: &wgpu::BindGroup,
+    ) {
+        let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("Lighting"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: output,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &frame.bind_group, &[]);
+        pass.set_bind_group(1, &gbuffer.bind_group, &[]);
+        pass.set_bind_group(2, inputs, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

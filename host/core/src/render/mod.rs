@@ -1,0 +1,15 @@
+//! The deferred renderer shared by every technique.
+
+pub mod debug_view;
+pub mod frame;
+pub mod gbuffer;
+pub mod lighting;
+mod renderer;
+pub mod scene_buffers;
+pub mod visibility;
+
+pub use frame::{CameraMatrices, FrameBindings};
+pub use gbuffer::GBuffer;
+pub use renderer::{GBufferData, MAX_OUTPUT_SIDE, RenderError, Renderer, View};
+pub use scene_buffers::{SceneBuffers, Vertex};
+pub use visibility::{IndirectTarget, SlotAssignment, VisibilityTargets, channel_writes};

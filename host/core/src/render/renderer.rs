@@ -1,0 +1,636 @@
+//! One frame: G-buffer, visibility clear, the technique's passes, then lighting or a debug view.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::str::FromStr;
+use std::sync::Arc;
+
+use glam::{UVec2, Vec3, Vec4};
+
+use super::debug_view::{DEBUG_TARGET_FORMAT, DebugSource, DebugViewPass};
+use super::frame::FrameBindings;
+use super::gbuffer::{GBuffer, GBufferPass};
+use super::lighting::{LightingPass, OUTPUT_FORMAT};
+use super::scene_buffers::SceneBuffers;
+use super::visibility::{IndirectTarget, SlotAssignment, VisibilityTargets};
+use crate::gpu::{
+    FrameTimings, GpuContext, PassOwner, PassRecorder, ShaderError, ShaderLibrary,
+    TimestampQueries, readback,
+};
+use crate::params::{self, ParamValues};
+use crate::scene::{Camera, Light, Scene};
+use crate::technique::{
+    self, Changes, RenderContext, ShadowTechnique, TechniqueError, TechniqueRegistration,
+    ViewMapping,
+};
+
+/// What the output image shows.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum View {
+    /// The lit image.
+    Final,
+    /// Visibility of one light as greyscale.
+    Visibility { light: usize },
+    /// World normals as colour.
+    Normals,
+    /// Linearised depth.
+    Depth,
+    /// Albedo.
+    Albedo,
+    /// A resource the technique marks viewable.
+    Resource(String),
+}
+
+impl FromStr for View {
+    type Err = std::convert::Infallible;
+
+    /// `final`, `visibility` (light 0), `visibility:N`, `normals`, `depth`, `albedo`, or a
+    /// technique resource name.
+    fn from_str(s: &str) -> Result<View, Self::Err> {
+        Ok(match s {
+            "final" => View::Final,
+            "visibility" => View::Visibility { light: 0 },
+            "normals" => View::Normals,
+            "depth" => View::Depth,
+            "albedo" => View::Albedo,
+            other => match other
+                .strip_prefix("visibility:")
+                .and_then(|n| n.parse().ok())
+            {
+                Some(light) => View::Visibility { light },
+                None => View::Resource(other.to_string()),
+            },
+        })
+    }
+}
+
+/// Errors creating the renderer.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error("invalid output size {0}x{1}: both sides must be 1..={2}")]
+    Size(u32, u32, u32),
+    #[error(transparent)]
+    Shader(#[from] ShaderError),
+    #[error(transparent)]
+    Technique(#[from] TechniqueError),
+    #[error("view `{0}`: {1}")]
+    View(String, String),
+}
+
+/// The G-buffer as read back for the judge: one entry per pixel, row-major from the top.
+#[derive(Debug, Clone)]
+pub struct GBufferData {
+    pub size: UVec2,
+    /// World position; w = 1 on geometry, 0 on background.
+    pub positions: Vec<Vec4>,
+    /// World normal (facing the camera).
+    pub normals: Vec<Vec3>,
+}
+
+struct ActiveTechnique {
+    registration: &'static TechniqueRegistration,
+    params: ParamValues,
+    instance: Box<dyn ShadowTechnique>,
+    pending: Changes,
+}
+
+/// Renders scenes with one technique at a time.
+pub struct Renderer {
+    gpu: Arc<GpuContext>,
+    shaders: ShaderLibrary,
+    scene: Scene,
+    camera: Camera,
+    lights: Vec<Light>,
+    size: UVec2,
+    scene_buffers: SceneBuffers,
+    frame: FrameBindings,
+    gbuffer: GBuffer,
+    visibility: VisibilityTargets,
+    indirect: IndirectTarget,
+    output: wgpu::Texture,
+    output_view: wgpu::TextureView,
+    output_debug_view: wgpu::TextureView,
+    gbuffer_pass: GBufferPass,
+    lighting: LightingPass,
+    lighting_inputs: wgpu::BindGroup,
+    debug: DebugViewPass,
+    timestamps: Option<TimestampQueries>,
+    technique: ActiveTechnique,
+}
+
+fn create_output(gpu: &GpuContext, size: UVec2) -> (wgpu::Texture, wgpu::TextureView, wgpu::TextureView) {
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("output image"),
+        size: wgpu::Extent3d {
+            width: size.x,
+            height: size.y,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: OUTPUT_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[DEBUG_TARGET_FORMAT],
+    });
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("output image view"),
+        ..Default::default()
+    });
+    let debug_view = texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("output image view (linear, debug)"),
+        format: Some(DEBUG_TARGET_FORMAT),
+        ..Default::default()
+    });
+    (texture, view, debug_view)
+}
+
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".to_string())
+}
+
+/// Runs plugin code, turning panics and wgpu validation errors into [`TechniqueError`]s.
+fn guarded<T>(
+    gpu: &GpuContext,
+    id: &str,
+    f: impl FnOnce() -> Result<T, TechniqueError>,
+) -> Result<T, TechniqueError> {
+    let (outcome, validation) = gpu.validation_scope(|| catch_unwind(AssertUnwindSafe(f)));
+    let value = match outcome {
+        Ok(result) => result?,
+        Err(payload) => {
+            return Err(TechniqueError::Panicked {
+                id: id.to_string(),
+                message: panic_message(payload.as_ref()),
+            });
+        }
+    };
+    match validation {
+        Some(message) => Err(TechniqueError::Validation {
+            id: id.to_string(),
+            message,
+        }),
+        None => Ok(value),
+    }
+}
+
+/// Creates a technique through its factory after validating `values` against its schema.
+fn instantiate(
+    gpu: &GpuContext,
+    registration: &'static TechniqueRegistration,
+    values: &ParamValues,
+) -> Result<ActiveTechnique, TechniqueError> {
+    if let Some(reason) = registration.unavailable_reason(gpu) {
+        return Err(TechniqueError::Unavailable {
+            id: registration.id.to_string(),
+            reason,
+        });
+    }
+    let schema = (registration.params)();
+    let mut params = params::defaults(&schema);
+    for (key, value) in values {
+        params::find_spec(&schema, key)?.check(value)?;
+        params.insert(key.clone(), value.clone());
+    }
+    let instance = guarded(gpu, registration.id, || (registration.create)(gpu, &params))?;
+    Ok(ActiveTechnique {
+        registration,
+        params,
+        instance,
+        pending: Changes::ALL,
+    })
+}
+
+/// Borrows the renderer's fields (not the technique) as a [`RenderContext`].
+macro_rules! render_context {
+    ($renderer:ident) => {
+        RenderContext {
+            gpu: &$renderer.gpu,
+            shaders: &$renderer.shaders,
+            scene: &$renderer.scene,
+            scene_buffers: &$renderer.scene_buffers,
+            frame: &$renderer.frame,
+            gbuffer: &$renderer.gbuffer,
+            visibility: &$renderer.visibility,
+            indirect: &$renderer.indirect,
+            camera: &$renderer.camera,
+            lights: &$renderer.lights,
+            size: $renderer.size,
+        }
+    };
+}
+
+/// Largest accepted output side.
+pub const MAX_OUTPUT_SIDE: u32 = 8192;
+
+impl Renderer {
+    /// Creates a renderer for `scene` at `size`, starting with the `unshadowed` technique.
+    pub fn new(gpu: Arc<GpuContext>, scene: Scene, size: UVec2) -> Result<Renderer, RenderError> {
+        Self::with_shaders(gpu, scene, size, ShaderLibrary::embedded())
+    }
+
+    /// As [`Renderer::new`] with a given shader library (the viewer reads shaders from disk).
+    pub fn with_shaders(
+        gpu: Arc<GpuContext>,
+        scene: Scene,
+        size: UVec2,
+        shaders: ShaderLibrary,
+    ) -> Result<Renderer, RenderError> {
+        check_size(size)?;
+        let baseline = technique::find_technique(crate::builtin::UNSHADOWED_ID)?;
+        let technique = instantiate(&gpu, baseline, &ParamValues::new())?;
+        let scene_buffers = SceneBuffers::new(&gpu, &scene);
+        let frame = FrameBindings::new(&gpu, &scene);
+        let gbuffer = GBuffer::new(&gpu, size);
+        let slots = SlotAssignment::one_per_light(scene.lights.len());
+        let visibility = VisibilityTargets::new(&gpu, size, slots);
+        let indirect = IndirectTarget::new(&gpu, size);
+        let (output, output_view, output_debug_view) = create_output(&gpu, size);
+        let gbuffer_pass = GBufferPass::new(&gpu, &shaders, &frame)?;
+        let lighting = LightingPass::new(&gpu, &shaders, &frame, &gbuffer)?;
+        let lighting_inputs = lighting.inputs(&gpu, &visibility, &indirect);
+        let debug = DebugViewPass::new(&gpu, &shaders)?;
+        let timestamps = TimestampQueries::new(&gpu);
+        Ok(Renderer {
+            camera: scene.camera,
+            lights: scene.lights.clone(),
+            gpu,
+            shaders,
+            scene,
+            size,
+            scene_buffers,
+            frame,
+            gbuffer,
+            visibility,
+            indirect,
+            output,
+            output_view,
+            output_debug_view,
+            gbuffer_pass,
+            lighting,
+            lighting_inputs,
+            debug,
+            timestamps,
+            technique,
+        })
+    }
+
+    /// The GPU context.
+    pub fn gpu(&self) -> &Arc<GpuContext> {
+        &self.gpu
+    }
+
+    /// The scene being rendered.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Output size.
+    pub fn size(&self) -> UVec2 {
+        self.size
+    }
+
+    /// The current lights.
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// The current camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The active technique's registration.
+    pub fn technique(&self) -> &'static TechniqueRegistration {
+        self.technique.registration
+    }
+
+    /// The active technique instance (resources, counters, passes).
+    pub fn technique_instance(&self) -> &dyn ShadowTechnique {
+        self.technique.instance.as_ref()
+    }
+
+    /// The active technique's parameter values.
+    pub fn technique_params(&self) -> &ParamValues {
+        &self.technique.params
+    }
+
+    /// The visibility slots in use.
+    pub fn slots(&self) -> &SlotAssignment {
+        &self.visibility.slots
+    }
+
+    /// Switches to technique `id` with `values` (missing keys take defaults). On error the
+    /// current technique stays active. The old technique's resources are dropped.
+    pub fn set_technique(&mut self, id: &str, values: &ParamValues) -> Result<(), TechniqueError> {
+        let registration = technique::find_technique(id)?;
+        let next = instantiate(&self.gpu, registration, values)?;
+        self.technique = next;
+        self.update_slots();
+        Ok(())
+    }
+
+    /// Changes the output size.
+    pub fn set_size(&mut self, size: UVec2) -> Result<(), RenderError> {
+        check_size(size)?;
+        if size != self.size {
+            self.size = size;
+            self.gbuffer = GBuffer::new(&self.gpu, size);
+            self.indirect = IndirectTarget::new(&self.gpu, size);
+            (self.output, self.output_view, self.output_debug_view) = create_output(&self.gpu, size);
+            self.visibility =
+                VisibilityTargets::new(&self.gpu, size, self.visibility.slots.clone());
+            self.lighting_inputs = self.lighting.inputs(&self.gpu, &self.visibility, &self.indirect);
+            self.technique.pending.resolution = true;
+        }
+        Ok(())
+    }
+
+    /// Moves the camera.
+    pub fn set_camera(&mut self, camera: Camera) {
+        if camera != self.camera {
+            self.camera = camera;
+            self.technique.pending.camera = true;
+        }
+    }
+
+    /// Replaces the lights (same count as the scene's, at most).
+    pub fn set_lights(&mut self, lights: Vec<Light>) {
+        if lights != self.lights {
+            let count_changed = lights.len() != self.lights.len();
+            self.lights = lights;
+            if count_changed {
+                self.frame.set_light_capacity(&self.gpu, self.lights.len());
+            }
+            self.update_slots();
+            self.technique.pending.lights = true;
+        }
+    }
+
+    fn update_slots(&mut self) {
+        let slots = if self.technique.instance.packs_visibility_slots() {
+            SlotAssignment::packed(&self.lights)
+        } else {
+            SlotAssignment::one_per_light(self.lights.len())
+        };
+        if slots != self.visibility.slots {
+            self.visibility = VisibilityTargets::new(&self.gpu, self.size, slots);
+            self.lighting_inputs = self.lighting.inputs(&self.gpu, &self.visibility, &self.indirect);
+            self.technique.pending.lights = true;
+        }
+    }
+
+    /// Renders one frame into the output image and returns its pass timings. If the technique
+    /// fails (error, panic or GPU validation error) it is replaced by `unshadowed` and the error
+    /// is returned; the next frame renders normally.
+    pub fn render(&mut self, view: &View) -> Result<FrameTimings, RenderError> {
+        self.frame.update(
+            &self.gpu,
+            &self.camera,
+            self.scene.ambient,
+            &self.lights,
+            &self.visibility.slots,
+            self.size,
+        );
+        let id = self.technique.registration.id;
+        if self.technique.pending != Changes::default() {
+            let changes = self.technique.pending;
+            let ctx = render_context!(self);
+            let active = &mut self.technique;
+            let prepared = guarded(&self.gpu, id, || active.instance.prepare(&ctx, changes));
+            if let Err(e) = prepared {
+                return Err(self.fallback_later(e));
+            }
+            self.technique.pending = Changes::default();
+        }
+
+        let ctx = render_context!(self);
+        let mut recorder = PassRecorder::new(&self.gpu, self.timestamps.as_ref());
+        self.gbuffer_pass.record(
+            &mut recorder,
+            &self.gbuffer,
+            &self.frame,
+            &self.scene,
+            &self.scene_buffers,
+        );
+        clear_visibility(&mut recorder, &self.visibility, &self.indirect);
+        recorder.set_owner(PassOwner::Technique);
+        let active = &mut self.technique;
+        let recorded = guarded(&self.gpu, id, || active.instance.record(&ctx, &mut recorder));
+        if let Err(e) = recorded {
+            drop(recorder);
+            self.gpu.wait_idle();
+            return Err(self.fallback_later(e));
+        }
+        recorder.set_owner(PassOwner::Host);
+        match view {
+            View::Final => self.lighting.record(
+                &mut recorder,
+                &self.output_view,
+                &self.frame,
+                &self.gbuffer,
+                &self.lighting_inputs,
+            ),
+            other => {
+                let source = self.debug_source(other)?;
+                self.debug
+                    .record(&self.gpu, &mut recorder, &self.output_debug_view, &source);
+            }
+        }
+        let timings = recorder.finish();
+        let errors = self.gpu.take_uncaptured_errors();
+        if !errors.is_empty() {
+            return Err(self.fallback_later(TechniqueError::Validation {
+                id: id.to_string(),
+                message: errors.join("; "),
+            }));
+        }
+        Ok(timings)
+    }
+
+    /// Swaps in `unshadowed` after a failure and passes the error on.
+    fn fallback_later(&mut self, error: TechniqueError) -> RenderError {
+        log::error!("{error}; falling back to `{}`", crate::builtin::UNSHADOWED_ID);
+        if let Ok(baseline) = technique::find_technique(crate::builtin::UNSHADOWED_ID)
+            && let Ok(next) = instantiate(&self.gpu, baseline, &ParamValues::new())
+        {
+            self.technique = next;
+            self.update_slots();
+        }
+        RenderError::Technique(error)
+    }
+
+    fn debug_source(&self, view: &View) -> Result<DebugSource<'_>, RenderError> {
+        let (lo, hi) = self.scene.bounds();
+        let farthest = [lo, hi]
+            .iter()
+            .map(|c| c.distance(self.camera.position))
+            .fold(0.0, f32::max)
+            + lo.distance(hi);
+        Ok(match view {
+            View::Final => unreachable!("the final view is the lighting pass"),
+            View::Visibility { light } => {
+                if *light >= self.lights.len() {
+                    return Err(RenderError::View(
+                        format!("visibility:{light}"),
+                        format!("the scene has {} lights", self.lights.len()),
+                    ));
+                }
+                let (layer, channel) = self.visibility.slots.slot(*light);
+                DebugSource {
+                    view: &self.visibility.layer_views[layer as usize],
+                    mapping: ViewMapping::Channel {
+                        channel,
+                        min: 0.0,
+                        max: 1.0,
+                    },
+                    linearize: None,
+                }
+            }
+            View::Normals => DebugSource {
+                view: &self.gbuffer.normal_view,
+                mapping: ViewMapping::Color { min: -1.0, max: 1.0 },
+                linearize: None,
+            },
+            View::Albedo => DebugSource {
+                view: &self.gbuffer.albedo_view,
+                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
+                linearize: None,
+            },
+            View::Depth => DebugSource {
+                view: &self.gbuffer.depth_sample_view,
+                mapping: ViewMapping::Depth {
+                    min: self.camera.near,
+                    max: farthest.min(self.camera.far),
+                },
+                linearize: Some((self.camera.near, self.camera.far)),
+            },
+            View::Resource(name) => {
+                let image = self.technique.instance.debug_view(name).ok_or_else(|| {
+                    let viewable: Vec<String> = self
+                        .technique
+                        .instance
+                        .resources()
+                        .into_iter()
+                        .filter(|r| r.viewable)
+                        .map(|r| r.name)
+                        .collect();
+                    RenderError::View(
+                        name.clone(),
+                        format!(
+                            "not a view of `{}`; choose final, visibility[:N], normals, depth, albedo{}",
+                            self.technique.registration.id,
+                            viewable.iter().map(|v| format!(", {v}")).collect::<String>()
+                        ),
+                    )
+                })?;
+                DebugSource {
+                    view: image.view,
+                    mapping: image.mapping,
+                    linearize: None,
+                }
+            }
+        })
+    }
+
+    /// The output image (sRGB RGBA8).
+    pub fn read_output(&self) -> image::RgbaImage {
+        let bytes = readback::read_texture(&self.gpu, &self.output, 0, wgpu::TextureAspect::All, 4);
+        image::RgbaImage::from_raw(self.size.x, self.size.y, bytes)
+            .expect("readback has width * height texels")
+    }
+
+    /// Visibility of light `light` per pixel, in [0, 1].
+    pub fn read_visibility(&self, light: usize) -> Vec<f32> {
+        let (layer, channel) = self.visibility.slots.slot(light);
+        let bytes = readback::read_texture(
+            &self.gpu,
+            &self.visibility.texture,
+            layer,
+            wgpu::TextureAspect::All,
+            4,
+        );
+        bytes
+            .chunks_exact(4)
+            .map(|t| t[channel as usize] as f32 / 255.0)
+            .collect()
+    }
+
+    /// World positions and normals per pixel.
+    pub fn read_gbuffer(&self) -> GBufferData {
+        let positions = readback::f32s(&readback::read_texture(
+            &self.gpu,
+            &self.gbuffer.position,
+            0,
+            wgpu::TextureAspect::All,
+            16,
+        ));
+        let normals = readback::f16s(&readback::read_texture(
+            &self.gpu,
+            &self.gbuffer.normal,
+            0,
+            wgpu::TextureAspect::All,
+            8,
+        ));
+        GBufferData {
+            size: self.size,
+            positions: positions.chunks_exact(4).map(Vec4::from_slice).collect(),
+            normals: normals
+                .chunks_exact(4)
+                .map(|n| Vec3::new(n[0], n[1], n[2]))
+                .collect(),
+        }
+    }
+}
+
+fn check_size(size: UVec2) -> Result<(), RenderError> {
+    if size.x == 0 || size.y == 0 || size.x > MAX_OUTPUT_SIDE || size.y > MAX_OUTPUT_SIDE {
+        return Err(RenderError::Size(size.x, size.y, MAX_OUTPUT_SIDE));
+    }
+    Ok(())
+}
+
+/// Clears every visibility layer to 1 (lit) and the indirect target to 0.
+fn clear_visibility(
+    recorder: &mut PassRecorder<'_>,
+    visibility: &VisibilityTargets,
+    indirect: &IndirectTarget,
+) {
+    let attachment = |view, value: f64| {
+        Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color {
+                    r: value,
+                    g: value,
+                    b: value,
+                    a: value,
+                }),
+                store: wgpu::StoreOp::Store,
+            },
+        })
+    };
+    let mut targets: Vec<_> = visibility
+        .layer_views
+        .iter()
+        .map(|v| attachment(v, 1.0))
+        .collect();
+    targets.push(attachment(&indirect.view, 0.0));
+    for chunk in targets.chunks(8) {
+        drop(recorder.render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("Clear visibility"),
+            color_attachments: chunk,
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        }));
+    }
+}

@@ -1,0 +1,118 @@
+//! The scene's geometry on the GPU: shared vertex and index buffers and edge adjacency.
+
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+use crate::gpu::GpuContext;
+use crate::scene::Scene;
+
+/// One vertex: world-space position and normal (24 bytes).
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+}
+
+impl Vertex {
+    /// Vertex buffer layout: location 0 position, location 1 normal.
+    pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+        array_stride: size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+    };
+}
+
+/// Geometry buffers, built once per scene.
+pub struct SceneBuffers {
+    /// All vertices (`VERTEX | STORAGE`).
+    pub vertices: wgpu::Buffer,
+    /// Triangle indices, u32 (`INDEX | STORAGE`).
+    pub indices: wgpu::Buffer,
+    /// [`crate::scene::EdgeRecord`]s (`STORAGE`).
+    pub edges: wgpu::Buffer,
+    /// Edge incidences `triangle << 1 | reversed` (`STORAGE`).
+    pub edge_faces: wgpu::Buffer,
+    /// Object index of each triangle (`STORAGE`).
+    pub triangle_objects: wgpu::Buffer,
+    pub vertex_count: u32,
+    pub index_count: u32,
+    pub edge_count: u32,
+}
+
+impl SceneBuffers {
+    /// Uploads `scene`'s geometry.
+    pub fn new(gpu: &GpuContext, scene: &Scene) -> SceneBuffers {
+        let vertices: Vec<Vertex> = scene
+            .mesh
+            .positions
+            .iter()
+            .zip(&scene.mesh.normals)
+            .map(|(p, n)| Vertex {
+                position: p.to_array(),
+                normal: n.to_array(),
+            })
+            .collect();
+        let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            // Storage bindings must not be empty.
+            let padded;
+            let contents = if contents.is_empty() {
+                padded = [0u8; 16];
+                &padded[..]
+            } else {
+                contents
+            };
+            gpu.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage,
+                })
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
+        SceneBuffers {
+            vertices: init(
+                "scene vertices",
+                bytemuck::cast_slice(&vertices),
+                wgpu::BufferUsages::VERTEX | storage,
+            ),
+            indices: init(
+                "scene indices",
+                bytemuck::cast_slice(&scene.mesh.indices),
+                wgpu::BufferUsages::INDEX | storage,
+            ),
+            edges: init(
+                "scene edges",
+                bytemuck::cast_slice(&scene.adjacency.edges),
+                storage,
+            ),
+            edge_faces: init(
+                "scene edge faces",
+                bytemuck::cast_slice(&scene.adjacency.edge_faces),
+                storage,
+            ),
+            triangle_objects: init(
+                "scene triangle objects",
+                bytemuck::cast_slice(&scene.triangle_objects()),
+                storage,
+            ),
+            vertex_count: vertices.len() as u32,
+            index_count: scene.mesh.indices.len() as u32,
+            edge_count: scene.adjacency.edges.len() as u32,
+        }
+    }
+
+    /// Draws every object (or only shadow casters) with `first_instance` = object index, so
+    /// shaders find the object's data through `@builtin(instance_index)`.
+    pub fn draw_objects(&self, pass: &mut wgpu::RenderPass<'_>, scene: &Scene, casters_only: bool) {
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        for (i, object) in scene.objects.iter().enumerate() {
+            if casters_only && !object.casts_shadows {
+                continue;
+            }
+            let range = object.indices.start as u32..object.indices.end as u32;
+            pass.draw_indexed(range, 0, i as u32..i as u32 + 1);
+        }
+    }
+}

@@ -1,0 +1,276 @@
+//! Per-light visibility storage.
+//!
+//! Visibility lives in an `Rgba8Unorm` 2D array texture; each light maps to a slot = (layer,
+//! channel). By default every light has its own slot. A technique that writes a light's
+//! visibility only inside that light's influence volume may let lights whose volumes do not
+//! overlap share a slot, so memory does not grow with one full-screen channel per light.
+
+use glam::{UVec2, Vec3};
+
+use crate::gpu::GpuContext;
+use crate::scene::{Light, LightKind};
+
+/// Texture format of the visibility array.
+pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// Which slot each light writes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SlotAssignment {
+    /// Slot index per light; slot `s` is layer `s / 4`, channel `s % 4`.
+    slots: Vec<u32>,
+    slot_count: u32,
+}
+
+impl SlotAssignment {
+    /// One slot per light.
+    pub fn one_per_light(light_count: usize) -> SlotAssignment {
+        SlotAssignment {
+            slots: (0..light_count as u32).collect(),
+            slot_count: light_count as u32,
+        }
+    }
+
+    /// Greedy colouring: each light takes the first slot none of whose lights' influence
+    /// spheres intersect its own. Directional lights reach everywhere and keep a slot alone.
+    pub fn packed(lights: &[Light]) -> SlotAssignment {
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        let mut slots = Vec::with_capacity(lights.len());
+        for (i, light) in lights.iter().enumerate() {
+            let free = members.iter().position(|group| {
+                group
+                    .iter()
+                    .all(|&j| !influences_overlap(light, &lights[j]))
+            });
+            let slot = match free {
+                Some(s) => s,
+                None => {
+                    members.push(Vec::new());
+                    members.len() - 1
+                }
+            };
+            members[slot].push(i);
+            slots.push(slot as u32);
+        }
+        SlotAssignment {
+            slots,
+            slot_count: members.len() as u32,
+        }
+    }
+
+    /// (layer, channel) of light `light`.
+    pub fn slot(&self, light: usize) -> (u32, u32) {
+        let s = self.slots[light];
+        (s / 4, s % 4)
+    }
+
+    /// Number of distinct slots.
+    pub fn slot_count(&self) -> u32 {
+        self.slot_count
+    }
+
+    /// Array layers needed (at least one).
+    pub fn layer_count(&self) -> u32 {
+        self.slot_count.div_ceil(4).max(1)
+    }
+
+    /// The lights sharing slot `slot`.
+    pub fn lights_in_slot(&self, slot: u32) -> impl Iterator<Item = usize> + '_ {
+        self.slots
+            .iter()
+            .enumerate()
+            .filter(move |(_, s)| **s == slot)
+            .map(|(i, _)| i)
+    }
+}
+
+/// Bounding sphere of a light's influence, or `None` if unbounded.
+fn influence_sphere(light: &Light) -> Option<(Vec3, f32)> {
+    match light.kind {
+        LightKind::Directional => None,
+        LightKind::Point | LightKind::Spot => Some((light.position, light.range)),
+    }
+}
+
+fn influences_overlap(a: &Light, b: &Light) -> bool {
+    match (influence_sphere(a), influence_sphere(b)) {
+        (Some((pa, ra)), Some((pb, rb))) => pa.distance(pb) < ra + rb,
+        _ => true,
+    }
+}
+
+/// The colour write mask that writes only `channel`.
+pub fn channel_writes(channel: u32) -> wgpu::ColorWrites {
+    match channel {
+        0 => wgpu::ColorWrites::RED,
+        1 => wgpu::ColorWrites::GREEN,
+        2 => wgpu::ColorWrites::BLUE,
+        _ => wgpu::ColorWrites::ALPHA,
+    }
+}
+
+/// The visibility array texture and its views.
+pub struct VisibilityTargets {
+    pub texture: wgpu::Texture,
+    /// All layers, for the lighting pass.
+    pub array_view: wgpu::TextureView,
+    /// One 2D view per layer, for render attachments.
+    pub layer_views: Vec<wgpu::TextureView>,
+    pub slots: SlotAssignment,
+}
+
+impl VisibilityTargets {
+    /// Creates storage for `slots` at `size`.
+    pub fn new(gpu: &GpuContext, size: UVec2, slots: SlotAssignment) -> VisibilityTargets {
+        let layers = slots.layer_count();
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("visibility slots"),
+            size: wgpu::Extent3d {
+                width: size.x,
+                height: size.y,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: VISIBILITY_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("visibility slots (array)"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let layer_views = (0..layers)
+            .map(|layer| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some(&format!("visibility layer {layer}")),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        VisibilityTargets {
+            texture,
+            array_view,
+            layer_views,
+            slots,
+        }
+    }
+
+    /// The attachment view and channel write mask for light `light`.
+    pub fn target(&self, light: usize) -> (&wgpu::TextureView, wgpu::ColorWrites) {
+        let (layer, channel) = self.slots.slot(light);
+        (&self.layer_views[layer as usize], channel_writes(channel))
+    }
+}
+
+/// Additive indirect radiance (`Rgba16Float`), cleared to zero each frame.
+pub struct IndirectTarget {
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+}
+
+/// Format of the indirect radiance target.
+pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+impl IndirectTarget {
+    /// Creates the target at `size`.
+    pub fn new(gpu: &GpuContext, size: UVec2) -> IndirectTarget {
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("indirect radiance"),
+            size: wgpu::Extent3d {
+                width: size.x,
+                height: size.y,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: INDIRECT_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("indirect radiance view"),
+            ..Default::default()
+        });
+        IndirectTarget { texture, view }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(x: f32, range: f32) -> Light {
+        Light {
+            kind: LightKind::Point,
+            position: Vec3::new(x, 1.0, 0.0),
+            direction: Vec3::NEG_Y,
+            radiance: Vec3::ONE,
+            range,
+            spot_angle: 0.0,
+            spot_softness: 0.0,
+            radius: 0.0,
+        }
+    }
+
+    #[test]
+    fn one_per_light_fills_channels_then_layers() {
+        let s = SlotAssignment::one_per_light(6);
+        assert_eq!(s.slot(0), (0, 0));
+        assert_eq!(s.slot(3), (0, 3));
+        assert_eq!(s.slot(5), (1, 1));
+        assert_eq!(s.layer_count(), 2);
+        assert_eq!(SlotAssignment::one_per_light(0).layer_count(), 1);
+    }
+
+    #[test]
+    fn distant_lights_share_slots_and_overlapping_ones_do_not() {
+        // A row of 64 lights 10 apart with range 4: neighbours never overlap.
+        let lights: Vec<Light> = (0..64).map(|i| point(i as f32 * 10.0, 4.0)).collect();
+        let s = SlotAssignment::packed(&lights);
+        assert_eq!(s.slot_count(), 1);
+        assert_eq!(s.layer_count(), 1);
+
+        // Range 6: neighbours (10 apart) overlap, next-but-one (20 apart) do not.
+        let lights: Vec<Light> = (0..64).map(|i| point(i as f32 * 10.0, 6.0)).collect();
+        let s = SlotAssignment::packed(&lights);
+        assert_eq!(s.slot_count(), 2);
+        for slot in 0..s.slot_count() {
+            let members: Vec<_> = s.lights_in_slot(slot).collect();
+            for (k, &a) in members.iter().enumerate() {
+                for &b in &members[k + 1..] {
+                    assert!(!influences_overlap(&lights[a], &lights[b]));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn directional_lights_are_never_packed() {
+        let mut lights = vec![point(0.0, 1.0), point(100.0, 1.0)];
+        lights.push(Light {
+            kind: LightKind::Directional,
+            ..point(0.0, f32::INFINITY)
+        });
+        let s = SlotAssignment::packed(&lights);
+        assert_eq!(s.slot(0), s.slot(1));
+        assert_ne!(s.slot(2), s.slot(0));
+        assert_eq!(s.slot_count(), 2);
+    }
+
+    #[test]
+    fn overlapping_many_lights_need_many_slots() {
+        let lights: Vec<Light> = (0..256).map(|i| point(i as f32 * 0.01, 5.0)).collect();
+        let s = SlotAssignment::packed(&lights);
+        assert_eq!(s.slot_count(), 256);
+        assert_eq!(s.layer_count(), 64);
+    }
+}

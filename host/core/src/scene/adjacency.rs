@@ -1,0 +1,239 @@
+//! Triangle edge adjacency for silhouette work, built once at scene load.
+//!
+//! Vertices are welded by exact position within each object (normals split vertices at creases;
+//! silhouettes must not see those splits). Every undirected edge lists its incident triangles with
+//! the direction in which each triangle traverses it, so techniques can count face orientations
+//! with multiplicity: an edge of a closed, consistently wound mesh has exactly two incident faces
+//! traversing it in opposite directions ([`EdgeKind::Manifold`]); an edge with one face is a
+//! [`EdgeKind::Boundary`] of an open mesh; anything else is [`EdgeKind::NonManifold`].
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use super::mesh::MeshData;
+
+/// How an edge is connected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum EdgeKind {
+    /// Two faces, opposite traversal: the normal case on closed meshes.
+    Manifold = 0,
+    /// One face: the edge of a hole or an open surface.
+    Boundary = 1,
+    /// More than two faces, or two faces traversing it the same way (inconsistent winding).
+    NonManifold = 2,
+}
+
+/// One undirected edge as stored on the GPU (16 bytes).
+///
+/// `v0 < v1` in welded numbering; the indices stored are representative indices into the scene's
+/// vertex buffer. `faces` is `first << 0` into [`Adjacency::edge_faces`]; `info` packs the face
+/// count (low 24 bits) and the [`EdgeKind`] (high 8 bits).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Pod, Zeroable)]
+#[repr(C)]
+pub struct EdgeRecord {
+    pub v0: u32,
+    pub v1: u32,
+    pub first_face: u32,
+    pub info: u32,
+}
+
+impl EdgeRecord {
+    /// Number of incident faces.
+    pub fn face_count(&self) -> u32 {
+        self.info & 0x00ff_ffff
+    }
+    /// Connectivity class.
+    pub fn kind(&self) -> EdgeKind {
+        match self.info >> 24 {
+            0 => EdgeKind::Manifold,
+            1 => EdgeKind::Boundary,
+            _ => EdgeKind::NonManifold,
+        }
+    }
+}
+
+/// Edge adjacency of a whole scene.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Adjacency {
+    /// All edges, object by object.
+    pub edges: Vec<EdgeRecord>,
+    /// Incidences: `triangle_index << 1 | reversed`, where `reversed` = 1 when the triangle
+    /// traverses the edge from `v1` to `v0`.
+    pub edge_faces: Vec<u32>,
+    /// Edge range of each object in `edges`.
+    pub object_edges: Vec<Range<u32>>,
+}
+
+impl Adjacency {
+    /// Builds adjacency for `mesh`, one object per range of `object_index_ranges` (ranges into
+    /// `mesh.indices`). Vertices are welded only within an object.
+    pub fn build(mesh: &MeshData, object_index_ranges: &[Range<usize>]) -> Adjacency {
+        let mut out = Adjacency::default();
+        for range in object_index_ranges {
+            let start = out.edges.len() as u32;
+            build_object(mesh, range.clone(), &mut out);
+            out.object_edges.push(start..out.edges.len() as u32);
+        }
+        out
+    }
+
+    fn count(&self, kind: EdgeKind) -> usize {
+        self.edges.iter().filter(|e| e.kind() == kind).count()
+    }
+
+    /// Number of boundary edges.
+    pub fn boundary_edges(&self) -> usize {
+        self.count(EdgeKind::Boundary)
+    }
+
+    /// Number of non-manifold edges.
+    pub fn non_manifold_edges(&self) -> usize {
+        self.count(EdgeKind::NonManifold)
+    }
+
+    /// Incidences of `edge` as (triangle index, reversed).
+    pub fn faces_of(&self, edge: &EdgeRecord) -> impl Iterator<Item = (u32, bool)> + '_ {
+        let start = edge.first_face as usize;
+        self.edge_faces[start..start + edge.face_count() as usize]
+            .iter()
+            .map(|f| (f >> 1, f & 1 == 1))
+    }
+}
+
+fn build_object(mesh: &MeshData, range: Range<usize>, out: &mut Adjacency) {
+    // Weld: map each vertex used by this object to the first vertex with the same position.
+    let mut weld: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut representative = |index: u32| -> u32 {
+        let p: Vec3 = mesh.positions[index as usize];
+        let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()].map(|b| {
+            // +0.0 and -0.0 are the same point.
+            if b == 0x8000_0000 { 0 } else { b }
+        });
+        *weld.entry(key).or_insert(index)
+    };
+
+    // (min, max) welded vertex pair -> incidences in order of appearance.
+    let mut incidences: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    let mut order: Vec<(u32, u32)> = Vec::new();
+    let first_triangle = range.start / 3;
+    for (t, tri) in mesh.indices[range].chunks_exact(3).enumerate() {
+        let triangle = (first_triangle + t) as u32;
+        let w = [tri[0], tri[1], tri[2]].map(&mut representative);
+        for k in 0..3 {
+            let (a, b) = (w[k], w[(k + 1) % 3]);
+            if a == b {
+                continue;
+            }
+            let key = (a.min(b), a.max(b));
+            let reversed = u32::from(a > b);
+            let list = incidences.entry(key).or_insert_with(|| {
+                order.push(key);
+                Vec::new()
+            });
+            list.push(triangle << 1 | reversed);
+        }
+    }
+
+    for key in order {
+        let faces = &incidences[&key];
+        let kind = match faces.as_slice() {
+            [_] => EdgeKind::Boundary,
+            [a, b] if (a & 1) != (b & 1) => EdgeKind::Manifold,
+            _ => EdgeKind::NonManifold,
+        };
+        out.edges.push(EdgeRecord {
+            v0: key.0,
+            v1: key.1,
+            first_face: out.edge_faces.len() as u32,
+            info: faces.len() as u32 | (kind as u32) << 24,
+        });
+        out.edge_faces.extend_from_slice(faces);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::mesh;
+
+    fn whole(m: &MeshData) -> Adjacency {
+        Adjacency::build(m, &[0..m.indices.len()])
+    }
+
+    #[test]
+    fn cube_has_eighteen_manifold_edges() {
+        // 12 cube edges + 6 face diagonals; creases split normals but welding joins them.
+        let adjacency = whole(&mesh::cuboid(Vec3::ONE));
+        assert_eq!(adjacency.edges.len(), 18);
+        assert!(
+            adjacency
+                .edges
+                .iter()
+                .all(|e| e.kind() == EdgeKind::Manifold && e.face_count() == 2)
+        );
+        assert_eq!(adjacency.edge_faces.len(), 36);
+    }
+
+    #[test]
+    fn open_quad_has_four_boundary_edges_and_one_shared() {
+        let quad = mesh::plane(1.0, 1);
+        let adjacency = whole(&quad);
+        assert_eq!(adjacency.edges.len(), 5);
+        assert_eq!(adjacency.boundary_edges(), 4);
+        assert_eq!(adjacency.count(EdgeKind::Manifold), 1);
+    }
+
+    #[test]
+    fn three_faces_on_one_edge_are_non_manifold() {
+        let m = MeshData {
+            positions: vec![
+                Vec3::ZERO,
+                Vec3::X,
+                Vec3::Y,
+                Vec3::NEG_Y,
+                Vec3::Z,
+            ],
+            normals: vec![Vec3::Z; 5],
+            indices: vec![0, 1, 2, 1, 0, 3, 0, 1, 4],
+        };
+        let adjacency = whole(&m);
+        let shared: Vec<_> = adjacency
+            .edges
+            .iter()
+            .filter(|e| e.kind() == EdgeKind::NonManifold)
+            .collect();
+        assert_eq!(shared.len(), 1);
+        assert_eq!((shared[0].v0, shared[0].v1), (0, 1));
+        let faces: Vec<_> = adjacency.faces_of(shared[0]).collect();
+        assert_eq!(faces, vec![(0, false), (1, true), (2, false)]);
+        assert_eq!(adjacency.boundary_edges(), 6);
+    }
+
+    #[test]
+    fn inconsistent_winding_is_non_manifold() {
+        let m = MeshData {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::NEG_Y],
+            normals: vec![Vec3::Z; 4],
+            indices: vec![0, 1, 2, 0, 1, 3],
+        };
+        assert_eq!(whole(&m).non_manifold_edges(), 1);
+    }
+
+    #[test]
+    fn objects_are_not_welded_together() {
+        let mut m = mesh::plane(1.0, 1);
+        let other = mesh::plane(1.0, 1);
+        m.append(&other);
+        let adjacency = Adjacency::build(&m, &[0..6, 6..12]);
+        assert_eq!(adjacency.edges.len(), 10);
+        assert_eq!(adjacency.non_manifold_edges(), 0);
+        assert_eq!(adjacency.object_edges, vec![0..5, 5..10]);
+        // Triangle indices are global.
+        let last = adjacency.edges[9];
+        assert!(adjacency.faces_of(&last).all(|(t, _)| t >= 2));
+    }
+}

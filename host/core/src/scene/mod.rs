@@ -1,0 +1,633 @@
+//! Scenes: the RON description, loaded and validated into world-space geometry, lights and a
+//! camera that every technique and the reference judge share.
+
+pub mod adjacency;
+pub mod description;
+pub mod mesh;
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec3, Vec4};
+
+pub use adjacency::{Adjacency, EdgeKind, EdgeRecord};
+pub use description::*;
+pub use mesh::{MeshData, MeshReport};
+
+/// Most lights a scene may hold.
+pub const MAX_LIGHTS: usize = 1024;
+
+/// Why a scene could not be loaded. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{path}: cannot read scene: {message}")]
+    Io { path: PathBuf, message: String },
+    /// The RON text is malformed or has unknown or missing fields.
+    #[error("{path}:{line}:{col}: {message}")]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    /// A value is out of its domain (non-finite coordinates, negative sizes, ...).
+    #[error("{path}: {field}: {message}")]
+    Invalid {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+    /// A referenced OBJ file is missing or malformed.
+    #[error("{path}: {field}: {obj}: {message}")]
+    Obj {
+        path: PathBuf,
+        field: String,
+        obj: PathBuf,
+        message: String,
+    },
+}
+
+/// The kinds of light a technique may support.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum LightKind {
+    Directional,
+    Point,
+    Spot,
+}
+
+impl LightKind {
+    /// Every kind.
+    pub const ALL: [LightKind; 3] = [LightKind::Directional, LightKind::Point, LightKind::Spot];
+
+    /// Lower-case name as used in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            LightKind::Directional => "directional",
+            LightKind::Point => "point",
+            LightKind::Spot => "spot",
+        }
+    }
+}
+
+/// A light in world space, ready for rendering.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Light {
+    pub kind: LightKind,
+    /// Position (point and spot).
+    pub position: Vec3,
+    /// Unit direction the light travels (directional and spot).
+    pub direction: Vec3,
+    /// Linear colour times intensity.
+    pub radiance: Vec3,
+    /// Distance at which the contribution reaches zero (point and spot); infinite otherwise.
+    pub range: f32,
+    /// Cone half-angle in radians (spot).
+    pub spot_angle: f32,
+    /// Fraction of the cone over which the edge fades (spot).
+    pub spot_softness: f32,
+    /// Emitter radius in world units (point, spot) or angular radius in radians (directional).
+    pub radius: f32,
+}
+
+impl Light {
+    /// Homogeneous light position: (x, y, z, 1) for point and spot lights, (-d, 0) toward the
+    /// light for directional ones.
+    pub fn homogeneous(&self) -> Vec4 {
+        match self.kind {
+            LightKind::Directional => (-self.direction).extend(0.0),
+            _ => self.position.extend(1.0),
+        }
+    }
+
+    /// Whether a surface point receives any light from this light, ignoring occlusion: inside
+    /// the range and the spot cone.
+    pub fn reaches(&self, point: Vec3) -> bool {
+        match self.kind {
+            LightKind::Directional => true,
+            LightKind::Point => point.distance(self.position) < self.range,
+            LightKind::Spot => {
+                let to_point = point - self.position;
+                let distance = to_point.length();
+                distance < self.range
+                    && distance > 0.0
+                    && to_point.dot(self.direction) / distance > self.spot_angle.cos()
+            }
+        }
+    }
+
+    /// Unit vector from `point` toward the light.
+    pub fn direction_to_light(&self, point: Vec3) -> Vec3 {
+        match self.kind {
+            LightKind::Directional => -self.direction,
+            _ => (self.position - point).normalize_or_zero(),
+        }
+    }
+}
+
+/// A perspective camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    pub position: Vec3,
+    pub target: Vec3,
+    pub fov_y: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl Camera {
+    /// World-to-view matrix (right-handed, Y up).
+    pub fn view(&self) -> Mat4 {
+        let forward = (self.target - self.position).normalize_or_zero();
+        let up = if forward.cross(Vec3::Y).length_squared() < 1e-6 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
+        glam::camera::rh::view::look_at_mat4(self.position, self.target, up)
+    }
+
+    /// View-to-clip matrix for the given aspect ratio (depth 0 at near, 1 at far).
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        glam::camera::rh::proj::directx::perspective(self.fov_y, aspect, self.near, self.far)
+    }
+}
+
+/// One object after loading: its slice of the shared buffers and its material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneObject {
+    pub name: String,
+    /// Model matrix (vertices are already transformed to world space with it).
+    pub transform: Mat4,
+    /// Index range in [`Scene::mesh`] indices.
+    pub indices: Range<usize>,
+    pub color: Vec3,
+    pub specular: f32,
+    pub shininess: f32,
+    pub casts_shadows: bool,
+    /// What loading changed.
+    pub report: MeshReport,
+}
+
+/// A receiver plane for planar projected shadows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReceiverPlane {
+    /// Index of the object whose geometry is the plane.
+    pub object: usize,
+    /// Plane (n, d) with n . x + d = 0 and n the front side.
+    pub plane: Vec4,
+    /// The four world-space corners.
+    pub corners: [Vec3; 4],
+}
+
+/// A loaded scene in world space.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub name: String,
+    /// File it came from (or a label for embedded scenes).
+    pub path: PathBuf,
+    pub camera: Camera,
+    pub ambient: Vec3,
+    pub lights: Vec<Light>,
+    pub objects: Vec<SceneObject>,
+    /// All geometry in world space; objects own index ranges of it.
+    pub mesh: MeshData,
+    pub adjacency: Adjacency,
+    pub receivers: Vec<ReceiverPlane>,
+    pub paths: PathsDesc,
+}
+
+impl Scene {
+    /// Loads a RON scene file; OBJ paths are relative to it.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        Scene::from_ron(&text, path, base)
+    }
+
+    /// Parses RON `text`; `path` names it in errors and `base` resolves OBJ paths.
+    pub fn from_ron(text: &str, path: &Path, base: &Path) -> Result<Scene, SceneError> {
+        let description: SceneDescription =
+            ron::from_str(text).map_err(|e| SceneError::Parse {
+                path: path.to_path_buf(),
+                line: e.span.start.line,
+                col: e.span.start.col,
+                message: e.code.to_string(),
+            })?;
+        Scene::from_description(&description, path, base)
+    }
+
+    /// Validates and builds a scene from its description.
+    pub fn from_description(
+        desc: &SceneDescription,
+        path: &Path,
+        base: &Path,
+    ) -> Result<Scene, SceneError> {
+        let invalid = |field: String, message: &str| SceneError::Invalid {
+            path: path.to_path_buf(),
+            field,
+            message: message.to_string(),
+        };
+        let camera = build_camera(&desc.camera).map_err(|(f, m)| invalid(f, m))?;
+        check_vec(desc.ambient, "ambient").map_err(|(f, m)| invalid(f, m))?;
+
+        if desc.lights.is_empty() {
+            return Err(invalid("lights".into(), "a scene needs at least one light"));
+        }
+        if desc.lights.len() > MAX_LIGHTS {
+            return Err(invalid(
+                "lights".into(),
+                &format!(
+                    "{} lights given, at most {MAX_LIGHTS} are supported",
+                    desc.lights.len()
+                ),
+            ));
+        }
+        let lights = desc
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| build_light(l, &format!("lights[{i}]")))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|(f, m)| invalid(f, &m))?;
+
+        if desc.objects.is_empty() {
+            return Err(invalid("objects".into(), "a scene needs at least one object"));
+        }
+        let mut mesh = MeshData::default();
+        let mut objects = Vec::with_capacity(desc.objects.len());
+        let mut receivers = Vec::new();
+        for (i, object) in desc.objects.iter().enumerate() {
+            let field = format!("objects[{i}]");
+            let (local, report) = build_mesh(&object.mesh, &field, path, base)?;
+            let t = &object.transform;
+            for (v, name) in [
+                (t.translation, "translation"),
+                (t.rotation_degrees, "rotation_degrees"),
+                (t.scale, "scale"),
+            ] {
+                check_vec(v, &format!("{field}.transform.{name}")).map_err(|(f, m)| invalid(f, m))?;
+            }
+            if t.scale.cmpeq(Vec3::ZERO).any() {
+                return Err(invalid(
+                    format!("{field}.transform.scale"),
+                    "scale components must be non-zero",
+                ));
+            }
+            check_vec(object.color, &format!("{field}.color")).map_err(|(f, m)| invalid(f, m))?;
+            if !(0.0..=1.0).contains(&object.specular) || !object.shininess.is_finite() {
+                return Err(invalid(
+                    format!("{field}.specular"),
+                    "specular must be in [0, 1] and shininess finite",
+                ));
+            }
+            let transform = t.matrix();
+            let world = local.transformed(transform);
+            let start = mesh.indices.len();
+            mesh.append(&world);
+            if object.receiver {
+                let MeshDesc::Plane { size, .. } = object.mesh else {
+                    return Err(invalid(
+                        format!("{field}.receiver"),
+                        "only Plane meshes can be receiver planes",
+                    ));
+                };
+                receivers.push(receiver_plane(i, transform, size));
+            }
+            if report.degenerate_removed > 0 {
+                log::warn!(
+                    "{}: {field}: removed {} degenerate triangles",
+                    path.display(),
+                    report.degenerate_removed
+                );
+            }
+            objects.push(SceneObject {
+                name: if object.name.is_empty() {
+                    format!("object {i}")
+                } else {
+                    object.name.clone()
+                },
+                transform,
+                indices: start..mesh.indices.len(),
+                color: object.color,
+                specular: object.specular,
+                shininess: object.shininess,
+                casts_shadows: object.casts_shadows,
+                report,
+            });
+        }
+
+        validate_paths(&desc.paths, lights.len()).map_err(|(f, m)| invalid(f, &m))?;
+
+        let ranges: Vec<_> = objects.iter().map(|o| o.indices.clone()).collect();
+        let adjacency = Adjacency::build(&mesh, &ranges);
+        Ok(Scene {
+            name: if desc.name.is_empty() {
+                path.file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default()
+            } else {
+                desc.name.clone()
+            },
+            path: path.to_path_buf(),
+            camera,
+            ambient: desc.ambient,
+            lights,
+            objects,
+            mesh,
+            adjacency,
+            receivers,
+            paths: desc.paths.clone(),
+        })
+    }
+
+    /// Total triangle count.
+    pub fn triangle_count(&self) -> usize {
+        self.mesh.triangle_count()
+    }
+
+    /// World-space bounds of all geometry.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        mesh::bounds(&self.mesh.positions).unwrap_or((Vec3::ZERO, Vec3::ZERO))
+    }
+
+    /// Which object each triangle belongs to.
+    pub fn triangle_objects(&self) -> Vec<u32> {
+        let mut out = vec![0; self.triangle_count()];
+        for (i, o) in self.objects.iter().enumerate() {
+            out[o.indices.start / 3..o.indices.end / 3].fill(i as u32);
+        }
+        out
+    }
+}
+
+type FieldError = (String, &'static str);
+
+fn check_vec(v: Vec3, field: &str) -> Result<(), FieldError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err((field.to_string(), "coordinates must be finite numbers"))
+    }
+}
+
+fn check_positive(v: f32, field: &str) -> Result<(), FieldError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err((field.to_string(), "must be a finite number greater than zero"))
+    }
+}
+
+fn build_camera(c: &CameraDesc) -> Result<Camera, FieldError> {
+    check_vec(c.position, "camera.position")?;
+    check_vec(c.target, "camera.target")?;
+    if c.position.distance(c.target) < 1e-6 {
+        return Err(("camera.target".into(), "must differ from camera.position"));
+    }
+    if !(c.fov_y_degrees > 1.0 && c.fov_y_degrees < 179.0) {
+        return Err(("camera.fov_y_degrees".into(), "must be between 1 and 179"));
+    }
+    check_positive(c.near, "camera.near")?;
+    if !(c.far.is_finite() && c.far > c.near) {
+        return Err(("camera.far".into(), "must be finite and greater than near"));
+    }
+    Ok(Camera {
+        position: c.position,
+        target: c.target,
+        fov_y: c.fov_y_degrees.to_radians(),
+        near: c.near,
+        far: c.far,
+    })
+}
+
+fn build_light(desc: &LightDesc, field: &str) -> Result<Light, (String, String)> {
+    let err = |sub: &str, message: &str| (format!("{field}.{sub}"), message.to_string());
+    let lift = |r: Result<(), FieldError>| r.map_err(|(f, m)| (f, m.to_string()));
+    let direction = |d: Vec3| -> Result<Vec3, (String, String)> {
+        lift(check_vec(d, &format!("{field}.direction")))?;
+        d.try_normalize()
+            .ok_or_else(|| err("direction", "must not be zero"))
+    };
+    let color = |c: Vec3, intensity: f32| -> Result<Vec3, (String, String)> {
+        lift(check_vec(c, &format!("{field}.color")))?;
+        if c.min_element() < 0.0 {
+            return Err(err("color", "components must not be negative"));
+        }
+        if !(intensity.is_finite() && intensity >= 0.0) {
+            return Err(err("intensity", "must be a finite number >= 0"));
+        }
+        Ok(c * intensity)
+    };
+    let radius = |r: f32| {
+        if r.is_finite() && r >= 0.0 {
+            Ok(r)
+        } else {
+            Err(err("radius", "must be a finite number >= 0"))
+        }
+    };
+    Ok(match *desc {
+        LightDesc::Directional {
+            direction: d,
+            color: c,
+            intensity,
+            angular_radius_degrees,
+        } => {
+            if !(0.0..45.0).contains(&angular_radius_degrees) {
+                return Err(err("angular_radius_degrees", "must be in [0, 45)"));
+            }
+            Light {
+                kind: LightKind::Directional,
+                position: Vec3::ZERO,
+                direction: direction(d)?,
+                radiance: color(c, intensity)?,
+                range: f32::INFINITY,
+                spot_angle: 0.0,
+                spot_softness: 0.0,
+                radius: angular_radius_degrees.to_radians(),
+            }
+        }
+        LightDesc::Point {
+            position,
+            color: c,
+            intensity,
+            range,
+            radius: r,
+        } => {
+            lift(check_vec(position, &format!("{field}.position")))?;
+            lift(check_positive(range, &format!("{field}.range")))?;
+            Light {
+                kind: LightKind::Point,
+                position,
+                direction: Vec3::NEG_Y,
+                radiance: color(c, intensity)?,
+                range,
+                spot_angle: 0.0,
+                spot_softness: 0.0,
+                radius: radius(r)?,
+            }
+        }
+        LightDesc::Spot {
+            position,
+            direction: d,
+            color: c,
+            intensity,
+            range,
+            angle_degrees,
+            softness,
+            radius: r,
+        } => {
+            lift(check_vec(position, &format!("{field}.position")))?;
+            lift(check_positive(range, &format!("{field}.range")))?;
+            if !(angle_degrees > 0.5 && angle_degrees < 89.0) {
+                return Err(err("angle_degrees", "must be between 0.5 and 89"));
+            }
+            if !(0.0..=1.0).contains(&softness) {
+                return Err(err("softness", "must be in [0, 1]"));
+            }
+            Light {
+                kind: LightKind::Spot,
+                position,
+                direction: direction(d)?,
+                radiance: color(c, intensity)?,
+                range,
+                spot_angle: angle_degrees.to_radians(),
+                spot_softness: softness,
+                radius: radius(r)?,
+            }
+        }
+    })
+}
+
+fn build_mesh(
+    desc: &MeshDesc,
+    field: &str,
+    path: &Path,
+    base: &Path,
+) -> Result<(MeshData, MeshReport), SceneError> {
+    let invalid = |message: &str| SceneError::Invalid {
+        path: path.to_path_buf(),
+        field: format!("{field}.mesh"),
+        message: message.to_string(),
+    };
+    let positive = |values: &[f32]| values.iter().all(|v| v.is_finite() && *v > 0.0);
+    let count_ok = |n: u32| (3..=4096).contains(&n);
+    let mesh = match *desc {
+        MeshDesc::Obj(ref file) => {
+            let obj = base.join(file);
+            return mesh::load_obj(&obj).map_err(|e| SceneError::Obj {
+                path: path.to_path_buf(),
+                field: format!("{field}.mesh"),
+                obj,
+                message: e.to_string(),
+            });
+        }
+        MeshDesc::Plane { size, subdivisions } => {
+            if !positive(&[size]) || !(1..=1024).contains(&subdivisions) {
+                return Err(invalid("Plane needs size > 0 and 1..=1024 subdivisions"));
+            }
+            mesh::plane(size, subdivisions)
+        }
+        MeshDesc::Box { size } => {
+            if !positive(&size.to_array()) {
+                return Err(invalid("Box sizes must be finite and > 0"));
+            }
+            mesh::cuboid(size)
+        }
+        MeshDesc::Sphere {
+            radius,
+            segments,
+            rings,
+        } => {
+            if !positive(&[radius]) || !count_ok(segments) || !count_ok(rings) {
+                return Err(invalid("Sphere needs radius > 0 and 3..=4096 segments and rings"));
+            }
+            mesh::sphere(radius, segments, rings)
+        }
+        MeshDesc::Cylinder {
+            radius,
+            height,
+            segments,
+        } => {
+            if !positive(&[radius, height]) || !count_ok(segments) {
+                return Err(invalid("Cylinder needs radius, height > 0 and 3..=4096 segments"));
+            }
+            mesh::cylinder(radius, height, segments)
+        }
+        MeshDesc::Torus {
+            major_radius,
+            minor_radius,
+            segments,
+            rings,
+        } => {
+            if !positive(&[major_radius, minor_radius])
+                || !count_ok(segments)
+                || !count_ok(rings)
+            {
+                return Err(invalid("Torus needs radii > 0 and 3..=4096 segments and rings"));
+            }
+            mesh::torus(major_radius, minor_radius, segments, rings)
+        }
+        MeshDesc::Cone {
+            radius,
+            height,
+            segments,
+        } => {
+            if !positive(&[radius, height]) || !count_ok(segments) {
+                return Err(invalid("Cone needs radius, height > 0 and 3..=4096 segments"));
+            }
+            mesh::cone(radius, height, segments)
+        }
+    };
+    Ok((mesh, MeshReport::default()))
+}
+
+fn receiver_plane(object: usize, transform: Mat4, size: f32) -> ReceiverPlane {
+    let h = size * 0.5;
+    let corners = [(-h, -h), (h, -h), (h, h), (-h, h)]
+        .map(|(x, z)| transform.transform_point3(Vec3::new(x, 0.0, z)));
+    let origin = transform.transform_point3(Vec3::ZERO);
+    let normal = (glam::Mat3::from_mat4(transform).inverse().transpose() * Vec3::Y).normalize();
+    ReceiverPlane {
+        object,
+        plane: normal.extend(-normal.dot(origin)),
+        corners,
+    }
+}
+
+fn validate_paths(paths: &PathsDesc, light_count: usize) -> Result<(), (String, String)> {
+    let times_increase = |times: &[f32], field: String| -> Result<(), (String, String)> {
+        if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[1] <= w[0]) {
+            Err((field, "key times must be finite and strictly increasing".into()))
+        } else {
+            Ok(())
+        }
+    };
+    let camera_times: Vec<f32> = paths.camera.iter().map(|k| k.time).collect();
+    times_increase(&camera_times, "paths.camera".into())?;
+    for (i, k) in paths.camera.iter().enumerate() {
+        if !(k.position.is_finite() && k.target.is_finite()) {
+            return Err((format!("paths.camera[{i}]"), "coordinates must be finite numbers".into()));
+        }
+    }
+    for (i, path) in paths.lights.iter().enumerate() {
+        if path.light >= light_count {
+            return Err((
+                format!("paths.lights[{i}].light"),
+                format!("light {} does not exist ({light_count} lights)", path.light),
+            ));
+        }
+        let times: Vec<f32> = path.keys.iter().map(|k| k.time).collect();
+        times_increase(&times, format!("paths.lights[{i}]"))?;
+        if path.keys.iter().any(|k| !k.value.is_finite()) {
+            return Err((format!("paths.lights[{i}]"), "coordinates must be finite numbers".into()));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,200 @@
+use std::path::{Path, PathBuf};
+
+use super::*;
+
+const MINIMAL: &str = r#"(
+    camera: (position: (0, 2, 5), target: (0, 0, 0)),
+    lights: [Point(position: (0, 4, 0), intensity: 10)],
+    objects: [
+        (mesh: Plane(size: 10), receiver: true),
+        (mesh: Box(size: (1, 1, 1)), transform: (translation: (0, 0.5, 0))),
+    ],
+)"#;
+
+fn parse(text: &str) -> Result<Scene, SceneError> {
+    Scene::from_ron(text, Path::new("test.ron"), Path::new("."))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("zoo-scene-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn minimal_scene_loads() {
+    let scene = parse(MINIMAL).unwrap();
+    assert_eq!(scene.lights.len(), 1);
+    assert_eq!(scene.objects.len(), 2);
+    assert_eq!(scene.triangle_count(), 2 + 12);
+    assert_eq!(scene.receivers.len(), 1);
+    let plane = scene.receivers[0].plane;
+    assert!((plane - glam::Vec4::new(0.0, 1.0, 0.0, 0.0)).length() < 1e-6);
+    // The box sits on the floor.
+    let (lo, hi) = scene.bounds();
+    assert!((lo.y - 0.0).abs() < 1e-6 && (hi.y - 1.0).abs() < 1e-6);
+    assert_eq!(scene.name, "test");
+}
+
+#[test]
+fn malformed_ron_reports_line_and_column() {
+    let text = "(\n    camera: (position: (0, 2, 5) target: (0, 0, 0)),\n)";
+    let err = parse(text).unwrap_err();
+    let SceneError::Parse { line, col, .. } = &err else {
+        panic!("expected a parse error, got {err}");
+    };
+    assert_eq!(*line, 2);
+    assert!(*col > 20, "column {col}");
+    assert!(err.to_string().starts_with("test.ron:2:"), "{err}");
+}
+
+#[test]
+fn unknown_fields_are_rejected_with_their_name() {
+    let text = MINIMAL.replace("intensity: 10", "intensity: 10, colour: (1, 0, 0)");
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.contains("colour"), "{err}");
+    assert!(err.starts_with("test.ron:3:"), "{err}");
+}
+
+#[test]
+fn non_finite_values_name_the_field() {
+    let text = MINIMAL.replace("position: (0, 4, 0)", "position: (0, NaN, 0)");
+    let err = parse(&text).unwrap_err().to_string();
+    assert_eq!(err, "test.ron: lights[0].position: coordinates must be finite numbers");
+    let text = MINIMAL.replace("translation: (0, 0.5, 0)", "translation: (0, inf, 0)");
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.contains("objects[1].transform.translation"), "{err}");
+}
+
+#[test]
+fn too_many_lights_and_no_lights_are_errors() {
+    let many = vec!["Point(position: (0, 4, 0))"; MAX_LIGHTS + 1].join(", ");
+    let text = MINIMAL.replace("Point(position: (0, 4, 0), intensity: 10)", &many);
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.contains("1025 lights given, at most 1024"), "{err}");
+
+    let ok = vec!["Point(position: (0, 4, 0))"; 256].join(", ");
+    let text = MINIMAL.replace("Point(position: (0, 4, 0), intensity: 10)", &ok);
+    assert_eq!(parse(&text).unwrap().lights.len(), 256);
+
+    let text = MINIMAL.replace("Point(position: (0, 4, 0), intensity: 10)", "");
+    assert!(parse(&text).unwrap_err().to_string().contains("at least one light"));
+}
+
+#[test]
+fn bad_light_parameters_are_errors() {
+    let text = MINIMAL.replace(
+        "Point(position: (0, 4, 0), intensity: 10)",
+        "Spot(position: (0, 4, 0), direction: (0, 0, 0))",
+    );
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.contains("lights[0].direction: must not be zero"), "{err}");
+    let text = MINIMAL.replace("intensity: 10", "intensity: 10, range: -1");
+    assert!(parse(&text).unwrap_err().to_string().contains("lights[0].range"));
+}
+
+#[test]
+fn receiver_must_be_a_plane() {
+    let text = MINIMAL.replace("(mesh: Box(size: (1, 1, 1)),", "(mesh: Box(size: (1, 1, 1)), receiver: true,");
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.contains("objects[1].receiver: only Plane"), "{err}");
+}
+
+#[test]
+fn missing_obj_names_scene_field_and_file() {
+    let text = MINIMAL.replace("Box(size: (1, 1, 1))", r#"Obj("missing/bunny.obj")"#);
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.starts_with("test.ron: objects[1].mesh: ./missing/bunny.obj: cannot read"), "{err}");
+}
+
+#[test]
+fn malformed_obj_reports_its_line() {
+    let dir = temp_dir("badobj");
+    std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 zz\nf 1 2 3\n").unwrap();
+    let text = MINIMAL.replace("Box(size: (1, 1, 1))", r#"Obj("bad.obj")"#);
+    let err = Scene::from_ron(&text, &dir.join("s.ron"), &dir).unwrap_err().to_string();
+    assert!(err.contains("bad.obj: line 3, column 7: `zz` is not a number"), "{err}");
+}
+
+#[test]
+fn obj_without_normals_and_with_quads_loads() {
+    let dir = temp_dir("quadobj");
+    std::fs::write(
+        dir.join("quad.obj"),
+        "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nv 0 0 0\nf 4 3 2 1\nf 1 1 5\n",
+    )
+    .unwrap();
+    let text = MINIMAL.replace("Box(size: (1, 1, 1))", r#"Obj("quad.obj")"#);
+    let scene = Scene::from_ron(&text, &dir.join("s.ron"), &dir).unwrap();
+    let object = &scene.objects[1];
+    assert_eq!(object.indices.len(), 6, "quad triangulated, degenerate face dropped");
+    assert!(object.report.normals_computed);
+    assert_eq!(object.report.degenerate_removed, 1);
+    let first = scene.mesh.indices[object.indices.start] as usize;
+    assert!((scene.mesh.normals[first] - glam::Vec3::Y).length() < 1e-5);
+}
+
+#[test]
+fn paths_are_validated() {
+    let text = MINIMAL.replace(
+        "objects: [",
+        "paths: (lights: [(light: 3, keys: [(time: 0, value: (0, 1, 0))])]),\n    objects: [",
+    );
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.contains("paths.lights[0].light: light 3 does not exist"), "{err}");
+    let text = MINIMAL.replace(
+        "objects: [",
+        "paths: (camera: [(time: 1, position: (0, 1, 5), target: (0, 0, 0)), (time: 0, position: (0, 1, 5), target: (0, 0, 0))]),\n    objects: [",
+    );
+    assert!(parse(&text).unwrap_err().to_string().contains("strictly increasing"));
+}
+
+#[test]
+fn missing_scene_file_is_an_io_error() {
+    let err = Scene::load(Path::new("no/such/scene.ron")).unwrap_err().to_string();
+    assert!(err.starts_with("no/such/scene.ron: cannot read scene"), "{err}");
+}
+
+/// The real third-party meshes in `../shared/models` (not part of the repository).
+fn shared_models() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "SKIPPED: {} is absent; the real-mesh loading test needs the shared models folder",
+            dir.display()
+        );
+        None
+    }
+}
+
+#[test]
+fn real_meshes_load() {
+    let Some(dir) = shared_models() else { return };
+    for (file, min_triangles, open) in [
+        ("stanford-bunny.obj", 60_000, true),
+        ("teapot.obj", 1_000, true),
+        ("suzanne.obj", 900, true),
+        ("spot.obj", 5_000, false),
+    ] {
+        let (mesh, report) = mesh::load_obj(&dir.join(file)).unwrap();
+        assert!(mesh.triangle_count() >= min_triangles, "{file}: {}", mesh.triangle_count());
+        assert!(mesh.positions.iter().all(|p| p.is_finite()));
+        assert!(mesh.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-3), "{file}");
+        let adjacency = Adjacency::build(&mesh, &[0..mesh.indices.len()]);
+        if open {
+            assert!(
+                adjacency.boundary_edges() + adjacency.non_manifold_edges() > 0,
+                "{file} should have open edges"
+            );
+        }
+        eprintln!(
+            "{file}: {} triangles, {} edges ({} boundary, {} non-manifold), {report:?}",
+            mesh.triangle_count(),
+            adjacency.edges.len(),
+            adjacency.boundary_edges(),
+            adjacency.non_manifold_edges()
+        );
+    }
+}

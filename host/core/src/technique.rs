@@ -1,0 +1,322 @@
+//! The `ShadowTechnique` contract and the link-time registry of techniques.
+//!
+//! A technique is a crate under `plugins/` that implements [`ShadowTechnique`] and registers a
+//! [`TechniqueRegistration`] with [`register_technique!`](crate::register_technique). The host
+//! renders the G-buffer, clears the visibility storage to 1 (lit), lets the technique record its
+//! passes, and shades every technique identically from the visibility it wrote.
+
+use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
+use crate::params::{ParamError, ParamSpec, ParamValues};
+use crate::render::{FrameBindings, GBuffer, IndirectTarget, SceneBuffers, VisibilityTargets};
+use crate::scene::{Camera, Light, LightKind, Scene};
+
+/// Static description of a technique, registered at link time.
+pub struct TechniqueRegistration {
+    /// Stable identifier used on the command line and in reports (`sm-pcf`).
+    pub id: &'static str,
+    /// Display name.
+    pub name: &'static str,
+    /// One-line description.
+    pub description: &'static str,
+    /// The seed, paper or thesis it follows.
+    pub source: &'static str,
+    /// Light kinds it computes visibility for; others are reported as unsupported.
+    pub light_kinds: &'static [LightKind],
+    /// Device features it cannot run without.
+    pub required_features: fn() -> wgpu::Features,
+    /// Device features it uses when present.
+    pub optional_features: fn() -> wgpu::Features,
+    /// Device limits it needs.
+    pub required_limits: fn() -> wgpu::Limits,
+    /// Its parameter schema (usually `MyParams::schema`).
+    pub params: fn() -> Vec<ParamSpec>,
+    /// Creates an instance for the given device and validated parameter values.
+    pub create: fn(&GpuContext, &ParamValues) -> Result<Box<dyn ShadowTechnique>, TechniqueError>,
+}
+
+inventory::collect!(TechniqueRegistration);
+
+impl TechniqueRegistration {
+    /// Whether it supports lights of `kind`.
+    pub fn supports(&self, kind: LightKind) -> bool {
+        self.light_kinds.contains(&kind)
+    }
+
+    /// Why it cannot run on `gpu`, if it cannot.
+    pub fn unavailable_reason(&self, gpu: &GpuContext) -> Option<String> {
+        let missing = (self.required_features)() - gpu.device.features();
+        if !missing.is_empty() {
+            return Some(format!("needs device features {missing:?}"));
+        }
+        let mut failed = Vec::new();
+        (self.required_limits)().check_limits_with_fail_fn(
+            &gpu.device.limits(),
+            false,
+            |name, wanted, allowed| failed.push(format!("{name} {wanted} (device: {allowed})")),
+        );
+        (!failed.is_empty()).then(|| format!("needs limits {}", failed.join(", ")))
+    }
+
+    /// Comma-separated supported light kinds.
+    pub fn light_kind_names(&self) -> String {
+        self.light_kinds
+            .iter()
+            .map(|k| k.name())
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+}
+
+/// Every registered technique, sorted by id. Duplicate ids are a programming error and panic at
+/// first use with both descriptions named.
+pub fn registry() -> Vec<&'static TechniqueRegistration> {
+    let mut all: Vec<_> = inventory::iter::<TechniqueRegistration>.into_iter().collect();
+    all.sort_by_key(|r| r.id);
+    for pair in all.windows(2) {
+        assert!(
+            pair[0].id != pair[1].id,
+            "two techniques are registered as `{}`: \"{}\" and \"{}\"",
+            pair[0].id,
+            pair[0].description,
+            pair[1].description
+        );
+    }
+    all
+}
+
+/// Looks up a technique by id.
+pub fn find_technique(id: &str) -> Result<&'static TechniqueRegistration, TechniqueError> {
+    let all = registry();
+    all.iter().copied().find(|r| r.id == id).ok_or_else(|| {
+        TechniqueError::Unknown {
+            id: id.to_string(),
+            known: all.iter().map(|r| r.id).collect::<Vec<_>>().join(", "),
+        }
+    })
+}
+
+/// Registers a technique: `register_technique!(TechniqueRegistration { ... });`.
+#[macro_export]
+macro_rules! register_technique {
+    ($registration:expr) => {
+        $crate::inventory::submit! { $registration }
+    };
+}
+
+/// Errors a technique reports. The host disables a technique that returns one.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum TechniqueError {
+    /// No technique has that id.
+    #[error("unknown technique `{id}` (registered: {known})")]
+    Unknown { id: String, known: String },
+    /// A parameter was rejected.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// A shader failed to compile.
+    #[error(transparent)]
+    Shader(#[from] ShaderError),
+    /// The device lacks something the technique needs.
+    #[error("{id} cannot run here: {reason}")]
+    Unavailable { id: String, reason: String },
+    /// wgpu reported a validation error while preparing or recording.
+    #[error("{id}: GPU validation error: {message}")]
+    Validation { id: String, message: String },
+    /// The technique panicked.
+    #[error("{id} panicked: {message}")]
+    Panicked { id: String, message: String },
+    /// Anything else.
+    #[error("{0}")]
+    Other(String),
+}
+
+/// A declared pass.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PassInfo {
+    /// Name, equal to the label the pass is recorded with.
+    pub name: String,
+    /// Render or compute.
+    pub kind: PassKind,
+}
+
+/// Kind of GPU pass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PassKind {
+    Render,
+    Compute,
+}
+
+impl PassInfo {
+    /// A render pass called `name`.
+    pub fn render(name: impl Into<String>) -> PassInfo {
+        PassInfo {
+            name: name.into(),
+            kind: PassKind::Render,
+        }
+    }
+    /// A compute pass called `name`.
+    pub fn compute(name: impl Into<String>) -> PassInfo {
+        PassInfo {
+            name: name.into(),
+            kind: PassKind::Compute,
+        }
+    }
+}
+
+/// What a resource is, for debug views and the memory table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ResourceKind {
+    Texture,
+    Buffer,
+}
+
+/// How a viewable texture is displayed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ViewMapping {
+    /// Depth values, remapped from [min, max] to black..white.
+    Depth { min: f32, max: f32 },
+    /// A float texture's channels as colour, remapped from [min, max].
+    Color { min: f32, max: f32 },
+    /// One float channel as greyscale, remapped from [min, max].
+    Channel { channel: u32, min: f32, max: f32 },
+    /// Unsigned integers (counts, ids) shown with a false-colour palette.
+    Integer,
+}
+
+/// A technique resource as listed in the memory table and debug view menu.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResourceInfo {
+    pub name: String,
+    pub kind: ResourceKind,
+    /// Width, height and layers (textures) or element count, 1, 1 (buffers).
+    pub size: [u32; 3],
+    /// Texture format or element type.
+    pub format: String,
+    /// GPU memory in bytes.
+    pub bytes: u64,
+    /// Whether [`ShadowTechnique::debug_view`] can show it.
+    pub viewable: bool,
+}
+
+impl ResourceInfo {
+    /// Describes a texture (single mip level).
+    pub fn texture(name: impl Into<String>, texture: &wgpu::Texture, viewable: bool) -> ResourceInfo {
+        let format = texture.format();
+        let texel = format
+            .block_copy_size(None)
+            .or_else(|| format.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)))
+            .unwrap_or(4) as u64;
+        let size = texture.size();
+        ResourceInfo {
+            name: name.into(),
+            kind: ResourceKind::Texture,
+            size: [size.width, size.height, size.depth_or_array_layers],
+            format: format!("{format:?}"),
+            bytes: texel * size.width as u64 * size.height as u64 * size.depth_or_array_layers as u64,
+            viewable,
+        }
+    }
+
+    /// Describes a buffer of `element` values.
+    pub fn buffer(name: impl Into<String>, buffer: &wgpu::Buffer, element: &str) -> ResourceInfo {
+        ResourceInfo {
+            name: name.into(),
+            kind: ResourceKind::Buffer,
+            size: [buffer.size() as u32, 1, 1],
+            format: element.to_string(),
+            bytes: buffer.size(),
+            viewable: false,
+        }
+    }
+}
+
+/// A texture view offered for display.
+pub struct DebugImage<'a> {
+    /// A single-layer 2D view.
+    pub view: &'a wgpu::TextureView,
+    /// How to show it.
+    pub mapping: ViewMapping,
+}
+
+/// What changed since the last [`ShadowTechnique::prepare`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Changes {
+    /// First call, or a new scene.
+    pub scene: bool,
+    /// Light positions, directions or count.
+    pub lights: bool,
+    /// Output resolution.
+    pub resolution: bool,
+    /// The camera.
+    pub camera: bool,
+}
+
+impl Changes {
+    /// Everything changed (the first prepare).
+    pub const ALL: Changes = Changes {
+        scene: true,
+        lights: true,
+        resolution: true,
+        camera: true,
+    };
+}
+
+/// Everything a technique may read while preparing and recording a frame.
+pub struct RenderContext<'a> {
+    pub gpu: &'a GpuContext,
+    pub shaders: &'a ShaderLibrary,
+    pub scene: &'a Scene,
+    /// Shared vertex, index and adjacency buffers.
+    pub scene_buffers: &'a SceneBuffers,
+    /// Camera, lights and objects (bind group 0 by convention, `common/frame.wgsl`).
+    pub frame: &'a FrameBindings,
+    /// G-buffer textures (bind group 1 by convention, `common/gbuffer.wgsl`) and depth-stencil.
+    pub gbuffer: &'a GBuffer,
+    /// Where visibility goes: one (layer, channel) slot per light.
+    pub visibility: &'a VisibilityTargets,
+    /// Additive indirect radiance (for global-illumination techniques).
+    pub indirect: &'a IndirectTarget,
+    /// The current camera (may differ from the scene's when animated).
+    pub camera: &'a Camera,
+    /// The current lights.
+    pub lights: &'a [Light],
+    /// Output size in pixels.
+    pub size: glam::UVec2,
+}
+
+/// A shadow technique instance. Created by its registration's factory; dropping it frees its
+/// GPU resources.
+pub trait ShadowTechnique: Send {
+    /// Its passes, in recording order (the names it records them with).
+    fn passes(&self) -> Vec<PassInfo>;
+
+    /// Its GPU resources, for debug views and the memory table.
+    fn resources(&self) -> Vec<ResourceInfo> {
+        Vec::new()
+    }
+
+    /// Whether lights whose influence volumes do not overlap may share one visibility slot.
+    /// Techniques that write visibility only inside a light's influence may say yes.
+    fn packs_visibility_slots(&self) -> bool {
+        false
+    }
+
+    /// Creates or resizes resources after the scene, lights, resolution or camera changed.
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError>;
+
+    /// Records this frame's passes. Visibility has been cleared to 1 (lit) for every slot.
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> Result<(), TechniqueError>;
+
+    /// A viewable resource by name, for the debug view.
+    fn debug_view(&self, _resource: &str) -> Option<DebugImage<'_>> {
+        None
+    }
+
+    /// Workload counters from the last frame (silhouette edges, VPLs, ...).
+    fn counters(&self) -> Vec<(String, f64)> {
+        Vec::new()
+    }
+}

@@ -1,0 +1,61 @@
+// Shows one texture (G-buffer channel, visibility slot or technique resource) on screen.
+
+#import "common/fullscreen.wgsl"
+
+struct ViewParams {
+    // 0 colour, 1 single channel, 2 depth (raw), 3 depth linearised with near/far, 4 integer.
+    mode: u32,
+    channel: u32,
+    min_value: f32,
+    max_value: f32,
+    near: f32,
+    far: f32,
+    _pad: vec2<f32>,
+}
+
+@group(0) @binding(0) var<uniform> params: ViewParams;
+@group(0) @binding(1) var source_float: texture_2d<f32>;
+@group(0) @binding(2) var source_depth: texture_depth_2d;
+@group(0) @binding(3) var source_uint: texture_2d<u32>;
+
+fn source_pixel(in: FullscreenOut, size: vec2<u32>) -> vec2<i32> {
+    return vec2<i32>(min(vec2<u32>(in.uv * vec2<f32>(size)), size - vec2<u32>(1u)));
+}
+
+fn remap(v: f32) -> f32 {
+    return saturate((v - params.min_value) / max(params.max_value - params.min_value, 1e-12));
+}
+
+@fragment
+fn fs_float(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let texel = textureLoad(source_float, source_pixel(in, textureDimensions(source_float)), 0);
+    if params.mode == 1u {
+        return vec4<f32>(vec3<f32>(remap(texel[params.channel])), 1.0);
+    }
+    return vec4<f32>(remap(texel.r), remap(texel.g), remap(texel.b), 1.0);
+}
+
+@fragment
+fn fs_depth(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let d = textureLoad(source_depth, source_pixel(in, textureDimensions(source_depth)), 0);
+    var v = d;
+    if params.mode == 3u {
+        if d >= 1.0 {
+            return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        }
+        v = params.near * params.far / (params.far - d * (params.far - params.near));
+    }
+    return vec4<f32>(vec3<f32>(1.0 - remap(v)), 1.0);
+}
+
+@fragment
+fn fs_uint(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let v = textureLoad(source_uint, source_pixel(in, textureDimensions(source_uint)), 0).r;
+    if v == 0u {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    // Distinct hues for small integers.
+    let h = fract(f32(v) * 0.618034);
+    let c = saturate(abs(fract(vec3<f32>(h) + vec3<f32>(0.0, 2.0 / 3.0, 1.0 / 3.0)) * 6.0 - 3.0) - 1.0);
+    return vec4<f32>(c, 1.0);
+}

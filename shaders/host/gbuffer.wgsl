@@ -1,0 +1,48 @@
+// G-buffer pass: world position, normal + shininess, albedo + specular.
+
+#import "common/frame.wgsl"
+
+struct VertexIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @builtin(instance_index) object: u32,
+}
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) object: u32,
+}
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    // Scene vertices are stored in world space.
+    var out: VertexOut;
+    out.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
+    out.world = v.position;
+    out.normal = v.normal;
+    out.object = v.object;
+    return out;
+}
+
+struct GBufferOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+}
+
+@fragment
+fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
+    let object = objects[in.object];
+    var n = normalize(in.normal);
+    // Back faces (open meshes seen from inside) are shaded from their visible side.
+    if !front {
+        n = -n;
+    }
+    var out: GBufferOut;
+    out.position = vec4<f32>(in.world, 1.0);
+    out.normal = vec4<f32>(n, object.material.x / 256.0);
+    out.albedo = object.color;
+    return out;
+}

@@ -1,0 +1,36 @@
+// Deferred lighting: ambient + sum over lights of visibility * direct + indirect.
+// Every technique is shaded by this same pass from the visibility it wrote.
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "common/lighting.wgsl"
+#import "common/fullscreen.wgsl"
+
+@group(2) @binding(0) var visibility: texture_2d_array<f32>;
+@group(2) @binding(1) var indirect: texture_2d<f32>;
+
+fn tonemap(c: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(1.0) - exp(-c);
+}
+
+@fragment
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let pixel = vec2<i32>(in.position.xy);
+    let s = load_surface(pixel);
+    if !s.valid {
+        let sky = mix(vec3<f32>(0.02, 0.02, 0.025), vec3<f32>(0.05, 0.06, 0.08), in.uv.y);
+        return vec4<f32>(sky, 1.0);
+    }
+    let view_dir = normalize(camera.position - s.position);
+    var color = camera.ambient * s.albedo;
+    for (var i = 0u; i < camera.light_count; i++) {
+        let light = lights[i];
+        let v = textureLoad(visibility, pixel, light.slot_layer, 0)[light.slot_channel];
+        if v > 0.0 {
+            color += v * direct_light(light, s.position, s.normal, view_dir,
+                                      s.albedo, s.specular, s.shininess);
+        }
+    }
+    color += textureLoad(indirect, pixel, 0).rgb * s.albedo;
+    return vec4<f32>(tonemap(color), 1.0);
+}
