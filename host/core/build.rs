@@ -32,15 +32,31 @@ fn main() {
     println!("cargo:rerun-if-changed={}", root.display());
     let mut files = Vec::new();
     collect(&root, &root, &mut files);
-    let mut code = String::from("/// Every WGSL file under `shaders/`, as (relative path, source).\n");
+    let mut code =
+        String::from("/// Every WGSL file under `shaders/`, as (relative path, source).\n");
     code.push_str("pub static EMBEDDED: &[(&str, &str)] = &[\n");
     for (name, path) in &files {
         println!("cargo:rerun-if-changed={}", path.display());
-        writeln!(code, "    ({name:?}, include_str!({:?})),", path.display().to_string()).unwrap();
+        writeln!(
+            code,
+            "    ({name:?}, include_str!({:?})),",
+            path.display().to_string()
+        )
+        .unwrap();
     }
     code.push_str("];\n");
-    writeln!(code, "/// Where the shaders were at build time (for hot reload).").unwrap();
-    writeln!(code, "pub const SOURCE_ROOT: &str = {:?};", root.display().to_string()).unwrap();
-    let out = PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo")).join("embedded_shaders.rs");
+    writeln!(
+        code,
+        "/// Where the shaders were at build time (for hot reload)."
+    )
+    .unwrap();
+    writeln!(
+        code,
+        "pub const SOURCE_ROOT: &str = {:?};",
+        root.display().to_string()
+    )
+    .unwrap();
+    let out =
+        PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo")).join("embedded_shaders.rs");
     std::fs::write(out, code).expect("write embedded_shaders.rs");
 }

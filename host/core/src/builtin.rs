@@ -3,9 +3,7 @@
 use crate::gpu::{GpuContext, PassRecorder};
 use crate::params::{ParamSpec, ParamValues};
 use crate::scene::LightKind;
-use crate::technique::{
-    Changes, PassInfo, RenderContext, ShadowTechnique, TechniqueError, TechniqueRegistration,
-};
+use crate::technique::{Changes, PassInfo, RenderContext, ShadowTechnique, TechniqueError};
 
 /// Id of the baseline technique.
 pub const UNSHADOWED_ID: &str = "unshadowed";
@@ -27,7 +25,11 @@ impl ShadowTechnique for Unshadowed {
         Ok(())
     }
 
-    fn record(&mut self, _: &RenderContext<'_>, _: &mut PassRecorder<'_>) -> Result<(), TechniqueError> {
+    fn record(
+        &mut self,
+        _: &RenderContext<'_>,
+        _: &mut PassRecorder<'_>,
+    ) -> Result<(), TechniqueError> {
         Ok(())
     }
 }
@@ -36,7 +38,7 @@ fn create(_: &GpuContext, _: &ParamValues) -> Result<Box<dyn ShadowTechnique>, T
     Ok(Box::new(Unshadowed))
 }
 
-crate::register_technique!(TechniqueRegistration {
+crate::register_technique! {
     id: UNSHADOWED_ID,
     name: "Unshadowed",
     description: "Baseline without shadows: visibility 1 for every light",
@@ -46,5 +48,5 @@ crate::register_technique!(TechniqueRegistration {
     optional_features: wgpu::Features::empty,
     required_limits: wgpu::Limits::downlevel_defaults,
     params: Vec::<ParamSpec>::new,
-    create,
-});
+    create: create,
+}

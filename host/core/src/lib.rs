@@ -29,3 +29,8 @@ pub use technique::{
 
 // Re-exported so plugins and the macros need no direct dependency on them.
 pub use {glam, inventory, serde, wgpu};
+
+/// Compiles the README's code examples ("Writing a technique") as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeDoctests;

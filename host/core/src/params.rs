@@ -447,11 +447,7 @@ macro_rules! technique_params {
 
 /// Joins doc-comment lines into one trimmed string (used by [`technique_params!`]).
 pub fn join_doc(lines: &[&'static str]) -> &'static str {
-    let text = lines
-        .iter()
-        .map(|l| l.trim())
-        .collect::<Vec<_>>()
-        .join(" ");
+    let text = lines.iter().map(|l| l.trim()).collect::<Vec<_>>().join(" ");
     // Schemas are built a handful of times per run; leaking keeps `ParamSpec` `'static`.
     Box::leak(text.into_boxed_str())
 }
@@ -505,7 +501,10 @@ mod tests {
         apply_assignments(
             &schema,
             &mut values,
-            &[("size".into(), "4096".into()), ("mode".into(), "fast".into())],
+            &[
+                ("size".into(), "4096".into()),
+                ("mode".into(), "fast".into()),
+            ],
         )
         .unwrap();
         let p = TestParams::from_values(&values).unwrap();
@@ -515,9 +514,12 @@ mod tests {
         let err = apply_assignments(&schema, &mut values, &[("size".into(), "99999".into())])
             .unwrap_err();
         assert!(err.to_string().contains("out of range 256..=8192"), "{err}");
-        let err = apply_assignments(&schema, &mut values, &[("nope".into(), "1".into())])
-            .unwrap_err();
-        assert!(err.to_string().contains("unknown parameter `nope`"), "{err}");
+        let err =
+            apply_assignments(&schema, &mut values, &[("nope".into(), "1".into())]).unwrap_err();
+        assert!(
+            err.to_string().contains("unknown parameter `nope`"),
+            "{err}"
+        );
         let err =
             apply_assignments(&schema, &mut values, &[("on".into(), "maybe".into())]).unwrap_err();
         assert!(err.to_string().contains("expected true or false"), "{err}");
@@ -526,7 +528,10 @@ mod tests {
     #[test]
     fn clamp_moves_values_into_range() {
         let schema = TestParams::schema();
-        assert_eq!(schema[1].clamp(&ParamValue::Float(3.0)), ParamValue::Float(1.0));
+        assert_eq!(
+            schema[1].clamp(&ParamValue::Float(3.0)),
+            ParamValue::Float(1.0)
+        );
         assert_eq!(schema[0].clamp(&ParamValue::Int(1)), ParamValue::Int(256));
         assert_eq!(
             schema[3].clamp(&ParamValue::Choice("bogus".into())),

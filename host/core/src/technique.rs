@@ -10,8 +10,14 @@ use crate::params::{ParamError, ParamSpec, ParamValues};
 use crate::render::{FrameBindings, GBuffer, IndirectTarget, SceneBuffers, VisibilityTargets};
 use crate::scene::{Camera, Light, LightKind, Scene};
 
+/// Creates a technique instance for a device and validated parameter values.
+pub type TechniqueFactory =
+    fn(&GpuContext, &ParamValues) -> Result<Box<dyn ShadowTechnique>, TechniqueError>;
+
 /// Static description of a technique, registered at link time.
 pub struct TechniqueRegistration {
+    /// Package that registered it (filled in by [`register_technique!`](crate::register_technique)).
+    pub package: &'static str,
     /// Stable identifier used on the command line and in reports (`sm-pcf`).
     pub id: &'static str,
     /// Display name.
@@ -31,7 +37,7 @@ pub struct TechniqueRegistration {
     /// Its parameter schema (usually `MyParams::schema`).
     pub params: fn() -> Vec<ParamSpec>,
     /// Creates an instance for the given device and validated parameter values.
-    pub create: fn(&GpuContext, &ParamValues) -> Result<Box<dyn ShadowTechnique>, TechniqueError>,
+    pub create: TechniqueFactory,
 }
 
 inventory::collect!(TechniqueRegistration);
@@ -70,7 +76,9 @@ impl TechniqueRegistration {
 /// Every registered technique, sorted by id. Duplicate ids are a programming error and panic at
 /// first use with both descriptions named.
 pub fn registry() -> Vec<&'static TechniqueRegistration> {
-    let mut all: Vec<_> = inventory::iter::<TechniqueRegistration>.into_iter().collect();
+    let mut all: Vec<_> = inventory::iter::<TechniqueRegistration>
+        .into_iter()
+        .collect();
     all.sort_by_key(|r| r.id);
     for pair in all.windows(2) {
         assert!(
@@ -87,19 +95,34 @@ pub fn registry() -> Vec<&'static TechniqueRegistration> {
 /// Looks up a technique by id.
 pub fn find_technique(id: &str) -> Result<&'static TechniqueRegistration, TechniqueError> {
     let all = registry();
-    all.iter().copied().find(|r| r.id == id).ok_or_else(|| {
-        TechniqueError::Unknown {
+    all.iter()
+        .copied()
+        .find(|r| r.id == id)
+        .ok_or_else(|| TechniqueError::Unknown {
             id: id.to_string(),
             known: all.iter().map(|r| r.id).collect::<Vec<_>>().join(", "),
-        }
-    })
+        })
 }
 
-/// Registers a technique: `register_technique!(TechniqueRegistration { ... });`.
+/// Registers a technique. Takes the fields of [`TechniqueRegistration`] except `package`,
+/// which is set to the calling crate's package name:
+///
+/// ```ignore
+/// zoo_host::register_technique! {
+///     id: "my-technique",
+///     name: "My technique",
+///     // ...
+/// }
+/// ```
 #[macro_export]
 macro_rules! register_technique {
-    ($registration:expr) => {
-        $crate::inventory::submit! { $registration }
+    ($($field:ident : $value:expr),* $(,)?) => {
+        $crate::inventory::submit! {
+            $crate::technique::TechniqueRegistration {
+                package: env!("CARGO_PKG_NAME"),
+                $($field: $value),*
+            }
+        }
     };
 }
 
@@ -199,7 +222,11 @@ pub struct ResourceInfo {
 
 impl ResourceInfo {
     /// Describes a texture (single mip level).
-    pub fn texture(name: impl Into<String>, texture: &wgpu::Texture, viewable: bool) -> ResourceInfo {
+    pub fn texture(
+        name: impl Into<String>,
+        texture: &wgpu::Texture,
+        viewable: bool,
+    ) -> ResourceInfo {
         let format = texture.format();
         let texel = format
             .block_copy_size(None)
@@ -211,7 +238,10 @@ impl ResourceInfo {
             kind: ResourceKind::Texture,
             size: [size.width, size.height, size.depth_or_array_layers],
             format: format!("{format:?}"),
-            bytes: texel * size.width as u64 * size.height as u64 * size.depth_or_array_layers as u64,
+            bytes: texel
+                * size.width as u64
+                * size.height as u64
+                * size.depth_or_array_layers as u64,
             viewable,
         }
     }

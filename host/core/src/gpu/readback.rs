@@ -12,8 +12,8 @@ pub fn read_texture(
 ) -> Vec<u8> {
     let (width, height) = (texture.width(), texture.height());
     let unpadded = width * bytes_per_texel;
-    let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded =
+        unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback buffer"),
         size: (padded * height) as u64,

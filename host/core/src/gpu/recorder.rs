@@ -61,12 +61,15 @@ impl FrameTimings {
             .iter()
             .filter(|p| p.owner == owner)
             .map(|p| p.milliseconds)
-            .sum()
+            .fold(0.0, |a, b| a + b)
     }
 
     /// Sum over all passes.
     pub fn frame_total(&self) -> f64 {
-        self.passes.iter().map(|p| p.milliseconds).sum()
+        self.passes
+            .iter()
+            .map(|p| p.milliseconds)
+            .fold(0.0, |a, b| a + b)
     }
 }
 
@@ -247,7 +250,10 @@ impl<'a> PassRecorder<'a> {
                 (TimingSource::GpuTimestamps, times)
             }
             Some(_) => (TimingSource::GpuTimestamps, Vec::new()),
-            None => (TimingSource::CpuWallClock, std::mem::take(&mut self.cpu_times)),
+            None => (
+                TimingSource::CpuWallClock,
+                std::mem::take(&mut self.cpu_times),
+            ),
         };
         FrameTimings {
             source,

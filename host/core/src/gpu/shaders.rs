@@ -168,7 +168,8 @@ impl ShaderLibrary {
         validator.validate(&module).map_err(|e| {
             let location = e.location(&composed.source);
             let mut message = e.as_inner().to_string();
-            let mut source: Option<&dyn std::error::Error> = std::error::Error::source(e.as_inner());
+            let mut source: Option<&dyn std::error::Error> =
+                std::error::Error::source(e.as_inner());
             while let Some(inner) = source {
                 message.push_str(": ");
                 message.push_str(&inner.to_string());
@@ -264,6 +265,9 @@ mod tests {
         let err = library.compose("loop.wgsl").unwrap_err().to_string();
         assert_eq!(err, "shaders/loop.wgsl:1: `loop.wgsl` imports itself");
         let err = library.compose("missing.wgsl").unwrap_err().to_string();
-        assert_eq!(err, "shaders/missing.wgsl:2: cannot import `common/nope.wgsl`: no such shader");
+        assert_eq!(
+            err,
+            "shaders/missing.wgsl:2: cannot import `common/nope.wgsl`: no such shader"
+        );
     }
 }

@@ -84,6 +84,8 @@ pub struct GBufferData {
     pub positions: Vec<Vec4>,
     /// World normal (facing the camera).
     pub normals: Vec<Vec3>,
+    /// Albedo (rgb), specular strength and shininess per pixel.
+    pub materials: Vec<crate::scene::shading::Material>,
 }
 
 struct ActiveTechnique {
@@ -117,7 +119,10 @@ pub struct Renderer {
     technique: ActiveTechnique,
 }
 
-fn create_output(gpu: &GpuContext, size: UVec2) -> (wgpu::Texture, wgpu::TextureView, wgpu::TextureView) {
+fn create_output(
+    gpu: &GpuContext,
+    size: UVec2,
+) -> (wgpu::Texture, wgpu::TextureView, wgpu::TextureView) {
     let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("output image"),
         size: wgpu::Extent3d {
@@ -256,7 +261,7 @@ impl Renderer {
         let lighting_inputs = lighting.inputs(&gpu, &visibility, &indirect);
         let debug = DebugViewPass::new(&gpu, &shaders)?;
         let timestamps = TimestampQueries::new(&gpu);
-        Ok(Renderer {
+        let mut renderer = Renderer {
             camera: scene.camera,
             lights: scene.lights.clone(),
             gpu,
@@ -277,7 +282,9 @@ impl Renderer {
             debug,
             timestamps,
             technique,
-        })
+        };
+        renderer.update_slots();
+        Ok(renderer)
     }
 
     /// The GPU context.
@@ -342,10 +349,13 @@ impl Renderer {
             self.size = size;
             self.gbuffer = GBuffer::new(&self.gpu, size);
             self.indirect = IndirectTarget::new(&self.gpu, size);
-            (self.output, self.output_view, self.output_debug_view) = create_output(&self.gpu, size);
+            (self.output, self.output_view, self.output_debug_view) =
+                create_output(&self.gpu, size);
             self.visibility =
                 VisibilityTargets::new(&self.gpu, size, self.visibility.slots.clone());
-            self.lighting_inputs = self.lighting.inputs(&self.gpu, &self.visibility, &self.indirect);
+            self.lighting_inputs =
+                self.lighting
+                    .inputs(&self.gpu, &self.visibility, &self.indirect);
             self.technique.pending.resolution = true;
         }
         Ok(())
@@ -380,7 +390,9 @@ impl Renderer {
         };
         if slots != self.visibility.slots {
             self.visibility = VisibilityTargets::new(&self.gpu, self.size, slots);
-            self.lighting_inputs = self.lighting.inputs(&self.gpu, &self.visibility, &self.indirect);
+            self.lighting_inputs =
+                self.lighting
+                    .inputs(&self.gpu, &self.visibility, &self.indirect);
             self.technique.pending.lights = true;
         }
     }
@@ -421,7 +433,9 @@ impl Renderer {
         clear_visibility(&mut recorder, &self.visibility, &self.indirect);
         recorder.set_owner(PassOwner::Technique);
         let active = &mut self.technique;
-        let recorded = guarded(&self.gpu, id, || active.instance.record(&ctx, &mut recorder));
+        let recorded = guarded(&self.gpu, id, || {
+            active.instance.record(&ctx, &mut recorder)
+        });
         if let Err(e) = recorded {
             drop(recorder);
             self.gpu.wait_idle();
@@ -455,7 +469,10 @@ impl Renderer {
 
     /// Swaps in `unshadowed` after a failure and passes the error on.
     fn fallback_later(&mut self, error: TechniqueError) -> RenderError {
-        log::error!("{error}; falling back to `{}`", crate::builtin::UNSHADOWED_ID);
+        log::error!(
+            "{error}; falling back to `{}`",
+            crate::builtin::UNSHADOWED_ID
+        );
         if let Ok(baseline) = technique::find_technique(crate::builtin::UNSHADOWED_ID)
             && let Ok(next) = instantiate(&self.gpu, baseline, &ParamValues::new())
         {
@@ -470,8 +487,7 @@ impl Renderer {
         let farthest = [lo, hi]
             .iter()
             .map(|c| c.distance(self.camera.position))
-            .fold(0.0, f32::max)
-            + lo.distance(hi);
+            .fold(0.0, f32::max);
         Ok(match view {
             View::Final => unreachable!("the final view is the lighting pass"),
             View::Visibility { light } => {
@@ -494,7 +510,10 @@ impl Renderer {
             }
             View::Normals => DebugSource {
                 view: &self.gbuffer.normal_view,
-                mapping: ViewMapping::Color { min: -1.0, max: 1.0 },
+                mapping: ViewMapping::Color {
+                    min: -1.0,
+                    max: 1.0,
+                },
                 linearize: None,
             },
             View::Albedo => DebugSource {
@@ -577,12 +596,28 @@ impl Renderer {
             wgpu::TextureAspect::All,
             8,
         ));
+        let albedo = readback::read_texture(
+            &self.gpu,
+            &self.gbuffer.albedo,
+            0,
+            wgpu::TextureAspect::All,
+            4,
+        );
         GBufferData {
             size: self.size,
             positions: positions.chunks_exact(4).map(Vec4::from_slice).collect(),
             normals: normals
                 .chunks_exact(4)
                 .map(|n| Vec3::new(n[0], n[1], n[2]))
+                .collect(),
+            materials: albedo
+                .chunks_exact(4)
+                .zip(normals.chunks_exact(4))
+                .map(|(a, n)| crate::scene::shading::Material {
+                    albedo: Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32) / 255.0,
+                    specular: a[3] as f32 / 255.0,
+                    shininess: n[3] * 256.0,
+                })
                 .collect(),
         }
     }

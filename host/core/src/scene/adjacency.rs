@@ -81,6 +81,12 @@ impl Adjacency {
         out
     }
 
+    /// Builds adjacency for `mesh` as a single object.
+    pub fn of_mesh(mesh: &MeshData) -> Adjacency {
+        let whole = 0..mesh.indices.len();
+        Adjacency::build(mesh, std::slice::from_ref(&whole))
+    }
+
     fn count(&self, kind: EdgeKind) -> usize {
         self.edges.iter().filter(|e| e.kind() == kind).count()
     }
@@ -161,7 +167,7 @@ mod tests {
     use crate::scene::mesh;
 
     fn whole(m: &MeshData) -> Adjacency {
-        Adjacency::build(m, &[0..m.indices.len()])
+        Adjacency::of_mesh(m)
     }
 
     #[test]
@@ -190,13 +196,7 @@ mod tests {
     #[test]
     fn three_faces_on_one_edge_are_non_manifold() {
         let m = MeshData {
-            positions: vec![
-                Vec3::ZERO,
-                Vec3::X,
-                Vec3::Y,
-                Vec3::NEG_Y,
-                Vec3::Z,
-            ],
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::NEG_Y, Vec3::Z],
             normals: vec![Vec3::Z; 5],
             indices: vec![0, 1, 2, 1, 0, 3, 0, 1, 4],
         };

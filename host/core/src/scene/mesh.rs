@@ -320,11 +320,10 @@ pub fn load_obj(path: &Path) -> Result<(MeshData, MeshReport), ObjError> {
 pub fn parse_obj(text: &str) -> Result<(MeshData, MeshReport), ObjError> {
     let polygons_triangulated = prevalidate_obj(text)?;
     let mut reader = std::io::Cursor::new(text.as_bytes());
-    let (models, _materials) =
-        tobj::load_obj_buf(&mut reader, &tobj::GPU_LOAD_OPTIONS, |_| {
-            Ok(Default::default())
-        })
-        .map_err(|e| ObjError::Load(e.to_string()))?;
+    let (models, _materials) = tobj::load_obj_buf(&mut reader, &tobj::GPU_LOAD_OPTIONS, |_| {
+        Ok(Default::default())
+    })
+    .map_err(|e| ObjError::Load(e.to_string()))?;
 
     let mut mesh = MeshData::default();
     let mut normals_computed = false;
@@ -460,7 +459,7 @@ mod tests {
     use super::*;
 
     fn closed_after_welding(mesh: &MeshData) -> bool {
-        let adjacency = crate::scene::adjacency::Adjacency::build(mesh, &[0..mesh.indices.len()]);
+        let adjacency = crate::scene::adjacency::Adjacency::of_mesh(mesh);
         adjacency.boundary_edges() == 0 && adjacency.non_manifold_edges() == 0
     }
 
@@ -525,8 +524,7 @@ mod tests {
 
     #[test]
     fn obj_quads_are_triangulated_and_normals_computed() {
-        let (mesh, report) =
-            parse_obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        let (mesh, report) = parse_obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
         assert_eq!(mesh.triangle_count(), 2);
         assert!(report.normals_computed);
         assert_eq!(report.polygons_triangulated, 1);
@@ -555,7 +553,10 @@ mod tests {
         let err = parse_obj("v 0 0 0\nv 1 x 0\n").unwrap_err();
         assert!(err.to_string().starts_with("line 2, column 5"), "{err}");
         let err = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap_err();
-        assert!(err.to_string().contains("vertex index 7 is out of range"), "{err}");
+        assert!(
+            err.to_string().contains("vertex index 7 is out of range"),
+            "{err}"
+        );
         assert_eq!(parse_obj("# nothing\n").unwrap_err(), ObjError::Empty);
         assert_eq!(
             parse_obj("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap_err(),

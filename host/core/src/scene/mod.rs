@@ -4,6 +4,7 @@
 pub mod adjacency;
 pub mod description;
 pub mod mesh;
+pub mod shading;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -210,13 +211,12 @@ impl Scene {
 
     /// Parses RON `text`; `path` names it in errors and `base` resolves OBJ paths.
     pub fn from_ron(text: &str, path: &Path, base: &Path) -> Result<Scene, SceneError> {
-        let description: SceneDescription =
-            ron::from_str(text).map_err(|e| SceneError::Parse {
-                path: path.to_path_buf(),
-                line: e.span.start.line,
-                col: e.span.start.col,
-                message: e.code.to_string(),
-            })?;
+        let description: SceneDescription = ron::from_str(text).map_err(|e| SceneError::Parse {
+            path: path.to_path_buf(),
+            line: e.span.start.line,
+            col: e.span.start.col,
+            message: e.code.to_string(),
+        })?;
         Scene::from_description(&description, path, base)
     }
 
@@ -255,7 +255,10 @@ impl Scene {
             .map_err(|(f, m)| invalid(f, &m))?;
 
         if desc.objects.is_empty() {
-            return Err(invalid("objects".into(), "a scene needs at least one object"));
+            return Err(invalid(
+                "objects".into(),
+                "a scene needs at least one object",
+            ));
         }
         let mut mesh = MeshData::default();
         let mut objects = Vec::with_capacity(desc.objects.len());
@@ -269,7 +272,8 @@ impl Scene {
                 (t.rotation_degrees, "rotation_degrees"),
                 (t.scale, "scale"),
             ] {
-                check_vec(v, &format!("{field}.transform.{name}")).map_err(|(f, m)| invalid(f, m))?;
+                check_vec(v, &format!("{field}.transform.{name}"))
+                    .map_err(|(f, m)| invalid(f, m))?;
             }
             if t.scale.cmpeq(Vec3::ZERO).any() {
                 return Err(invalid(
@@ -378,7 +382,10 @@ fn check_positive(v: f32, field: &str) -> Result<(), FieldError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err((field.to_string(), "must be a finite number greater than zero"))
+        Err((
+            field.to_string(),
+            "must be a finite number greater than zero",
+        ))
     }
 }
 
@@ -543,7 +550,9 @@ fn build_mesh(
             rings,
         } => {
             if !positive(&[radius]) || !count_ok(segments) || !count_ok(rings) {
-                return Err(invalid("Sphere needs radius > 0 and 3..=4096 segments and rings"));
+                return Err(invalid(
+                    "Sphere needs radius > 0 and 3..=4096 segments and rings",
+                ));
             }
             mesh::sphere(radius, segments, rings)
         }
@@ -553,7 +562,9 @@ fn build_mesh(
             segments,
         } => {
             if !positive(&[radius, height]) || !count_ok(segments) {
-                return Err(invalid("Cylinder needs radius, height > 0 and 3..=4096 segments"));
+                return Err(invalid(
+                    "Cylinder needs radius, height > 0 and 3..=4096 segments",
+                ));
             }
             mesh::cylinder(radius, height, segments)
         }
@@ -563,11 +574,10 @@ fn build_mesh(
             segments,
             rings,
         } => {
-            if !positive(&[major_radius, minor_radius])
-                || !count_ok(segments)
-                || !count_ok(rings)
-            {
-                return Err(invalid("Torus needs radii > 0 and 3..=4096 segments and rings"));
+            if !positive(&[major_radius, minor_radius]) || !count_ok(segments) || !count_ok(rings) {
+                return Err(invalid(
+                    "Torus needs radii > 0 and 3..=4096 segments and rings",
+                ));
             }
             mesh::torus(major_radius, minor_radius, segments, rings)
         }
@@ -577,7 +587,9 @@ fn build_mesh(
             segments,
         } => {
             if !positive(&[radius, height]) || !count_ok(segments) {
-                return Err(invalid("Cone needs radius, height > 0 and 3..=4096 segments"));
+                return Err(invalid(
+                    "Cone needs radius, height > 0 and 3..=4096 segments",
+                ));
             }
             mesh::cone(radius, height, segments)
         }
@@ -601,7 +613,10 @@ fn receiver_plane(object: usize, transform: Mat4, size: f32) -> ReceiverPlane {
 fn validate_paths(paths: &PathsDesc, light_count: usize) -> Result<(), (String, String)> {
     let times_increase = |times: &[f32], field: String| -> Result<(), (String, String)> {
         if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[1] <= w[0]) {
-            Err((field, "key times must be finite and strictly increasing".into()))
+            Err((
+                field,
+                "key times must be finite and strictly increasing".into(),
+            ))
         } else {
             Ok(())
         }
@@ -610,7 +625,10 @@ fn validate_paths(paths: &PathsDesc, light_count: usize) -> Result<(), (String, 
     times_increase(&camera_times, "paths.camera".into())?;
     for (i, k) in paths.camera.iter().enumerate() {
         if !(k.position.is_finite() && k.target.is_finite()) {
-            return Err((format!("paths.camera[{i}]"), "coordinates must be finite numbers".into()));
+            return Err((
+                format!("paths.camera[{i}]"),
+                "coordinates must be finite numbers".into(),
+            ));
         }
     }
     for (i, path) in paths.lights.iter().enumerate() {
@@ -623,7 +641,10 @@ fn validate_paths(paths: &PathsDesc, light_count: usize) -> Result<(), (String, 
         let times: Vec<f32> = path.keys.iter().map(|k| k.time).collect();
         times_increase(&times, format!("paths.lights[{i}]"))?;
         if path.keys.iter().any(|k| !k.value.is_finite()) {
-            return Err((format!("paths.lights[{i}]"), "coordinates must be finite numbers".into()));
+            return Err((
+                format!("paths.lights[{i}]"),
+                "coordinates must be finite numbers".into(),
+            ));
         }
     }
     Ok(())

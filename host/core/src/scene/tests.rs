@@ -60,7 +60,10 @@ fn unknown_fields_are_rejected_with_their_name() {
 fn non_finite_values_name_the_field() {
     let text = MINIMAL.replace("position: (0, 4, 0)", "position: (0, NaN, 0)");
     let err = parse(&text).unwrap_err().to_string();
-    assert_eq!(err, "test.ron: lights[0].position: coordinates must be finite numbers");
+    assert_eq!(
+        err,
+        "test.ron: lights[0].position: coordinates must be finite numbers"
+    );
     let text = MINIMAL.replace("translation: (0, 0.5, 0)", "translation: (0, inf, 0)");
     let err = parse(&text).unwrap_err().to_string();
     assert!(err.contains("objects[1].transform.translation"), "{err}");
@@ -78,7 +81,12 @@ fn too_many_lights_and_no_lights_are_errors() {
     assert_eq!(parse(&text).unwrap().lights.len(), 256);
 
     let text = MINIMAL.replace("Point(position: (0, 4, 0), intensity: 10)", "");
-    assert!(parse(&text).unwrap_err().to_string().contains("at least one light"));
+    assert!(
+        parse(&text)
+            .unwrap_err()
+            .to_string()
+            .contains("at least one light")
+    );
 }
 
 #[test]
@@ -88,14 +96,25 @@ fn bad_light_parameters_are_errors() {
         "Spot(position: (0, 4, 0), direction: (0, 0, 0))",
     );
     let err = parse(&text).unwrap_err().to_string();
-    assert!(err.contains("lights[0].direction: must not be zero"), "{err}");
+    assert!(
+        err.contains("lights[0].direction: must not be zero"),
+        "{err}"
+    );
     let text = MINIMAL.replace("intensity: 10", "intensity: 10, range: -1");
-    assert!(parse(&text).unwrap_err().to_string().contains("lights[0].range"));
+    assert!(
+        parse(&text)
+            .unwrap_err()
+            .to_string()
+            .contains("lights[0].range")
+    );
 }
 
 #[test]
 fn receiver_must_be_a_plane() {
-    let text = MINIMAL.replace("(mesh: Box(size: (1, 1, 1)),", "(mesh: Box(size: (1, 1, 1)), receiver: true,");
+    let text = MINIMAL.replace(
+        "(mesh: Box(size: (1, 1, 1)),",
+        "(mesh: Box(size: (1, 1, 1)), receiver: true,",
+    );
     let err = parse(&text).unwrap_err().to_string();
     assert!(err.contains("objects[1].receiver: only Plane"), "{err}");
 }
@@ -104,7 +123,10 @@ fn receiver_must_be_a_plane() {
 fn missing_obj_names_scene_field_and_file() {
     let text = MINIMAL.replace("Box(size: (1, 1, 1))", r#"Obj("missing/bunny.obj")"#);
     let err = parse(&text).unwrap_err().to_string();
-    assert!(err.starts_with("test.ron: objects[1].mesh: ./missing/bunny.obj: cannot read"), "{err}");
+    assert!(
+        err.starts_with("test.ron: objects[1].mesh: ./missing/bunny.obj: cannot read"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -112,8 +134,13 @@ fn malformed_obj_reports_its_line() {
     let dir = temp_dir("badobj");
     std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 zz\nf 1 2 3\n").unwrap();
     let text = MINIMAL.replace("Box(size: (1, 1, 1))", r#"Obj("bad.obj")"#);
-    let err = Scene::from_ron(&text, &dir.join("s.ron"), &dir).unwrap_err().to_string();
-    assert!(err.contains("bad.obj: line 3, column 7: `zz` is not a number"), "{err}");
+    let err = Scene::from_ron(&text, &dir.join("s.ron"), &dir)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("bad.obj: line 3, column 7: `zz` is not a number"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -127,7 +154,11 @@ fn obj_without_normals_and_with_quads_loads() {
     let text = MINIMAL.replace("Box(size: (1, 1, 1))", r#"Obj("quad.obj")"#);
     let scene = Scene::from_ron(&text, &dir.join("s.ron"), &dir).unwrap();
     let object = &scene.objects[1];
-    assert_eq!(object.indices.len(), 6, "quad triangulated, degenerate face dropped");
+    assert_eq!(
+        object.indices.len(),
+        6,
+        "quad triangulated, degenerate face dropped"
+    );
     assert!(object.report.normals_computed);
     assert_eq!(object.report.degenerate_removed, 1);
     let first = scene.mesh.indices[object.indices.start] as usize;
@@ -141,18 +172,31 @@ fn paths_are_validated() {
         "paths: (lights: [(light: 3, keys: [(time: 0, value: (0, 1, 0))])]),\n    objects: [",
     );
     let err = parse(&text).unwrap_err().to_string();
-    assert!(err.contains("paths.lights[0].light: light 3 does not exist"), "{err}");
+    assert!(
+        err.contains("paths.lights[0].light: light 3 does not exist"),
+        "{err}"
+    );
     let text = MINIMAL.replace(
         "objects: [",
         "paths: (camera: [(time: 1, position: (0, 1, 5), target: (0, 0, 0)), (time: 0, position: (0, 1, 5), target: (0, 0, 0))]),\n    objects: [",
     );
-    assert!(parse(&text).unwrap_err().to_string().contains("strictly increasing"));
+    assert!(
+        parse(&text)
+            .unwrap_err()
+            .to_string()
+            .contains("strictly increasing")
+    );
 }
 
 #[test]
 fn missing_scene_file_is_an_io_error() {
-    let err = Scene::load(Path::new("no/such/scene.ron")).unwrap_err().to_string();
-    assert!(err.starts_with("no/such/scene.ron: cannot read scene"), "{err}");
+    let err = Scene::load(Path::new("no/such/scene.ron"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with("no/such/scene.ron: cannot read scene"),
+        "{err}"
+    );
 }
 
 /// The real third-party meshes in `../shared/models` (not part of the repository).
@@ -179,10 +223,17 @@ fn real_meshes_load() {
         ("spot.obj", 5_000, false),
     ] {
         let (mesh, report) = mesh::load_obj(&dir.join(file)).unwrap();
-        assert!(mesh.triangle_count() >= min_triangles, "{file}: {}", mesh.triangle_count());
+        assert!(
+            mesh.triangle_count() >= min_triangles,
+            "{file}: {}",
+            mesh.triangle_count()
+        );
         assert!(mesh.positions.iter().all(|p| p.is_finite()));
-        assert!(mesh.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-3), "{file}");
-        let adjacency = Adjacency::build(&mesh, &[0..mesh.indices.len()]);
+        assert!(
+            mesh.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-3),
+            "{file}"
+        );
+        let adjacency = Adjacency::of_mesh(&mesh);
         if open {
             assert!(
                 adjacency.boundary_edges() + adjacency.non_manifold_edges() > 0,

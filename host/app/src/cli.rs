@@ -1,0 +1,103 @@
+//! Command-line arguments.
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+use glam::UVec2;
+
+/// Shadow Zoo: real-time shadow techniques side by side, judged against ray-traced visibility.
+#[derive(Debug, Parser)]
+#[command(name = "shadow-zoo", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// What to do.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// List the registered techniques: id, description and supported light kinds.
+    List,
+    /// Render one frame off-screen and write it as PNG.
+    Render(RenderArgs),
+}
+
+/// Arguments of `shadow-zoo render`.
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    /// Scene file (RON). Defaults to the built-in planar-room scene.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Technique id (see `shadow-zoo list`).
+    #[arg(long, default_value = "unshadowed")]
+    pub technique: String,
+    /// Output size as WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    pub size: UVec2,
+    /// PNG file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Set a technique parameter, e.g. `--set map_size=4096` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_assignment)]
+    pub set: Vec<(String, String)>,
+    /// What to show: final, visibility[:LIGHT], normals, depth, albedo, or a technique resource.
+    #[arg(long, default_value = "final")]
+    pub view: String,
+    /// Print per-pass GPU times.
+    #[arg(long)]
+    pub timings: bool,
+}
+
+/// Parses `WIDTHxHEIGHT`.
+pub fn parse_size(text: &str) -> Result<UVec2, String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got `{text}`"))?;
+    let side = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|v| (1..=zoo_host::render::MAX_OUTPUT_SIDE).contains(v))
+            .ok_or_else(|| {
+                format!(
+                    "`{s}` is not a size in 1..={}",
+                    zoo_host::render::MAX_OUTPUT_SIDE
+                )
+            })
+    };
+    Ok(UVec2::new(side(w)?, side(h)?))
+}
+
+/// Parses `KEY=VALUE`.
+pub fn parse_assignment(text: &str) -> Result<(String, String), String> {
+    let (key, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("expected KEY=VALUE, got `{text}`"))?;
+    if key.trim().is_empty() {
+        return Err(format!("missing key in `{text}`"));
+    }
+    Ok((key.trim().to_string(), value.trim().to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_and_reject_bad_input() {
+        assert_eq!(parse_size("256x128"), Ok(UVec2::new(256, 128)));
+        assert!(parse_size("256").unwrap_err().contains("WIDTHxHEIGHT"));
+        assert!(parse_size("0x5").unwrap_err().contains("`0` is not a size"));
+        assert!(parse_size("99999x5").is_err());
+    }
+
+    #[test]
+    fn assignments_parse() {
+        assert_eq!(
+            parse_assignment("map_size=2048"),
+            Ok(("map_size".into(), "2048".into()))
+        );
+        assert!(parse_assignment("novalue").is_err());
+        assert!(parse_assignment("=3").is_err());
+    }
+}

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Runs the whole test suite headless (README's test command; .ci/run calls it too).
+# On Linux without a Vulkan driver it installs Mesa's lavapipe software driver when run as
+# root, and otherwise stops with the command to run.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if [ "$(uname -s)" = Linux ]; then
+    have_driver() {
+        ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 &&
+            { ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'; }
+    }
+    if ! have_driver; then
+        install="apt-get update && apt-get install -y mesa-vulkan-drivers libvulkan1"
+        if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+            echo "No Vulkan driver found: installing lavapipe ($install)"
+            apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers libvulkan1
+        else
+            echo "No Vulkan driver found. Install Mesa's software driver (lavapipe) first:" >&2
+            echo "    sudo $install" >&2
+            exit 1
+        fi
+    fi
+    # One software adapter only (lavapipe), not a second GL one.
+    export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
+    export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
+fi
+export RUST_LOG="${RUST_LOG:-warn}"
+
+exec cargo test --workspace --locked "$@"

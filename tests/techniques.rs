@@ -1,0 +1,267 @@
+//! Every registered technique renders headless; the deferred lighting matches its CPU mirror.
+
+use glam::{UVec2, Vec3};
+use zoo_host::params::ParamValues;
+use zoo_host::render::GBufferData;
+use zoo_host::scene::shading;
+use zoo_host::test_support::{gpu, scene_path, workspace_root};
+use zoo_host::{Renderer, Scene, View, registry};
+
+fn load(name: &str) -> Scene {
+    Scene::load(&scene_path(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn every_plugin_crate_is_linked_and_registered() {
+    // Touch the application library so its plugin links are part of this binary.
+    let linked = shadow_zoo::LINKED_PLUGINS;
+    let dir = workspace_root().join("plugins");
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(&dir).expect("plugins/ exists") {
+        let manifest = entry.unwrap().path().join("Cargo.toml");
+        let Ok(text) = std::fs::read_to_string(&manifest) else {
+            continue;
+        };
+        let table: toml::Table = text.parse().unwrap();
+        let name = table["package"]["name"].as_str().unwrap().to_string();
+        assert!(
+            linked.contains(&name.as_str()),
+            "{} is not a dependency of the application: add `{name} = {{ path = \"{}\" }}` to Cargo.toml",
+            manifest.display(),
+            manifest
+                .parent()
+                .unwrap()
+                .strip_prefix(workspace_root())
+                .unwrap()
+                .display()
+        );
+        assert!(
+            registry().iter().any(|r| r.package == name),
+            "{name} is linked but registers no technique (missing `zoo_host::register_technique!`?)"
+        );
+        found.push(name);
+    }
+    assert_eq!(
+        found.len(),
+        linked.len(),
+        "linked {linked:?}, found under plugins/ {found:?}"
+    );
+    assert!(registry().iter().any(|r| r.id == "unshadowed"));
+}
+
+/// Expected sRGB output of the lighting pass at every geometry pixel, from the G-buffer and
+/// the CPU mirror of the shading model, with every light's visibility given by `visibility`.
+fn expected_image(scene: &Scene, g: &GBufferData, visibility: &[Vec<f32>]) -> Vec<Option<Vec3>> {
+    (0..g.positions.len())
+        .map(|i| {
+            let p = g.positions[i];
+            if p.w < 0.5 {
+                return None;
+            }
+            let m = &g.materials[i];
+            let view_dir = (scene.camera.position - p.truncate()).normalize();
+            let mut c = scene.ambient * m.albedo;
+            for (l, light) in scene.lights.iter().enumerate() {
+                c += visibility[l][i]
+                    * shading::direct_light(light, p.truncate(), g.normals[i], view_dir, m);
+            }
+            Some(shading::tonemap(c).map(shading::linear_to_srgb) * 255.0)
+        })
+        .collect()
+}
+
+fn assert_matches_cpu_shading(scene_name: &str, size: UVec2) {
+    let scene = load(scene_name);
+    let mut renderer = Renderer::new(gpu(), scene.clone(), size).unwrap();
+    renderer.render(&View::Final).unwrap();
+    let image = renderer.read_output();
+    let g = renderer.read_gbuffer();
+    let visibility: Vec<_> = (0..scene.lights.len())
+        .map(|l| renderer.read_visibility(l))
+        .collect();
+    let expected = expected_image(&scene, &g, &visibility);
+    let (mut compared, mut off) = (0, 0);
+    for (i, e) in expected.iter().enumerate() {
+        let Some(e) = e else { continue };
+        let px = image.as_raw()[i * 4..i * 4 + 3].iter().map(|&v| v as f32);
+        compared += 1;
+        if px.zip(e.to_array()).any(|(a, b)| (a - b).abs() > 3.0) {
+            off += 1;
+        }
+    }
+    assert!(
+        compared > (size.x * size.y / 3) as usize,
+        "{scene_name}: only {compared} geometry pixels"
+    );
+    let fraction = off as f64 / compared as f64;
+    assert!(
+        fraction < 0.002,
+        "{scene_name}: {off} of {compared} pixels differ from the CPU shading by more than 3/255"
+    );
+}
+
+#[test]
+fn deferred_lighting_matches_cpu_shading_on_planar_room() {
+    assert_matches_cpu_shading("planar-room.ron", UVec2::new(192, 144));
+}
+
+#[test]
+fn deferred_lighting_matches_cpu_shading_with_64_packed_lights() {
+    // `unshadowed` lets non-overlapping lights share visibility slots: the lighting pass must
+    // still find every light's slot.
+    let scene = load("many-lights.ron");
+    assert!(scene.lights.len() >= 64);
+    let renderer = Renderer::new(gpu(), scene.clone(), UVec2::new(64, 64)).unwrap();
+    let slots = renderer.slots().slot_count();
+    assert!(
+        slots < scene.lights.len() as u32,
+        "no packing: {slots} slots"
+    );
+    drop(renderer);
+    assert_matches_cpu_shading("many-lights.ron", UVec2::new(128, 96));
+}
+
+#[test]
+fn every_technique_renders_lit_and_finite() {
+    let scene = load("planar-room.ron");
+    let size = UVec2::new(160, 120);
+    let mut renderer = Renderer::new(gpu(), scene.clone(), size).unwrap();
+    renderer.render(&View::Final).unwrap();
+    let baseline = renderer.read_output();
+    let g = renderer.read_gbuffer();
+    assert!(
+        g.positions.iter().all(|p| p.is_finite()),
+        "non-finite G-buffer position"
+    );
+    assert!(
+        g.normals.iter().all(|n| n.is_finite()),
+        "non-finite G-buffer normal"
+    );
+    let geometry: Vec<usize> = (0..g.positions.len())
+        .filter(|&i| g.positions[i].w > 0.5)
+        .collect();
+
+    for registration in registry() {
+        let id = registration.id;
+        renderer
+            .set_technique(id, &ParamValues::new())
+            .unwrap_or_else(|e| panic!("{id}: {e}"));
+        let timings = renderer
+            .render(&View::Final)
+            .unwrap_or_else(|e| panic!("{id}: {e}"));
+        assert_eq!(renderer.technique().id, id, "{id} fell back to unshadowed");
+        let image = renderer.read_output();
+        let raw = image.as_raw();
+        // Shadows only take direct light away: never brighter than the unshadowed frame.
+        let brighter = (0..raw.len())
+            .filter(|&k| k % 4 != 3 && raw[k] as i32 > baseline.as_raw()[k] as i32 + 2)
+            .count();
+        assert_eq!(
+            brighter, 0,
+            "{id}: {brighter} channels brighter than unshadowed"
+        );
+        // Most of planar-room is lit by some light.
+        let ambient_only = 0.04 * 0.8;
+        let lit = geometry
+            .iter()
+            .filter(|&&i| {
+                let luminance = raw[i * 4..i * 4 + 3]
+                    .iter()
+                    .map(|&v| v as f32 / 255.0)
+                    .sum::<f32>()
+                    / 3.0;
+                luminance
+                    > shading::linear_to_srgb(shading::tonemap(Vec3::splat(ambient_only)).x) + 0.05
+            })
+            .count();
+        assert!(
+            lit * 2 > geometry.len(),
+            "{id}: only {lit} of {} geometry pixels are lit",
+            geometry.len()
+        );
+        for light in 0..scene.lights.len() {
+            let v = renderer.read_visibility(light);
+            let shadowed = v.iter().filter(|&&x| x < 0.5).count();
+            assert!(
+                shadowed < v.len() * 9 / 10,
+                "{id}: light {light} is shadowed almost everywhere"
+            );
+        }
+        let declared: Vec<String> = renderer
+            .technique_instance()
+            .passes()
+            .into_iter()
+            .map(|p| p.name)
+            .collect();
+        let recorded: Vec<String> = timings
+            .passes
+            .iter()
+            .filter(|p| p.owner == zoo_host::gpu::PassOwner::Technique)
+            .map(|p| p.name.clone())
+            .collect();
+        assert_eq!(
+            recorded, declared,
+            "{id}: recorded passes differ from its declared passes"
+        );
+    }
+}
+
+#[test]
+fn debug_views_render_and_unknown_views_are_errors() {
+    let scene = load("planar-room.ron");
+    let mut renderer = Renderer::new(gpu(), scene, UVec2::new(64, 64)).unwrap();
+    for view in ["normals", "depth", "albedo", "visibility:2"] {
+        renderer
+            .render(&view.parse().unwrap())
+            .unwrap_or_else(|e| panic!("{view}: {e}"));
+        let image = renderer.read_output();
+        assert!(image.pixels().any(|p| p.0[0] > 20), "{view} is black");
+    }
+    // Unshadowed: visibility is 1 everywhere, shown white.
+    renderer.render(&View::Visibility { light: 0 }).unwrap();
+    assert!(renderer.read_output().pixels().all(|p| p.0[0] == 255));
+    let err = renderer
+        .render(&View::Visibility { light: 9 })
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("the scene has 3 lights"), "{err}");
+    let err = renderer
+        .render(&View::Resource("shadow map".into()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("not a view of `unshadowed`"), "{err}");
+}
+
+#[test]
+fn every_standard_scene_loads_and_renders() {
+    let mut renderer = Renderer::new(gpu(), load("planar-room.ron"), UVec2::new(64, 48)).unwrap();
+    drop(renderer.render(&View::Final).unwrap());
+    for name in [
+        "planar-room",
+        "curved",
+        "dense",
+        "atrium",
+        "many-lights",
+        "inside-shadow",
+        "thin-casters",
+        "contact",
+    ] {
+        let scene = load(&format!("{name}.ron"));
+        match name {
+            "dense" => assert!(
+                scene.triangle_count() >= 200_000,
+                "dense has {}",
+                scene.triangle_count()
+            ),
+            "many-lights" => assert!(scene.lights.len() >= 64),
+            "planar-room" => assert_eq!(scene.receivers.len(), 3),
+            _ => {}
+        }
+        renderer = Renderer::new(gpu(), scene, UVec2::new(64, 48)).unwrap();
+        renderer
+            .render(&View::Final)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let image = renderer.read_output();
+        assert!(image.pixels().any(|p| p.0[0] > 60), "{name} renders dark");
+    }
+}
