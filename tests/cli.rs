@@ -105,3 +105,127 @@ fn bad_input_exits_non_zero_with_a_message_and_no_panic() {
         assert!(!all.contains("panicked"), "{args:?} panicked:\n{all}");
     }
 }
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("zoo-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn compare_writes_csv_report_and_error_maps() {
+    let out_dir = temp_dir("compare").join("results");
+    let out = shadow_zoo(&[
+        "compare",
+        "--scene",
+        "scenes/planar-room.ron",
+        "--techniques",
+        "unshadowed",
+        "--size",
+        "64x48",
+        "--samples",
+        "4",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some(
+            "scene,technique,light,light_kind,pixels,false_shadow,false_lit,false_shadow_core,false_lit_core,mae,p95_error,gpu_ms"
+        )
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    for (light, row) in rows.iter().enumerate() {
+        assert_eq!(row.len(), 12);
+        assert_eq!(
+            (row[0], row[1], row[2]),
+            ("planar-room", "unshadowed", light.to_string().as_str())
+        );
+        for value in &row[5..11] {
+            let v: f64 = value.parse().unwrap();
+            assert!((0.0..=1.0).contains(&v), "{value}");
+        }
+        assert_eq!(row[5], "0.000000", "unshadowed never shadows");
+        assert!(
+            out_dir
+                .join(format!("unshadowed-light{light}-error.png"))
+                .is_file()
+        );
+    }
+    assert_eq!(rows[0][3], "point");
+    assert_eq!(rows[2][3], "directional");
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(
+        report.contains("Adapter: ") && report.contains("3890 triangles, 3 lights"),
+        "{report}"
+    );
+    assert!(report.contains("| unshadowed | 0 | point |"), "{report}");
+}
+
+#[test]
+fn compare_rejects_bad_input_clearly() {
+    let dir = temp_dir("compare-bad");
+    let no_lights = dir.join("dark.ron");
+    std::fs::write(
+        &no_lights,
+        "(camera: (position: (0, 2, 5), target: (0, 0, 0)), lights: [], objects: [(mesh: Plane(size: 4))])",
+    )
+    .unwrap();
+    let file = dir.join("a-file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let unwritable = file.join("results");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "--scene",
+                "scenes/contact.ron",
+                "--techniques",
+                "unshadowed,bogus",
+            ],
+            "unknown technique `bogus`",
+        ),
+        (
+            vec!["--scene", no_lights.to_str().unwrap()],
+            "lights: a scene needs at least one light",
+        ),
+        (
+            vec!["--scene", "scenes/contact.ron", "--set", "bogus.size=3"],
+            "technique `bogus` is not being compared",
+        ),
+        (
+            vec![
+                "--scene",
+                "scenes/contact.ron",
+                "--set",
+                "unshadowed.size=3",
+            ],
+            "unknown parameter `size`",
+        ),
+    ];
+    for (args, expected) in cases {
+        let mut full = vec!["compare", "--out", dir.to_str().unwrap()];
+        full.extend(args.iter().copied());
+        let out = shadow_zoo(&full);
+        let all = text(&out);
+        assert!(!out.status.success(), "{full:?} succeeded");
+        assert!(
+            all.contains(expected),
+            "{full:?}: expected `{expected}` in:\n{all}"
+        );
+    }
+    let out = shadow_zoo(&[
+        "compare",
+        "--scene",
+        "scenes/contact.ron",
+        "--out",
+        unwritable.to_str().unwrap(),
+    ]);
+    let all = text(&out);
+    assert!(!out.status.success());
+    assert!(all.contains("cannot create output folder"), "{all}");
+}

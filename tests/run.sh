@@ -7,8 +7,12 @@ cd "$(dirname "$0")/.."
 
 if [ "$(uname -s)" = Linux ]; then
     have_driver() {
-        ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 &&
-            { ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'; }
+        local icds
+        shopt -s nullglob
+        icds=(/usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json /usr/local/share/vulkan/icd.d/*.json)
+        shopt -u nullglob
+        # (No `grep -q` on a pipe: with pipefail, ldconfig's SIGPIPE would fail the check.)
+        [ "${#icds[@]}" -gt 0 ] && [[ "$(ldconfig -p 2>/dev/null)" == *libvulkan.so.1* ]]
     }
     if ! have_driver; then
         install="apt-get update && apt-get install -y mesa-vulkan-drivers libvulkan1"

@@ -20,6 +20,33 @@ pub enum Command {
     List,
     /// Render one frame off-screen and write it as PNG.
     Render(RenderArgs),
+    /// Render techniques, judge them against ray-traced visibility, and write results.csv,
+    /// report.md and per-light error maps.
+    Compare(CompareArgs),
+}
+
+/// Arguments of `shadow-zoo compare`.
+#[derive(Debug, clap::Args)]
+pub struct CompareArgs {
+    /// Scene file (RON).
+    #[arg(long)]
+    pub scene: PathBuf,
+    /// Comma-separated technique ids, or `all`.
+    #[arg(long, default_value = "all")]
+    pub techniques: String,
+    /// Output size as WIDTHxHEIGHT.
+    #[arg(long, default_value = "256x256", value_parser = parse_size)]
+    pub size: UVec2,
+    /// Folder for results.csv, report.md and the error maps (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Set a technique parameter, e.g. `--set sm-pcf.map_size=4096` (repeatable).
+    #[arg(long = "set", value_name = "ID.KEY=VALUE", value_parser = parse_assignment)]
+    pub set: Vec<(String, String)>,
+    /// Area-light samples per pixel for the soft reference (rounded up to a square).
+    #[arg(long, default_value_t = zoo_host::judging::DEFAULT_SAMPLES,
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub samples: u32,
 }
 
 /// Arguments of `shadow-zoo render`.

@@ -24,6 +24,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Some(Command::Render(args)) => render(&args),
+        Some(Command::Compare(args)) => crate::compare::run(&args),
     }
 }
 

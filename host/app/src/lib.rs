@@ -5,6 +5,7 @@
 
 pub mod cli;
 pub mod commands;
+pub mod compare;
 
 mod linked {
     include!(concat!(env!("OUT_DIR"), "/linked_plugins.rs"));

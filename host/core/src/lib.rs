@@ -11,9 +11,9 @@ extern crate self as zoo_host;
 
 pub mod builtin;
 pub mod gpu;
+pub mod judging;
 pub mod params;
 pub mod render;
-pub mod scene;
 pub mod technique;
 #[cfg(feature = "test-support")]
 pub mod test_support;
@@ -28,7 +28,11 @@ pub use technique::{
 };
 
 // Re-exported so plugins and the macros need no direct dependency on them.
-pub use {glam, inventory, serde, wgpu};
+/// The reference judge (the GPU-free `zoo-judge` crate).
+pub use zoo_judge as judge;
+/// Scenes, lights, meshes and adjacency (the GPU-free `zoo-scene` crate).
+pub use zoo_scene as scene;
+pub use {glam, image, inventory, serde, wgpu};
 
 /// Compiles the README's code examples ("Writing a technique") as doctests.
 #[cfg(doctest)]

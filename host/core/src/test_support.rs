@@ -28,3 +28,164 @@ pub fn workspace_root() -> PathBuf {
 pub fn scene_path(name: &str) -> PathBuf {
     workspace_root().join("scenes").join(name)
 }
+
+/// A metric the judge reports, for bounds in plugin tests.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Metric {
+    FalseShadow,
+    FalseLit,
+    FalseShadowCore,
+    FalseLitCore,
+    Mae,
+    P95Error,
+}
+
+impl Metric {
+    /// Column name as in `results.csv`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::FalseShadow => "false_shadow",
+            Metric::FalseLit => "false_lit",
+            Metric::FalseShadowCore => "false_shadow_core",
+            Metric::FalseLitCore => "false_lit_core",
+            Metric::Mae => "mae",
+            Metric::P95Error => "p95_error",
+        }
+    }
+
+    /// This metric's value in `metrics`.
+    pub fn of(self, metrics: &zoo_judge::Metrics) -> f64 {
+        match self {
+            Metric::FalseShadow => metrics.false_shadow,
+            Metric::FalseLit => metrics.false_lit,
+            Metric::FalseShadowCore => metrics.false_shadow_core,
+            Metric::FalseLitCore => metrics.false_lit_core,
+            Metric::Mae => metrics.mae,
+            Metric::P95Error => metrics.p95_error,
+        }
+    }
+}
+
+/// A technique rendered on a standard scene and judged.
+pub struct JudgeRun {
+    pub scene: String,
+    pub reference: crate::judging::SceneReference,
+    pub judged: crate::judging::Judged,
+}
+
+/// Renders `scene` (a file in `scenes/`) with `technique` and `params` at `size` and judges
+/// every light with the default number of area samples.
+pub fn judge(scene: &str, technique: &str, params: &[(&str, &str)], size: glam::UVec2) -> JudgeRun {
+    let loaded = crate::scene::Scene::load(&scene_path(scene)).unwrap_or_else(|e| panic!("{e}"));
+    let registration = crate::find_technique(technique).unwrap_or_else(|e| panic!("{e}"));
+    let schema = (registration.params)();
+    let mut values = crate::params::defaults(&schema);
+    let assignments: Vec<(String, String)> = params
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    crate::params::apply_assignments(&schema, &mut values, &assignments)
+        .unwrap_or_else(|e| panic!("{technique}: {e}"));
+    let mut renderer = crate::Renderer::new(gpu(), loaded, size).unwrap_or_else(|e| panic!("{e}"));
+    let reference = crate::judging::SceneReference::compute(
+        &mut renderer,
+        crate::judging::DEFAULT_SAMPLES,
+        |_| {},
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let judged = crate::judging::judge_technique(&mut renderer, &reference, technique, &values)
+        .unwrap_or_else(|e| panic!("{technique} on {scene}: {e}"));
+    JudgeRun {
+        scene: scene.trim_end_matches(".ron").to_string(),
+        reference,
+        judged,
+    }
+}
+
+impl JudgeRun {
+    /// The metrics of `light`; panics if the technique does not support its kind.
+    pub fn metrics(&self, light: usize) -> zoo_judge::Metrics {
+        self.judged.scores[light].metrics.unwrap_or_else(|| {
+            panic!(
+                "{} does not support light {light} ({})",
+                self.judged.technique,
+                self.judged.scores[light].kind.name()
+            )
+        })
+    }
+
+    /// Metrics of `light` counted only where `mask` is true.
+    pub fn metrics_masked(&self, light: usize, mask: &[bool]) -> zoo_judge::Metrics {
+        let (width, height) = self.reference.size();
+        zoo_judge::Metrics::compute(
+            &self.reference.lights[light],
+            &self.judged.visibility[light],
+            width,
+            height,
+            Some(mask),
+        )
+    }
+
+    /// Asserts `metric <= bound` for each pair. On failure, writes the light's error map and
+    /// panics naming the metric, the measured value, the bound and the image.
+    pub fn assert_bounds(
+        &self,
+        light: usize,
+        metrics: &zoo_judge::Metrics,
+        bounds: &[(Metric, f64)],
+    ) {
+        let failures: Vec<String> = bounds
+            .iter()
+            .filter(|(metric, bound)| metric.of(metrics) > *bound)
+            .map(|(metric, bound)| {
+                format!(
+                    "{} = {:.5} exceeds {bound}",
+                    metric.name(),
+                    metric.of(metrics)
+                )
+            })
+            .collect();
+        if failures.is_empty() {
+            return;
+        }
+        let dir = workspace_root().join("target/judge-failures");
+        let path = dir.join(format!(
+            "{}-{}-light{light}-error.png",
+            self.scene, self.judged.technique
+        ));
+        let map = crate::judging::error_map(
+            &self.reference.lights[light],
+            &self.judged.visibility[light],
+            &self.judged.image,
+        );
+        let saved = std::fs::create_dir_all(&dir)
+            .map_err(|e| e.to_string())
+            .and_then(|_| map.save(&path).map_err(|e| e.to_string()));
+        panic!(
+            "{} on {}, light {light}: {}; error map: {}",
+            self.judged.technique,
+            self.scene,
+            failures.join(", "),
+            match saved {
+                Ok(()) => path.display().to_string(),
+                Err(e) => format!("could not be written ({e})"),
+            }
+        );
+    }
+
+    /// Mask of pixels that belong to the scene's receiver planes.
+    pub fn receiver_mask(&self, scene: &crate::scene::Scene) -> Vec<bool> {
+        self.reference
+            .gbuffer
+            .positions
+            .iter()
+            .map(|p| {
+                p.w > 0.5
+                    && scene
+                        .receivers
+                        .iter()
+                        .any(|r| (r.plane.truncate().dot(p.truncate()) + r.plane.w).abs() < 1e-3)
+            })
+            .collect()
+    }
+}

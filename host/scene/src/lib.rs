@@ -1,5 +1,5 @@
-//! Scenes: the RON description, loaded and validated into world-space geometry, lights and a
-//! camera that every technique and the reference judge share.
+//! Shadow Zoo scenes: the RON description, loaded and validated into world-space geometry,
+//! lights and a camera that every technique and the reference judge share. No GPU dependency.
 
 pub mod adjacency;
 pub mod description;

@@ -459,7 +459,7 @@ mod tests {
     use super::*;
 
     fn closed_after_welding(mesh: &MeshData) -> bool {
-        let adjacency = crate::scene::adjacency::Adjacency::of_mesh(mesh);
+        let adjacency = crate::adjacency::Adjacency::of_mesh(mesh);
         adjacency.boundary_edges() == 0 && adjacency.non_manifold_edges() == 0
     }
 

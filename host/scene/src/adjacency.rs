@@ -164,7 +164,7 @@ fn build_object(mesh: &MeshData, range: Range<usize>, out: &mut Adjacency) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::mesh;
+    use crate::mesh;
 
     fn whole(m: &MeshData) -> Adjacency {
         Adjacency::of_mesh(m)

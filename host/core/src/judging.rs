@@ -1,0 +1,165 @@
+//! Rendering techniques and scoring them with the reference judge.
+//!
+//! The reference depends only on the G-buffer (the camera and the scene), so it is computed once
+//! per view and every technique rendered from that view is scored against it.
+
+use std::time::Instant;
+
+use image::{Rgba, RgbaImage};
+use zoo_judge::{
+    DEFAULT_AREA_SAMPLES, ErrorClass, LightReference, Metrics, Occluders, SurfacePoint,
+    error_class, reference_visibility,
+};
+
+use crate::gpu::{FrameTimings, PassOwner};
+use crate::params::ParamValues;
+use crate::render::{GBufferData, RenderError, Renderer, View};
+use crate::scene::LightKind;
+
+/// The judge's verdict about one view of a scene, shared by every technique.
+pub struct SceneReference {
+    /// The G-buffer the reference was computed for.
+    pub gbuffer: GBufferData,
+    /// Reference visibility per light.
+    pub lights: Vec<LightReference>,
+    /// Shadow-casting triangles traced.
+    pub occluder_triangles: usize,
+    /// Seconds spent building the BVH and tracing.
+    pub seconds: f64,
+}
+
+impl SceneReference {
+    /// Renders the G-buffer of `renderer`'s current view and traces the reference for every
+    /// light with `samples` area samples per pixel. `progress` is called after each light.
+    pub fn compute(
+        renderer: &mut Renderer,
+        samples: u32,
+        mut progress: impl FnMut(usize),
+    ) -> Result<SceneReference, RenderError> {
+        // Any technique leaves the G-buffer the same; render one frame to fill it.
+        renderer.render(&View::Final)?;
+        let gbuffer = renderer.read_gbuffer();
+        let start = Instant::now();
+        let occluders = Occluders::new(renderer.scene());
+        let points = surface_points(&gbuffer);
+        let lights = renderer
+            .lights()
+            .iter()
+            .enumerate()
+            .map(|(i, light)| {
+                let r = reference_visibility(&occluders, light, &points, samples);
+                progress(i);
+                r
+            })
+            .collect();
+        Ok(SceneReference {
+            gbuffer,
+            lights,
+            occluder_triangles: occluders.len(),
+            seconds: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Output width and height.
+    pub fn size(&self) -> (usize, usize) {
+        (self.gbuffer.size.x as usize, self.gbuffer.size.y as usize)
+    }
+}
+
+/// The G-buffer's surfaces as judge input (`None` on background pixels).
+pub fn surface_points(gbuffer: &GBufferData) -> Vec<Option<SurfacePoint>> {
+    gbuffer
+        .positions
+        .iter()
+        .zip(&gbuffer.normals)
+        .map(|(p, n)| {
+            (p.w > 0.5 && n.is_finite() && p.is_finite()).then(|| SurfacePoint {
+                position: p.truncate(),
+                normal: n.normalize_or_zero(),
+            })
+        })
+        .collect()
+}
+
+/// The score of one technique for one light.
+#[derive(Debug, Clone)]
+pub struct LightScore {
+    pub light: usize,
+    pub kind: LightKind,
+    /// `None` when the technique does not support this light kind (not scored as wrong).
+    pub metrics: Option<Metrics>,
+}
+
+/// A technique rendered and judged.
+pub struct Judged {
+    pub technique: String,
+    pub params: ParamValues,
+    pub scores: Vec<LightScore>,
+    pub timings: FrameTimings,
+    /// The technique's summed pass time for the frame.
+    pub gpu_ms: f64,
+    /// The final image.
+    pub image: RgbaImage,
+    /// The technique's visibility per light.
+    pub visibility: Vec<Vec<f32>>,
+}
+
+/// Switches `renderer` to technique `id` with `params`, renders the current view and scores it
+/// against `reference`.
+pub fn judge_technique(
+    renderer: &mut Renderer,
+    reference: &SceneReference,
+    id: &str,
+    params: &ParamValues,
+) -> Result<Judged, RenderError> {
+    renderer.set_technique(id, params)?;
+    // A first frame lets techniques with temporal state settle; the second is measured.
+    renderer.render(&View::Final)?;
+    let timings = renderer.render(&View::Final)?;
+    let registration = renderer.technique();
+    let (width, height) = reference.size();
+    let mut scores = Vec::new();
+    let mut visibility = Vec::new();
+    for (i, light) in renderer.lights().iter().enumerate() {
+        let v = renderer.read_visibility(i);
+        let metrics = registration
+            .supports(light.kind)
+            .then(|| Metrics::compute(&reference.lights[i], &v, width, height, None));
+        scores.push(LightScore {
+            light: i,
+            kind: light.kind,
+            metrics,
+        });
+        visibility.push(v);
+    }
+    Ok(Judged {
+        technique: id.to_string(),
+        params: renderer.technique_params().clone(),
+        scores,
+        gpu_ms: timings.total(PassOwner::Technique),
+        timings,
+        image: renderer.read_output(),
+        visibility,
+    })
+}
+
+/// The error map of one light: red where the technique shadows a lit pixel, blue where it
+/// lights a shadowed one, grey where both agree on shadow, the scene dimmed elsewhere.
+pub fn error_map(reference: &LightReference, visibility: &[f32], scene: &RgbaImage) -> RgbaImage {
+    let mut out = scene.clone();
+    for (i, pixel) in out.pixels_mut().enumerate() {
+        *pixel = match error_class(reference, visibility, i) {
+            ErrorClass::FalseShadow => Rgba([230, 30, 30, 255]),
+            ErrorClass::FalseLit => Rgba([40, 90, 255, 255]),
+            ErrorClass::BothShadowed => Rgba([128, 128, 128, 255]),
+            ErrorClass::BothLit | ErrorClass::NotContributing => {
+                let [r, g, b, _] = pixel.0;
+                Rgba([r / 3, g / 3, b / 3, 255])
+            }
+        };
+    }
+    out
+}
+
+/// Area samples per pixel used when none are given.
+pub const DEFAULT_SAMPLES: u32 = DEFAULT_AREA_SAMPLES;

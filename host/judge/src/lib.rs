@@ -1,0 +1,18 @@
+//! The reference judge: exact ray-traced visibility for the pixels of a rendered G-buffer, and
+//! the metrics that score a technique's visibility against it. No GPU dependency.
+//!
+//! For every pixel whose surface a light reaches (facing it, inside its range and cone), shadow
+//! rays go from the surface, offset along its normal by a scene-scaled epsilon, to the light:
+//! one ray to the light's centre for hard visibility, and stratified samples over the light's
+//! disk (point and spot: a disk of the light's radius facing the surface; directional: the cone
+//! of the light's angular radius) for area visibility.
+
+mod metrics;
+mod occluders;
+mod reference;
+mod sampling;
+
+pub use metrics::{ErrorClass, Metrics, edge_band, error_class, percentile};
+pub use occluders::Occluders;
+pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, SurfacePoint, reference_visibility};
+pub use sampling::{concentric_disk, stratified_disk};

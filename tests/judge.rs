@@ -1,0 +1,56 @@
+//! The reference judge on rendered frames, and the plugin-test helper built on it.
+
+use glam::UVec2;
+use zoo_host::test_support::{Metric, judge};
+
+#[test]
+fn unshadowed_misses_exactly_the_reference_shadows() {
+    let run = judge("planar-room.ron", "unshadowed", &[], UVec2::new(192, 160));
+    for (light, reference) in run.reference.lights.iter().enumerate() {
+        let m = run.metrics(light);
+        assert!(
+            m.pixels > 1000,
+            "light {light} reaches only {} pixels",
+            m.pixels
+        );
+        assert_eq!(m.false_shadow, 0.0, "light {light}");
+        assert_eq!(m.false_lit, reference.shadowed_fraction(), "light {light}");
+        assert!(
+            m.false_lit > 0.02,
+            "light {light}: planar-room has shadows ({})",
+            m.false_lit
+        );
+        // The soft error of v = 1 is the mean occluded fraction of the area light.
+        assert!(
+            m.mae >= m.false_lit * 0.5,
+            "light {light}: mae {} false_lit {}",
+            m.mae,
+            m.false_lit
+        );
+    }
+}
+
+#[test]
+fn failed_bounds_name_metric_value_bound_and_error_map() {
+    let run = judge("contact.ron", "unshadowed", &[], UVec2::new(128, 96));
+    let metrics = run.metrics(0);
+    run.assert_bounds(0, &metrics, &[(Metric::FalseShadow, 0.0)]);
+    let failure = std::panic::catch_unwind(|| {
+        run.assert_bounds(
+            0,
+            &metrics,
+            &[(Metric::FalseLit, 0.0), (Metric::FalseShadow, 0.0)],
+        )
+    })
+    .expect_err("unshadowed leaves shadows out");
+    let message = failure
+        .downcast_ref::<String>()
+        .cloned()
+        .unwrap_or_default();
+    let expected = format!("false_lit = {:.5} exceeds 0", metrics.false_lit);
+    assert!(message.contains(&expected), "{message}");
+    assert!(!message.contains("false_shadow ="), "{message}");
+    let path = message.rsplit("error map: ").next().unwrap();
+    let map = image::open(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    assert_eq!((map.width(), map.height()), (128, 96));
+}
