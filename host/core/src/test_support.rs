@@ -66,9 +66,12 @@ impl Metric {
     }
 }
 
-/// A technique rendered on a standard scene and judged.
+/// A technique rendered on a scene and judged.
 pub struct JudgeRun {
+    /// Scene name (used in error-map file names).
     pub scene: String,
+    /// The scene as loaded.
+    pub loaded: crate::scene::Scene,
     pub reference: crate::judging::SceneReference,
     pub judged: crate::judging::Judged,
 }
@@ -77,6 +80,23 @@ pub struct JudgeRun {
 /// every light with the default number of area samples.
 pub fn judge(scene: &str, technique: &str, params: &[(&str, &str)], size: glam::UVec2) -> JudgeRun {
     let loaded = crate::scene::Scene::load(&scene_path(scene)).unwrap_or_else(|e| panic!("{e}"));
+    judge_scene(loaded, technique, params, size)
+}
+
+/// Parses a scene from RON text (OBJ paths relative to `scenes/`).
+pub fn scene_from_ron(name: &str, text: &str) -> crate::scene::Scene {
+    crate::scene::Scene::from_ron(text, Path::new(name), &workspace_root().join("scenes"))
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// As [`judge`], for a scene built in the test.
+pub fn judge_scene(
+    loaded: crate::scene::Scene,
+    technique: &str,
+    params: &[(&str, &str)],
+    size: glam::UVec2,
+) -> JudgeRun {
+    let scene = loaded.name.clone();
     let registration = crate::find_technique(technique).unwrap_or_else(|e| panic!("{e}"));
     let schema = (registration.params)();
     let mut values = crate::params::defaults(&schema);
@@ -86,7 +106,8 @@ pub fn judge(scene: &str, technique: &str, params: &[(&str, &str)], size: glam::
         .collect();
     crate::params::apply_assignments(&schema, &mut values, &assignments)
         .unwrap_or_else(|e| panic!("{technique}: {e}"));
-    let mut renderer = crate::Renderer::new(gpu(), loaded, size).unwrap_or_else(|e| panic!("{e}"));
+    let mut renderer =
+        crate::Renderer::new(gpu(), loaded.clone(), size).unwrap_or_else(|e| panic!("{e}"));
     let reference = crate::judging::SceneReference::compute(
         &mut renderer,
         crate::judging::DEFAULT_SAMPLES,
@@ -96,7 +117,8 @@ pub fn judge(scene: &str, technique: &str, params: &[(&str, &str)], size: glam::
     let judged = crate::judging::judge_technique(&mut renderer, &reference, technique, &values)
         .unwrap_or_else(|e| panic!("{technique} on {scene}: {e}"));
     JudgeRun {
-        scene: scene.trim_end_matches(".ron").to_string(),
+        scene,
+        loaded,
         reference,
         judged,
     }
@@ -174,7 +196,8 @@ impl JudgeRun {
     }
 
     /// Mask of pixels that belong to the scene's receiver planes.
-    pub fn receiver_mask(&self, scene: &crate::scene::Scene) -> Vec<bool> {
+    pub fn receiver_mask(&self) -> Vec<bool> {
+        let scene = &self.loaded;
         self.reference
             .gbuffer
             .positions
