@@ -32,7 +32,7 @@ pub use technique::{
 pub use zoo_judge as judge;
 /// Scenes, lights, meshes and adjacency (the GPU-free `zoo-scene` crate).
 pub use zoo_scene as scene;
-pub use {glam, image, inventory, serde, wgpu};
+pub use {glam, image, inventory, log, serde, wgpu};
 
 /// Compiles the README's code examples ("Writing a technique") as doctests.
 #[cfg(doctest)]

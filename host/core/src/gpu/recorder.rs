@@ -9,7 +9,7 @@ use std::time::Instant;
 use super::GpuContext;
 
 /// Passes one frame can time.
-pub const MAX_TIMED_PASSES: u32 = 64;
+pub const MAX_TIMED_PASSES: u32 = 1024;
 
 /// Who recorded a pass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,0 +1,390 @@
+//! Light view and projection matrices: a perspective frustum fitted to a spot cone, an
+//! orthographic box fitted to what the camera sees for directional lights, and six 90-degree
+//! cube faces (widened by a guard band) for point lights.
+
+use zoo_host::glam::camera::rh::{proj::directx, view::look_to_mat4};
+use zoo_host::glam::{Mat4, Vec3, Vec4Swizzles};
+use zoo_host::scene::{Camera, Light};
+
+/// How a shadow-map layer projects.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Perspective with the given tangent of the half field of view.
+    Perspective {
+        tan_half_fov: f32,
+        near: f32,
+        far: f32,
+    },
+    /// Orthographic with the given world extent (width = height) and depth range.
+    Orthographic { extent: f32, near: f32, far: f32 },
+}
+
+/// One shadow-map layer's camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightFrustum {
+    pub view: Mat4,
+    pub view_proj: Mat4,
+    pub projection: Projection,
+}
+
+impl LightFrustum {
+    fn new(view: Mat4, projection: Projection) -> LightFrustum {
+        let proj = match projection {
+            Projection::Perspective {
+                tan_half_fov,
+                near,
+                far,
+            } => directx::perspective(2.0 * tan_half_fov.atan(), 1.0, near, far),
+            Projection::Orthographic { extent, near, far } => {
+                let h = extent * 0.5;
+                directx::orthographic(-h, h, -h, h, near, far)
+            }
+        };
+        LightFrustum {
+            view,
+            view_proj: proj * view,
+            projection,
+        }
+    }
+
+    /// World size of one texel of a `resolution`-texel map at `point`.
+    pub fn texel_world_size(&self, point: Vec3, resolution: u32) -> f32 {
+        match self.projection {
+            Projection::Perspective { tan_half_fov, .. } => {
+                let distance = -self.view.transform_point3(point).z;
+                2.0 * distance * tan_half_fov / resolution as f32
+            }
+            Projection::Orthographic { extent, .. } => extent / resolution as f32,
+        }
+    }
+
+    /// Whether `point` projects inside the map and its depth range.
+    pub fn contains(&self, point: Vec3) -> bool {
+        let clip = self.view_proj * point.extend(1.0);
+        let ndc = clip.xyz() / clip.w;
+        clip.w > 0.0 && ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0 && (0.0..=1.0).contains(&ndc.z)
+    }
+}
+
+/// An up vector not parallel to `direction`.
+fn up_for(direction: Vec3) -> Vec3 {
+    if direction.cross(Vec3::Y).length_squared() < 1e-4 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
+}
+
+/// Near plane of a perspective light map: close enough for nearby casters, far enough to
+/// keep depth precision.
+pub fn perspective_near(range: f32) -> f32 {
+    (range * 1e-3).max(0.02)
+}
+
+/// A perspective frustum around a spot light's cone (with a small margin).
+pub fn spot_frustum(light: &Light) -> LightFrustum {
+    let half = (light.spot_angle * 1.05).min(85f32.to_radians());
+    let view = look_to_mat4(light.position, light.direction, up_for(light.direction));
+    LightFrustum::new(
+        view,
+        Projection::Perspective {
+            tan_half_fov: half.tan(),
+            near: perspective_near(light.range),
+            far: light.range,
+        },
+    )
+}
+
+/// Cube face directions and up vectors, in array-layer order +X, -X, +Y, -Y, +Z, -Z.
+pub const CUBE_FACES: [(Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::NEG_Y),
+    (Vec3::NEG_X, Vec3::NEG_Y),
+    (Vec3::Y, Vec3::Z),
+    (Vec3::NEG_Y, Vec3::NEG_Z),
+    (Vec3::Z, Vec3::NEG_Y),
+    (Vec3::NEG_Z, Vec3::NEG_Y),
+];
+
+/// Six faces around a point light. Each covers slightly more than 90 degrees so that filter
+/// taps up to `guard_texels` beyond a face edge still land inside the same face's map.
+pub fn cube_frustums(light: &Light, resolution: u32, guard_texels: u32) -> [LightFrustum; 6] {
+    let inner = resolution.saturating_sub(2 * guard_texels).max(1) as f32;
+    let tan_half_fov = resolution as f32 / inner;
+    CUBE_FACES.map(|(direction, up)| {
+        LightFrustum::new(
+            look_to_mat4(light.position, direction, up),
+            Projection::Perspective {
+                tan_half_fov,
+                near: perspective_near(light.range),
+                far: light.range,
+            },
+        )
+    })
+}
+
+/// The face of the cube whose central 90-degree region contains `direction`.
+pub fn cube_face(direction: Vec3) -> usize {
+    let a = direction.abs();
+    if a.x >= a.y && a.x >= a.z {
+        if direction.x >= 0.0 { 0 } else { 1 }
+    } else if a.y >= a.z {
+        if direction.y >= 0.0 { 2 } else { 3 }
+    } else if direction.z >= 0.0 {
+        4
+    } else {
+        5
+    }
+}
+
+/// World-space axis-aligned box.
+pub type Aabb = (Vec3, Vec3);
+
+fn corners((lo, hi): Aabb) -> [Vec3; 8] {
+    [0, 1, 2, 3, 4, 5, 6, 7].map(|i| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
+fn transformed_bounds(m: Mat4, points: &[Vec3]) -> Aabb {
+    points.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| {
+            let q = m.transform_point3(*p);
+            (lo.min(q), hi.max(q))
+        },
+    )
+}
+
+/// World-space corners of the camera's view frustum, its far plane pulled in to `far`.
+pub fn camera_frustum_corners(camera: &Camera, aspect: f32, far: f32) -> [Vec3; 8] {
+    let view_proj = camera.projection(aspect) * camera.view();
+    let inverse = view_proj.inverse();
+    // Depth of `far` in the camera's [0, 1] depth range.
+    let (n, f) = (camera.near, camera.far);
+    let far_depth = (f * (far - n) / (far * (f - n))).clamp(0.0, 1.0);
+    let mut out = [Vec3::ZERO; 8];
+    for (i, corner) in out.iter_mut().enumerate() {
+        let x = if i & 1 == 0 { -1.0 } else { 1.0 };
+        let y = if i & 2 == 0 { -1.0 } else { 1.0 };
+        let z = if i & 4 == 0 { 0.0 } else { far_depth };
+        *corner = inverse.project_point3(Vec3::new(x, y, z));
+    }
+    out
+}
+
+/// An orthographic frustum for a directional light travelling along `direction`: its sides
+/// fit the receivers the camera can see (each object's box clipped to the box around the camera
+/// frustum), and its depth range reaches back to every caster that can shadow them.
+pub fn directional_frustum(
+    direction: Vec3,
+    camera: &Camera,
+    aspect: f32,
+    objects: &[Aabb],
+    casters: &[Aabb],
+) -> LightFrustum {
+    let view = look_to_mat4(Vec3::ZERO, direction, up_for(direction));
+    let all = objects.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
+    );
+    let farthest = corners(all)
+        .iter()
+        .map(|c| c.distance(camera.position))
+        .fold(0.0, f32::max)
+        .min(camera.far);
+    let frustum = camera_frustum_corners(camera, aspect, farthest);
+    let frustum_box = transformed_bounds(Mat4::IDENTITY, &frustum);
+    // Receivers: the visible part of every object, in light space.
+    let mut visible: Vec<Vec3> = Vec::new();
+    for (lo, hi) in objects {
+        let (clo, chi) = (lo.max(frustum_box.0), hi.min(frustum_box.1));
+        if clo.cmple(chi).all() {
+            visible.extend(corners((clo, chi)));
+        }
+    }
+    if visible.is_empty() {
+        visible.extend(corners(all));
+    }
+    let (lo, hi) = transformed_bounds(view, &visible);
+    // Casters: anything whose light-space box overlaps the receivers' footprint.
+    let mut nearest = hi.z;
+    for caster in casters {
+        let (clo, chi) = transformed_bounds(view, &corners(*caster));
+        if clo.x <= hi.x && chi.x >= lo.x && clo.y <= hi.y && chi.y >= lo.y {
+            nearest = nearest.max(chi.z);
+        }
+    }
+    // Square extent centred on the receivers (the map is square).
+    let extent = (hi.x - lo.x).max(hi.y - lo.y).max(1e-3) * 1.02;
+    let center = (lo + hi) * 0.5;
+    let margin = (nearest - lo.z).max(1e-3) * 0.01;
+    let view = Mat4::from_translation(Vec3::new(-center.x, -center.y, 0.0)) * view;
+    LightFrustum::new(
+        view,
+        Projection::Orthographic {
+            extent,
+            near: -nearest - margin,
+            far: -lo.z + margin,
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::scene::LightKind;
+
+    fn spot() -> Light {
+        Light {
+            kind: LightKind::Spot,
+            position: Vec3::new(1.0, 6.0, 2.0),
+            direction: Vec3::new(0.2, -1.0, -0.3).normalize(),
+            radiance: Vec3::ONE,
+            range: 30.0,
+            spot_angle: 35f32.to_radians(),
+            spot_softness: 0.2,
+            radius: 0.0,
+        }
+    }
+
+    #[test]
+    fn spot_frustum_covers_the_cone() {
+        let light = spot();
+        let f = spot_frustum(&light);
+        // Points on the cone's edge at several distances are inside the map.
+        let up = light.direction.cross(Vec3::X).normalize();
+        for distance in [0.5, 5.0, 25.0] {
+            for k in 0..16 {
+                let angle = k as f32 / 16.0 * std::f32::consts::TAU;
+                let side = zoo_host::glam::Quat::from_axis_angle(light.direction, angle) * up;
+                let edge = light.direction * light.spot_angle.cos() + side * light.spot_angle.sin();
+                assert!(
+                    f.contains(light.position + edge * distance),
+                    "edge at {distance}"
+                );
+            }
+        }
+        assert!(
+            !f.contains(light.position - light.direction * 2.0),
+            "behind the light"
+        );
+    }
+
+    #[test]
+    fn texel_world_size_matches_the_projection() {
+        let light = spot();
+        let f = spot_frustum(&light);
+        let resolution = 2048;
+        for distance in [1.0, 4.0, 12.0] {
+            let p = light.position + light.direction * distance;
+            let size = f.texel_world_size(p, resolution);
+            let Projection::Perspective { tan_half_fov, .. } = f.projection else {
+                unreachable!()
+            };
+            assert!((size - 2.0 * distance * tan_half_fov / resolution as f32).abs() < 1e-6);
+            // Moving by one texel's world size across the axis moves one texel in the map.
+            let side = light.direction.cross(Vec3::Y).normalize();
+            let a = f.view_proj.project_point3(p);
+            let b = f.view_proj.project_point3(p + side * size);
+            let texels = (b - a).truncate().length() * 0.5 * resolution as f32;
+            assert!((texels - 1.0).abs() < 1e-3, "{texels} texels");
+        }
+        // Orthographic: constant.
+        let camera = Camera {
+            position: Vec3::new(0.0, 5.0, 8.0),
+            target: Vec3::ZERO,
+            fov_y: 1.0,
+            near: 0.1,
+            far: 100.0,
+        };
+        let bounds = (Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 2.0, 5.0));
+        let f = directional_frustum(
+            Vec3::new(0.3, -1.0, 0.2).normalize(),
+            &camera,
+            1.0,
+            &[bounds],
+            &[],
+        );
+        let Projection::Orthographic { extent, .. } = f.projection else {
+            unreachable!()
+        };
+        assert_eq!(f.texel_world_size(Vec3::ZERO, 1024), extent / 1024.0);
+    }
+
+    #[test]
+    fn directional_fit_contains_relevant_casters_and_visible_receivers() {
+        let camera = Camera {
+            position: Vec3::new(3.0, 4.0, 6.0),
+            target: Vec3::new(0.0, 0.0, 0.0),
+            fov_y: 50f32.to_radians(),
+            near: 0.1,
+            far: 200.0,
+        };
+        let floor = (Vec3::new(-20.0, -0.01, -20.0), Vec3::new(20.0, 0.0, 20.0));
+        let tall = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 15.0, 1.0));
+        let far_away = (Vec3::new(100.0, 0.0, 100.0), Vec3::new(101.0, 50.0, 101.0));
+        let direction = Vec3::new(0.4, -1.0, -0.3).normalize();
+        let objects = [floor, tall, far_away];
+        let f = directional_frustum(direction, &camera, 1.5, &objects, &objects);
+        // Every visible floor point (sampled on a grid of rays from the camera) is covered.
+        let inverse = (camera.projection(1.5) * camera.view()).inverse();
+        for i in 0..=10 {
+            for j in 0..=10 {
+                let ndc = Vec3::new(i as f32 / 5.0 - 1.0, j as f32 / 5.0 - 1.0, 0.5);
+                let through = inverse.project_point3(ndc);
+                let dir = (through - camera.position).normalize();
+                if dir.y >= -1e-3 {
+                    continue;
+                }
+                let t = -camera.position.y / dir.y;
+                let hit = camera.position + dir * t;
+                if hit.x.abs() <= 20.0 && hit.z.abs() <= 20.0 {
+                    assert!(f.contains(hit), "visible floor point {hit} outside the map");
+                }
+            }
+        }
+        // The tall caster (which shadows the visible floor) lies entirely in the depth range.
+        for c in corners(tall) {
+            let ndc = f.view_proj.project_point3(c);
+            assert!(
+                (0.0..=1.0).contains(&ndc.z),
+                "caster corner {c} at depth {}",
+                ndc.z
+            );
+        }
+        // The far-away caster is not what the fit is sized for: the map is much smaller than
+        // the whole scene.
+        let Projection::Orthographic { extent, .. } = f.projection else {
+            unreachable!()
+        };
+        assert!(extent < 100.0, "extent {extent} covers the whole scene");
+    }
+
+    #[test]
+    fn cube_faces_cover_every_direction_with_a_guard_band() {
+        let light = Light {
+            kind: LightKind::Point,
+            position: Vec3::new(0.5, 2.0, -1.0),
+            ..spot()
+        };
+        let faces = cube_frustums(&light, 512, 4);
+        for k in 0..500 {
+            let t = k as f32;
+            let dir = Vec3::new((t * 1.3).sin(), (t * 0.7).cos(), (t * 2.9).sin()).normalize();
+            let face = cube_face(dir);
+            let p = light.position + dir * 3.0;
+            let ndc = faces[face].view_proj.project_point3(p);
+            // Inside the central region: guard band of 4 texels left on each side.
+            let limit = 1.0 - 8.0 / 512.0 + 1e-4;
+            assert!(
+                ndc.x.abs() <= limit && ndc.y.abs() <= limit,
+                "{dir} -> face {face}: {ndc}"
+            );
+            assert!((0.0..=1.0).contains(&ndc.z));
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! Shadow maps against the reference judge, with the bounds of the sm-pcf issue.
+
+// Link the plugin so its technique registers.
+use zoo_plugin_sm_pcf as _;
+
+use zoo_host::glam::UVec2;
+use zoo_host::test_support::{JudgeRun, Metric, judge, judge_scene, scene_from_ron, scene_path};
+
+const SIZE: UVec2 = UVec2::new(256, 256);
+
+fn assert_default_bounds(run: &JudgeRun) {
+    for light in 0..run.loaded.lights.len() {
+        let m = run.metrics(light);
+        eprintln!(
+            "{} light {light} ({}): {m:?}",
+            run.scene,
+            run.loaded.lights[light].kind.name()
+        );
+        run.assert_bounds(
+            light,
+            &m,
+            &[
+                (Metric::FalseShadowCore, 0.005),
+                (Metric::FalseLitCore, 0.01),
+            ],
+        );
+    }
+}
+
+#[test]
+fn planar_room_within_bounds_with_a_2048_map() {
+    assert_default_bounds(&judge(
+        "planar-room.ron",
+        "sm-pcf",
+        &[("map_size", "2048")],
+        SIZE,
+    ));
+}
+
+#[test]
+fn curved_within_bounds_with_a_2048_map() {
+    assert_default_bounds(&judge(
+        "curved.ron",
+        "sm-pcf",
+        &[("map_size", "2048")],
+        SIZE,
+    ));
+}
+
+/// planar-room with its lights replaced by `lights`.
+fn planar_room_with(name: &str, lights: &str) -> zoo_host::Scene {
+    let text = std::fs::read_to_string(scene_path("planar-room.ron")).unwrap();
+    let start = text.find("    lights: [").unwrap();
+    let end = start + text[start..].find("    ],\n").unwrap() + "    ],\n".len();
+    let replaced = format!(
+        "{}    lights: [{lights}],\n{}",
+        &text[..start],
+        &text[end..]
+    );
+    scene_from_ron(name, &replaced)
+}
+
+#[test]
+fn point_light_in_the_middle_of_planar_room_uses_a_seamless_cube_map() {
+    let scene = planar_room_with(
+        "planar-room-centre",
+        "Point(position: (0.0, 3.4, 0.3), intensity: 30, range: 30)",
+    );
+    let run = judge_scene(scene, "sm-pcf", &[("map_size", "2048")], SIZE);
+    // The light sees every wall and the floor: all six faces are in use.
+    assert!(run.metrics(0).pixels > 40_000);
+    assert_default_bounds(&run);
+}
+
+#[test]
+fn without_bias_acne_appears_on_contact() {
+    let unbiased = [
+        ("slope_bias", "0"),
+        ("normal_offset", "0"),
+        ("constant_bias", "0"),
+    ];
+    let run = judge("contact.ron", "sm-pcf", &unbiased, SIZE);
+    let worst = (0..run.loaded.lights.len())
+        .map(|l| run.metrics(l).false_shadow)
+        .fold(0.0, f64::max);
+    eprintln!("contact without bias: worst false_shadow {worst}");
+    assert!(worst > 0.05, "no acne without bias ({worst})");
+    // And the defaults remove it.
+    let run = judge("contact.ron", "sm-pcf", &[], SIZE);
+    for light in 0..run.loaded.lights.len() {
+        let m = run.metrics(light);
+        run.assert_bounds(light, &m, &[(Metric::FalseShadow, 0.005)]);
+    }
+}
+
+#[test]
+fn error_falls_as_the_map_grows() {
+    // Hard filtering so resolution alone decides the edges.
+    let errors: Vec<f64> = [512, 1024, 2048]
+        .iter()
+        .map(|size| {
+            let s = size.to_string();
+            let run = judge(
+                "planar-room.ron",
+                "sm-pcf",
+                &[("map_size", &s), ("filter", "None")],
+                SIZE,
+            );
+            (0..run.loaded.lights.len())
+                .map(|l| {
+                    let m = run.metrics(l);
+                    m.false_shadow + m.false_lit
+                })
+                .sum()
+        })
+        .collect();
+    eprintln!("false_shadow + false_lit at 512, 1024, 2048: {errors:?}");
+    assert!(
+        errors[0] > errors[1] && errors[1] > errors[2],
+        "not monotone: {errors:?}"
+    );
+}
+
+#[test]
+fn pcss_matches_the_area_reference() {
+    // planar-room's lights have radii 0.25, 0.2 and a 0.27-degree sun.
+    let run = judge("planar-room.ron", "sm-pcf", &[("filter", "Pcss")], SIZE);
+    let hard = judge("planar-room.ron", "sm-pcf", &[("filter", "None")], SIZE);
+    for light in 0..run.loaded.lights.len() {
+        let m = run.metrics(light);
+        eprintln!(
+            "PCSS light {light}: mae {} (hard filtering: {})",
+            m.mae,
+            hard.metrics(light).mae
+        );
+        run.assert_bounds(light, &m, &[(Metric::Mae, 0.08)]);
+    }
+}
+
+#[test]
+fn pcss_follows_a_large_light_better_than_hard_shadows() {
+    let scene = planar_room_with(
+        "planar-room-large-light",
+        "Point(position: (2.5, 6.5, 3.0), intensity: 40, range: 30, radius: 0.8)",
+    );
+    let pcss = judge_scene(scene.clone(), "sm-pcf", &[("filter", "Pcss")], SIZE);
+    let hard = judge_scene(scene, "sm-pcf", &[("filter", "None")], SIZE);
+    let (soft, sharp) = (pcss.metrics(0), hard.metrics(0));
+    eprintln!(
+        "radius 0.8: PCSS mae {} p95 {}, hard mae {} p95 {}",
+        soft.mae, soft.p95_error, sharp.mae, sharp.p95_error
+    );
+    pcss.assert_bounds(0, &soft, &[(Metric::Mae, 0.08)]);
+    assert!(
+        soft.mae < sharp.mae,
+        "PCSS {} is no closer to the area light than hard {}",
+        soft.mae,
+        sharp.mae
+    );
+}
+
+#[test]
+fn every_filter_mode_renders_within_bounds() {
+    for filter in [
+        "None",
+        "Hardware2x2",
+        "Pcf3x3",
+        "Pcf5x5",
+        "Pcf7x7",
+        "Pcf9x9",
+        "Poisson",
+        "Pcss",
+    ] {
+        let run = judge(
+            "curved.ron",
+            "sm-pcf",
+            &[("filter", filter)],
+            UVec2::new(128, 128),
+        );
+        for light in 0..run.loaded.lights.len() {
+            let m = run.metrics(light);
+            assert!(
+                m.false_shadow_core <= 0.01 && m.false_lit_core <= 0.02,
+                "{filter}, light {light}: {m:?}"
+            );
+        }
+    }
+}
