@@ -280,6 +280,16 @@ fn fs_lookup(in: FullscreenOut) -> Outputs {
         return out;
     }
     let sl = shadow_lights[current.index];
+    // Write only where the light reaches, so lights with disjoint influence can share a slot.
+    let light = lights[sl.light];
+    if light.kind != LIGHT_DIRECTIONAL {
+        let to_surface = s.position - light.position;
+        let distance = length(to_surface);
+        if distance >= light.range
+            || (light.kind == LIGHT_SPOT && dot(to_surface, light.direction) <= light.cos_outer * distance) {
+            discard;
+        }
+    }
     let texel = texel_world(sl, s.position);
     // Normal offset: move the lookup point off the surface by a number of texels.
     let p = s.position + s.normal * (sl.normal_offset * texel);

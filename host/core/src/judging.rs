@@ -102,6 +102,8 @@ pub struct Judged {
     pub image: RgbaImage,
     /// The technique's visibility per light.
     pub visibility: Vec<Vec<f32>>,
+    /// Visibility slots the lights shared (fewer than lights when the technique packs them).
+    pub slot_count: u32,
 }
 
 /// Switches `renderer` to technique `id` with `params`, renders the current view and scores it
@@ -140,6 +142,7 @@ pub fn judge_technique(
         timings,
         image: renderer.read_output(),
         visibility,
+        slot_count: renderer.slots().slot_count(),
     })
 }
 

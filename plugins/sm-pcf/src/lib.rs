@@ -118,6 +118,46 @@ struct LightMaps {
     light: usize,
     first_layer: u32,
     frustums: Vec<LightFrustum>,
+    /// Screen rectangle (x, y, width, height) its lookup pass can touch.
+    scissor: [u32; 4],
+}
+
+/// The screen rectangle covering `light`'s range sphere (the whole screen for directional
+/// lights or when the sphere reaches behind the camera); width 0 when it is off screen.
+pub fn light_scissor(light: &Light, view_proj: zoo_host::glam::Mat4, size: UVec2) -> [u32; 4] {
+    let full = [0, 0, size.x, size.y];
+    if light.kind == LightKind::Directional {
+        return full;
+    }
+    let (mut lo, mut hi) = (
+        zoo_host::glam::Vec2::splat(f32::INFINITY),
+        zoo_host::glam::Vec2::splat(f32::NEG_INFINITY),
+    );
+    for i in 0..8 {
+        let corner = light.position
+            + light.range
+                * Vec3::new(
+                    if i & 1 == 0 { -1.0 } else { 1.0 },
+                    if i & 2 == 0 { -1.0 } else { 1.0 },
+                    if i & 4 == 0 { -1.0 } else { 1.0 },
+                );
+        let clip = view_proj * corner.extend(1.0);
+        if clip.w <= 1e-4 {
+            return full;
+        }
+        let ndc = clip.truncate().truncate() / clip.w;
+        let pixel = zoo_host::glam::Vec2::new(
+            (ndc.x * 0.5 + 0.5) * size.x as f32,
+            (0.5 - ndc.y * 0.5) * size.y as f32,
+        );
+        lo = lo.min(pixel);
+        hi = hi.max(pixel);
+    }
+    let x0 = lo.x.floor().clamp(0.0, size.x as f32) as u32;
+    let y0 = lo.y.floor().clamp(0.0, size.y as f32) as u32;
+    let x1 = hi.x.ceil().clamp(0.0, size.x as f32) as u32;
+    let y1 = hi.y.ceil().clamp(0.0, size.y as f32) as u32;
+    [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)]
 }
 
 struct Pipelines {
@@ -435,6 +475,7 @@ impl ShadowMaps {
                     light: i,
                     first_layer: next_layer,
                     frustums,
+                    scissor: light_scissor(light, ctx.frame.matrices.view_proj, ctx.size),
                 };
                 next_layer += maps.frustums.len() as u32;
                 maps
@@ -708,6 +749,11 @@ impl ShadowTechnique for ShadowMaps {
         out
     }
 
+    fn packs_visibility_slots(&self) -> bool {
+        // The lookup writes only inside each light's range and cone.
+        true
+    }
+
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError> {
         if self.pipelines.is_none() {
             self.pipelines = Some(self.create_pipelines(ctx)?);
@@ -814,7 +860,11 @@ impl ShadowTechnique for ShadowMaps {
             pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
             pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
             pass.set_bind_group(2, &buffers.lookup_bind_group, &[(k as u64 * SLOT) as u32]);
-            pass.draw(0..3, 0..1);
+            let [x, y, width, height] = light_maps.scissor;
+            if width > 0 && height > 0 {
+                pass.set_scissor_rect(x, y, width, height);
+                pass.draw(0..3, 0..1);
+            }
         }
         Ok(())
     }
@@ -906,6 +956,47 @@ mod tests {
         let (r, note) = effective_resolution(2048, 16384, 224);
         assert!(224 * (r as u64).pow(2) * 4 <= MEMORY_BUDGET);
         assert!(note.unwrap().contains("exceed"));
+    }
+
+    #[test]
+    fn scissor_covers_the_light_sphere_on_screen() {
+        let camera = zoo_host::scene::Camera {
+            position: Vec3::new(0.0, 5.0, 10.0),
+            target: Vec3::ZERO,
+            fov_y: 1.0,
+            near: 0.1,
+            far: 100.0,
+        };
+        let size = UVec2::new(200, 100);
+        let view_proj = camera.projection(2.0) * camera.view();
+        let mut light = Light {
+            kind: LightKind::Point,
+            position: Vec3::ZERO,
+            direction: Vec3::NEG_Y,
+            radiance: Vec3::ONE,
+            range: 1.0,
+            spot_angle: 0.0,
+            spot_softness: 0.0,
+            radius: 0.0,
+        };
+        let [x, y, w, h] = light_scissor(&light, view_proj, size);
+        assert!(w > 0 && h > 0 && w < 200 && h < 100, "{x} {y} {w} {h}");
+        // Every point of the sphere projects inside the rectangle.
+        for k in 0..200 {
+            let t = k as f32;
+            let p = Vec3::new((t * 1.7).sin(), (t * 0.9).cos(), (t * 2.3).sin()).normalize() * 0.99;
+            let ndc = view_proj.project_point3(p);
+            let px = (ndc.x * 0.5 + 0.5) * 200.0;
+            let py = (0.5 - ndc.y * 0.5) * 100.0;
+            assert!(
+                px >= x as f32 && px <= (x + w) as f32 && py >= y as f32 && py <= (y + h) as f32
+            );
+        }
+        // A sphere reaching behind the camera, or a directional light, covers the screen.
+        light.range = 20.0;
+        assert_eq!(light_scissor(&light, view_proj, size), [0, 0, 200, 100]);
+        light.kind = LightKind::Directional;
+        assert_eq!(light_scissor(&light, view_proj, size), [0, 0, 200, 100]);
     }
 
     #[test]

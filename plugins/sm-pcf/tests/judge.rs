@@ -186,3 +186,23 @@ fn every_filter_mode_renders_within_bounds() {
         }
     }
 }
+
+#[test]
+fn many_lights_share_slots_without_clobbering_each_other() {
+    let run = judge("many-lights.ron", "sm-pcf", &[], UVec2::new(128, 128));
+    assert_eq!(run.loaded.lights.len(), 64);
+    let slots = run.judged.slot_count;
+    assert!(slots < 64, "lights were not packed ({slots} slots)");
+    eprintln!("64 lights in {slots} visibility slots");
+    for light in 0..64 {
+        let m = run.metrics(light);
+        run.assert_bounds(
+            light,
+            &m,
+            &[
+                (Metric::FalseShadowCore, 0.01),
+                (Metric::FalseLitCore, 0.01),
+            ],
+        );
+    }
+}
