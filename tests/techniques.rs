@@ -233,6 +233,38 @@ fn debug_views_render_and_unknown_views_are_errors() {
 }
 
 #[test]
+fn every_viewable_resource_of_every_technique_renders() {
+    let scene = load("planar-room.ron");
+    let mut renderer = Renderer::new(gpu(), scene, UVec2::new(96, 64)).unwrap();
+    let mut shown = 0;
+    for registration in registry() {
+        renderer
+            .set_technique(registration.id, &ParamValues::new())
+            .unwrap();
+        renderer.render(&View::Final).unwrap();
+        let viewable: Vec<String> = renderer
+            .technique_instance()
+            .resources()
+            .into_iter()
+            .filter(|r| r.viewable)
+            .map(|r| r.name)
+            .collect();
+        for name in viewable {
+            renderer
+                .render(&View::Resource(name.clone()))
+                .unwrap_or_else(|e| panic!("{}: view `{name}`: {e}", registration.id));
+            assert_eq!(
+                renderer.technique().id,
+                registration.id,
+                "`{name}` disabled the technique"
+            );
+            shown += 1;
+        }
+    }
+    assert!(shown >= registry().len() - 1, "only {shown} debug views");
+}
+
+#[test]
 fn every_standard_scene_loads_and_renders() {
     let mut renderer = Renderer::new(gpu(), load("planar-room.ron"), UVec2::new(64, 48)).unwrap();
     drop(renderer.render(&View::Final).unwrap());

@@ -51,7 +51,7 @@ fn fs_depth(in: FullscreenOut) -> @location(0) vec4<f32> {
 @fragment
 fn fs_uint(in: FullscreenOut) -> @location(0) vec4<f32> {
     let v = textureLoad(source_uint, source_pixel(in, textureDimensions(source_uint)), 0).r;
-    if v == 0u {
+    if v == 0u || params.mode != 4u {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     // Distinct hues for small integers.

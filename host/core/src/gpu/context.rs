@@ -80,9 +80,10 @@ impl GpuContext {
         let uncaptured = Arc::new(Mutex::new(Vec::new()));
         let sink = uncaptured.clone();
         device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
-            log::error!("wgpu: {error}");
+            let message = error_chain(&error);
+            log::error!("wgpu: {message}");
             if let Ok(mut errors) = sink.lock() {
-                errors.push(error.to_string());
+                errors.push(message);
             }
         }));
         let info = adapter.get_info();
@@ -131,9 +132,24 @@ impl GpuContext {
     pub fn validation_scope<T>(&self, f: impl FnOnce() -> T) -> (T, Option<String>) {
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let value = f();
-        let error = pollster::block_on(scope.pop()).map(|e| e.to_string());
+        let error = pollster::block_on(scope.pop()).map(|e| error_chain(&e));
         (value, error)
     }
+}
+
+/// An error and all its causes on one line.
+pub fn error_chain(error: &dyn std::error::Error) -> String {
+    let mut message = error.to_string().trim().to_string();
+    let mut source = error.source();
+    while let Some(inner) = source {
+        let text = inner.to_string();
+        if !message.contains(text.trim()) {
+            message.push_str(": ");
+            message.push_str(text.trim());
+        }
+        source = inner.source();
+    }
+    message
 }
 
 async fn select_adapter(

@@ -1,0 +1,888 @@
+//! Stencil shadow volumes with z-fail counting (seed 000 section 8; seed 004 sections 2.4, 2.5,
+//! 3.5 and 9.2).
+//!
+//! Per light, a compute pass builds the volumes from the scene's edge adjacency: caps from the
+//! triangles facing the light (and, for open or non-manifold meshes, from every triangle
+//! oriented toward it), and side quads on edges whose face orientations do not cancel, counted
+//! with multiplicity. Vertices are extruded to infinity (w = 0) and drawn with unclipped depth
+//! (`DEPTH_CLIP_CONTROL`), so counting is robust with the camera anywhere. One two-sided draw
+//! updates the G-buffer's stencil (z-fail: back faces increment and front faces decrement where
+//! the depth test fails, with wrap); a full-screen pass then writes visibility 0 where the count
+//! is not zero.
+
+pub mod silhouette;
+
+use bytemuck::{Pod, Zeroable};
+use zoo_host::params::TechniqueParams;
+use zoo_host::render::channel_writes;
+use zoo_host::render::gbuffer::DEPTH_FORMAT;
+use zoo_host::render::visibility::VISIBILITY_FORMAT;
+use zoo_host::scene::{EdgeKind, LightKind, Scene};
+use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+use zoo_host::{
+    Changes, GpuContext, ParamValues, PassInfo, PassRecorder, RenderContext, ShadowTechnique,
+    TechniqueError, wgpu,
+};
+
+zoo_host::param_choice! {
+    /// How volume crossings are counted.
+    pub enum Counting { ZFail, ZPass }
+}
+
+zoo_host::param_choice! {
+    /// How volumes are built.
+    pub enum Volumes { Silhouette, PerTriangle }
+}
+
+zoo_host::technique_params! {
+    /// Parameters of stencil shadow volumes.
+    pub struct SvParams {
+        /// Counting: z-fail (robust, the default) or z-pass (wrong with the camera in a shadow).
+        counting: Counting = Counting::ZFail;
+        /// Volumes from silhouette edges (default) or one volume per triangle (seed 004's baseline).
+        volumes: Volumes = Volumes::Silhouette;
+        /// Constant depth bias pushing volume faces back, so a lit surface is never shadowed by
+        /// its own near cap (depth-buffer units).
+        depth_bias: u32 = 64, range(0, 65536), step(1);
+        /// Slope-scaled depth bias of volume faces.
+        slope_bias: f32 = 1.0, range(0.0, 8.0), step(0.1);
+        /// Light whose volumes and stencil counts the debug views show.
+        debug_light: u32 = 0, range(0, 1023), step(1);
+    }
+}
+
+const FLAG_CASTS: u32 = 1;
+const FLAG_CLOSED: u32 = 2;
+const SLOT: u64 = 256;
+const COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
+const OVERLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Stencil levels the count view distinguishes, shown as ids 1..=10: counts 1..=8, then 255 and
+/// 254 (-1 and -2 wrapped); any other non-zero count is id 11.
+const COUNT_LEVELS: [u32; 10] = [1, 2, 3, 4, 5, 6, 7, 8, 255, 254];
+
+/// `Params` in `sv-zfail/volumes.wgsl`, in a 256-byte slot.
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+struct Params {
+    light: u32,
+    mode: u32,
+    triangle_count: u32,
+    edge_count: u32,
+    capacity: u32,
+    _pad: [u32; 59],
+}
+
+/// Draw arguments followed by the silhouette counter (`DrawArgs` in the shader).
+const ARGS_BYTES: u64 = 20;
+
+struct Pipelines {
+    triangles: wgpu::ComputePipeline,
+    edges: wgpu::ComputePipeline,
+    compute_layout: wgpu::BindGroupLayout,
+    volume: wgpu::RenderPipeline,
+    resolve: Vec<wgpu::RenderPipeline>,
+    overlay: wgpu::RenderPipeline,
+    count_equal: wgpu::RenderPipeline,
+    count_any: wgpu::RenderPipeline,
+    count_layout: wgpu::BindGroupLayout,
+}
+
+struct Buffers {
+    triangle_flags: wgpu::Buffer,
+    weights: wgpu::Buffer,
+    volume: wgpu::Buffer,
+    args: wgpu::Buffer,
+    stats: wgpu::Buffer,
+    compute_bind_group: wgpu::BindGroup,
+    levels_bind_group: wgpu::BindGroup,
+}
+
+struct DebugTargets {
+    counts: (wgpu::Texture, wgpu::TextureView),
+    overlay: (wgpu::Texture, wgpu::TextureView),
+}
+
+/// Stencil shadow volumes.
+pub struct ShadowVolumes {
+    params: SvParams,
+    device: wgpu::Device,
+    pipelines: Option<Pipelines>,
+    buffers: Option<Buffers>,
+    debug: Option<DebugTargets>,
+    lights: usize,
+    triangles: u32,
+    edges: u32,
+}
+
+/// Per-triangle flags: casts shadows, and belongs to a closed (all edges manifold) object.
+pub fn triangle_flags(scene: &Scene) -> Vec<u32> {
+    let mut flags = vec![0; scene.triangle_count()];
+    for (i, object) in scene.objects.iter().enumerate() {
+        let edges = &scene.adjacency.edges[scene.adjacency.object_edges[i].start as usize
+            ..scene.adjacency.object_edges[i].end as usize];
+        let closed = edges.iter().all(|e| e.kind() == EdgeKind::Manifold);
+        let value = u32::from(object.casts_shadows) * FLAG_CASTS + u32::from(closed) * FLAG_CLOSED;
+        flags[object.indices.start / 3..object.indices.end / 3].fill(value);
+    }
+    flags
+}
+
+/// Vertex capacity of the volume buffer for `scene` (caps, plus sides for the chosen mode).
+pub fn volume_capacity(scene: &Scene, volumes: Volumes) -> u64 {
+    let triangles = scene.triangle_count() as u64;
+    let sides = match volumes {
+        Volumes::Silhouette => 6 * scene.adjacency.edge_faces.len() as u64,
+        Volumes::PerTriangle => 18 * triangles,
+    };
+    (6 * triangles + sides).max(3)
+}
+
+fn dispatch_size(items: u32) -> (u32, u32) {
+    let groups = items.div_ceil(64).max(1);
+    let x = groups.min(65535);
+    (x, groups.div_ceil(x))
+}
+
+impl ShadowVolumes {
+    fn create_pipelines(&self, ctx: &RenderContext<'_>) -> Result<Pipelines, TechniqueError> {
+        let device = &ctx.gpu.device;
+        let volumes_module = ctx.shaders.create_module(device, "sv-zfail/volumes.wgsl")?;
+        let stencil_module = ctx.shaders.create_module(device, "sv-zfail/stencil.wgsl")?;
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sv-zfail volume generation layout"),
+            entries: &[
+                storage(0, true),
+                storage(1, true),
+                storage(2, true),
+                storage(3, true),
+                storage(4, true),
+                storage(5, false),
+                storage(6, false),
+                storage(7, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 8,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(32),
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let compute_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("sv-zfail volume generation pipeline layout"),
+                bind_group_layouts: &[Some(&ctx.frame.layout), Some(&compute_layout)],
+                immediate_size: 0,
+            });
+        let compute = |label: &str, entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(&compute_pipeline_layout),
+                module: &volumes_module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let triangles = compute("sv-zfail caps pipeline", "triangles");
+        let edges = compute("sv-zfail sides pipeline", "edges_main");
+
+        let count_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sv-zfail count level layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(4),
+                },
+                count: None,
+            }],
+        });
+        let frame_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("sv-zfail render pipeline layout"),
+            bind_group_layouts: &[Some(&ctx.frame.layout)],
+            immediate_size: 0,
+        });
+        let count_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("sv-zfail count pipeline layout"),
+                bind_group_layouts: &[Some(&ctx.frame.layout), Some(&count_layout)],
+                immediate_size: 0,
+            });
+
+        let keep = wgpu::StencilOperation::Keep;
+        let face = |compare, pass_op, depth_fail_op| wgpu::StencilFaceState {
+            compare,
+            fail_op: keep,
+            depth_fail_op,
+            pass_op,
+        };
+        let (front, back) = match self.params.counting {
+            // z-fail: count crossings behind the visible surface.
+            Counting::ZFail => (
+                face(
+                    wgpu::CompareFunction::Always,
+                    keep,
+                    wgpu::StencilOperation::DecrementWrap,
+                ),
+                face(
+                    wgpu::CompareFunction::Always,
+                    keep,
+                    wgpu::StencilOperation::IncrementWrap,
+                ),
+            ),
+            // z-pass: count crossings in front of it.
+            Counting::ZPass => (
+                face(
+                    wgpu::CompareFunction::Always,
+                    wgpu::StencilOperation::IncrementWrap,
+                    keep,
+                ),
+                face(
+                    wgpu::CompareFunction::Always,
+                    wgpu::StencilOperation::DecrementWrap,
+                    keep,
+                ),
+            ),
+        };
+        let volume_vertex = wgpu::VertexBufferLayout {
+            array_stride: 16,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x4],
+        };
+        let depth_state = |compare, front, back, bias| wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(compare),
+            stencil: wgpu::StencilState {
+                front,
+                back,
+                read_mask: 0xff,
+                write_mask: 0xff,
+            },
+            bias,
+        };
+        let target = |format, write_mask, blend| {
+            Some(wgpu::ColorTargetState {
+                format,
+                blend,
+                write_mask,
+            })
+        };
+        let volume_primitive = wgpu::PrimitiveState {
+            cull_mode: None,
+            unclipped_depth: true,
+            ..Default::default()
+        };
+        let bias = wgpu::DepthBiasState {
+            constant: self.params.depth_bias as i32,
+            slope_scale: self.params.slope_bias,
+            clamp: 0.0,
+        };
+        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("sv-zfail volume stencil pipeline"),
+            layout: Some(&frame_layout),
+            vertex: wgpu::VertexState {
+                module: &stencil_module,
+                entry_point: Some("vs_volume"),
+                compilation_options: Default::default(),
+                buffers: &[Some(volume_vertex.clone())],
+            },
+            primitive: volume_primitive,
+            depth_stencil: Some(depth_state(wgpu::CompareFunction::Less, front, back, bias)),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &stencil_module,
+                entry_point: Some("fs_volume"),
+                compilation_options: Default::default(),
+                targets: &[target(VISIBILITY_FORMAT, wgpu::ColorWrites::empty(), None)],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let test = |compare| face(compare, keep, keep);
+        let fullscreen = |label: &str,
+                          layout: &wgpu::PipelineLayout,
+                          entry: &str,
+                          compare,
+                          targets: &[Option<wgpu::ColorTargetState>]| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module: &stencil_module,
+                    entry_point: Some("fullscreen_vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: Some(depth_state(
+                    wgpu::CompareFunction::Always,
+                    test(compare),
+                    test(compare),
+                    Default::default(),
+                )),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &stencil_module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let resolve = (0..4)
+            .map(|channel| {
+                fullscreen(
+                    &format!("sv-zfail resolve pipeline (channel {channel})"),
+                    &frame_layout,
+                    "fs_shadowed",
+                    wgpu::CompareFunction::NotEqual,
+                    &[target(VISIBILITY_FORMAT, channel_writes(channel), None)],
+                )
+            })
+            .collect();
+        let debug_targets = |count_writes, overlay_writes, blend| {
+            [
+                target(COUNTS_FORMAT, count_writes, None),
+                target(OVERLAY_FORMAT, overlay_writes, blend),
+            ]
+        };
+        let count_targets = debug_targets(wgpu::ColorWrites::ALL, wgpu::ColorWrites::empty(), None);
+        let count_equal = fullscreen(
+            "sv-zfail stencil count pipeline (equal)",
+            &count_pipeline_layout,
+            "fs_count",
+            wgpu::CompareFunction::Equal,
+            &count_targets,
+        );
+        let count_any = fullscreen(
+            "sv-zfail stencil count pipeline (any)",
+            &count_pipeline_layout,
+            "fs_count",
+            wgpu::CompareFunction::NotEqual,
+            &count_targets,
+        );
+        let additive = wgpu::BlendState {
+            color: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+            alpha: wgpu::BlendComponent::REPLACE,
+        };
+        let overlay = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("sv-zfail volume overlay pipeline"),
+            layout: Some(&frame_layout),
+            vertex: wgpu::VertexState {
+                module: &stencil_module,
+                entry_point: Some("vs_volume"),
+                compilation_options: Default::default(),
+                buffers: &[Some(volume_vertex)],
+            },
+            primitive: volume_primitive,
+            depth_stencil: Some(depth_state(
+                wgpu::CompareFunction::Always,
+                test(wgpu::CompareFunction::Always),
+                test(wgpu::CompareFunction::Always),
+                Default::default(),
+            )),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &stencil_module,
+                entry_point: Some("fs_volume_debug"),
+                compilation_options: Default::default(),
+                targets: &debug_targets(
+                    wgpu::ColorWrites::empty(),
+                    wgpu::ColorWrites::ALL,
+                    Some(additive),
+                ),
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(Pipelines {
+            triangles,
+            edges,
+            compute_layout,
+            volume,
+            resolve,
+            overlay,
+            count_equal,
+            count_any,
+            count_layout,
+        })
+    }
+
+    fn create_buffers(&self, ctx: &RenderContext<'_>) -> Buffers {
+        let device = &ctx.gpu.device;
+        let pipelines = self.pipelines.as_ref().expect("pipelines exist");
+        let scene = ctx.scene;
+        let flags = triangle_flags(scene);
+        let needed = volume_capacity(scene, self.params.volumes);
+        let limit = device.limits().max_storage_buffer_binding_size / 16;
+        if needed > limit {
+            zoo_host::log::warn!(
+                "sv-zfail: volumes may need {needed} vertices, the device binds at most {limit}; \
+                 extra volume geometry is dropped"
+            );
+        }
+        let capacity = needed.min(limit) as u32;
+        let init = |label: &str, contents: &[u8], usage| {
+            wgpu::util::DeviceExt::create_buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage,
+                },
+            )
+        };
+        let empty = |label: &str, size: u64, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16),
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
+        let triangle_flags = init(
+            "sv-zfail triangle flags",
+            bytemuck::cast_slice(&flags),
+            storage,
+        );
+        let weights = empty("sv-zfail triangle weights", 4 * flags.len() as u64, storage);
+        let volume = empty(
+            "sv-zfail volume vertices",
+            16 * capacity as u64,
+            storage | wgpu::BufferUsages::VERTEX,
+        );
+        let args = init(
+            "sv-zfail draw arguments",
+            bytemuck::cast_slice(&[0u32, 1, 0, 0, 0, 0, 0, 0]),
+            storage
+                | wgpu::BufferUsages::INDIRECT
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        );
+        let params: Vec<Params> = (0..ctx.lights.len())
+            .map(|light| Params {
+                light: light as u32,
+                mode: u32::from(self.params.volumes == Volumes::PerTriangle),
+                triangle_count: flags.len() as u32,
+                edge_count: scene.adjacency.edges.len() as u32,
+                capacity,
+                _pad: [0; 59],
+            })
+            .collect();
+        let params = init(
+            "sv-zfail light parameters",
+            bytemuck::cast_slice(&params),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let stats = empty(
+            "sv-zfail workload counters",
+            (ctx.lights.len() as u64 * ARGS_BYTES).next_multiple_of(4),
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        );
+        let level_data: Vec<u32> = std::iter::once(11)
+            .chain(COUNT_LEVELS.iter().enumerate().map(|(i, _)| i as u32 + 1))
+            .flat_map(|value| std::iter::once(value).chain(std::iter::repeat_n(0, 63)))
+            .collect();
+        let levels = init(
+            "sv-zfail count levels",
+            bytemuck::cast_slice(&level_data),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let b = scene_bindings(ctx);
+        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }
+        }
+        let compute_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sv-zfail volume generation bind group"),
+            layout: &pipelines.compute_layout,
+            entries: &[
+                entry(0, b.0),
+                entry(1, b.1),
+                entry(2, b.2),
+                entry(3, b.3),
+                entry(4, &triangle_flags),
+                entry(5, &weights),
+                entry(6, &volume),
+                entry(7, &args),
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(32),
+                    }),
+                },
+            ],
+        });
+        let levels_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sv-zfail count levels bind group"),
+            layout: &pipelines.count_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &levels,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(4),
+                }),
+            }],
+        });
+        Buffers {
+            triangle_flags,
+            weights,
+            volume,
+            args,
+            stats,
+            compute_bind_group,
+            levels_bind_group,
+        }
+    }
+
+    fn create_debug_targets(device: &wgpu::Device, size: zoo_host::glam::UVec2) -> DebugTargets {
+        let make = |label: &str, format| {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size.x,
+                    height: size.y,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some(&format!("{label} view")),
+                ..Default::default()
+            });
+            (texture, view)
+        };
+        DebugTargets {
+            counts: make("sv-zfail stencil counts", COUNTS_FORMAT),
+            overlay: make("sv-zfail volumes overlay", OVERLAY_FORMAT),
+        }
+    }
+
+    /// Silhouette edges and volume triangles per light from the last frame.
+    pub fn workload(&self) -> Vec<(u32, u32)> {
+        let Some(buffers) = &self.buffers else {
+            return Vec::new();
+        };
+        let slice = buffers.stats.slice(..);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = sender.send(r);
+        });
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+        let mut out = Vec::new();
+        if let Ok(Ok(())) = receiver.recv()
+            && let Ok(view) = slice.get_mapped_range()
+        {
+            let words: &[u32] = bytemuck::cast_slice(&view);
+            for light in 0..self.lights {
+                let base = light * (ARGS_BYTES as usize / 4);
+                out.push((words[base + 4], words[base] / 3));
+            }
+        }
+        buffers.stats.unmap();
+        out
+    }
+}
+
+/// Vertices, indices, edges and edge faces of the scene.
+fn scene_bindings<'a>(
+    ctx: &'a RenderContext<'_>,
+) -> (
+    &'a wgpu::Buffer,
+    &'a wgpu::Buffer,
+    &'a wgpu::Buffer,
+    &'a wgpu::Buffer,
+) {
+    let b = ctx.scene_buffers;
+    (&b.vertices, &b.indices, &b.edges, &b.edge_faces)
+}
+
+fn volume_pass_name(light: usize) -> String {
+    format!("Shadow volumes: light {light}")
+}
+
+fn generation_pass_name(light: usize) -> String {
+    format!("Volume generation: light {light}")
+}
+
+fn debug_pass_name(light: usize) -> String {
+    format!("Volume debug: light {light}")
+}
+
+impl ShadowTechnique for ShadowVolumes {
+    fn passes(&self) -> Vec<PassInfo> {
+        let mut out = Vec::new();
+        for light in 0..self.lights {
+            out.push(PassInfo::compute(generation_pass_name(light)));
+            out.push(PassInfo::render(volume_pass_name(light)));
+            if light as u32 == self.params.debug_light {
+                out.push(PassInfo::render(debug_pass_name(light)));
+            }
+        }
+        out
+    }
+
+    fn resources(&self) -> Vec<ResourceInfo> {
+        let mut out = Vec::new();
+        if let Some(b) = &self.buffers {
+            out.push(ResourceInfo::buffer(
+                "volume vertices",
+                &b.volume,
+                "vec4<f32>",
+            ));
+            out.push(ResourceInfo::buffer(
+                "triangle flags",
+                &b.triangle_flags,
+                "u32",
+            ));
+            out.push(ResourceInfo::buffer("triangle weights", &b.weights, "i32"));
+            out.push(ResourceInfo::buffer(
+                "draw arguments",
+                &b.args,
+                "DrawIndirectArgs + counter",
+            ));
+        }
+        if let Some(d) = &self.debug {
+            out.push(ResourceInfo::texture("stencil counts", &d.counts.0, true));
+            out.push(ResourceInfo::texture("volumes", &d.overlay.0, true));
+        }
+        out
+    }
+
+    fn packs_visibility_slots(&self) -> bool {
+        // Volumes are infinite: a light's shadow is written wherever it falls.
+        false
+    }
+
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError> {
+        if self.pipelines.is_none() {
+            self.pipelines = Some(self.create_pipelines(ctx)?);
+        }
+        if changes.scene || changes.lights || self.buffers.is_none() {
+            self.lights = ctx.lights.len();
+            self.triangles = ctx.scene.triangle_count() as u32;
+            self.edges = ctx.scene.adjacency.edges.len() as u32;
+            self.buffers = Some(self.create_buffers(ctx));
+        }
+        if changes.resolution || self.debug.is_none() {
+            self.debug = Some(Self::create_debug_targets(&ctx.gpu.device, ctx.size));
+        }
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> Result<(), TechniqueError> {
+        let (Some(p), Some(b), Some(debug)) = (&self.pipelines, &self.buffers, &self.debug) else {
+            return Err(TechniqueError::Other(
+                "sv-zfail: record before prepare".into(),
+            ));
+        };
+        let (tri_x, tri_y) = dispatch_size(self.triangles);
+        let (edge_x, edge_y) = dispatch_size(self.edges);
+        for light in 0..self.lights {
+            let offset = (light as u64 * SLOT) as u32;
+            // Reset the vertex count (keeping instance_count = 1) and the silhouette counter.
+            let encoder = recorder.encoder();
+            encoder.clear_buffer(&b.args, 0, Some(4));
+            encoder.clear_buffer(&b.args, 16, Some(4));
+            {
+                let name = generation_pass_name(light);
+                let mut pass = recorder.compute_pass(&name);
+                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+                pass.set_bind_group(1, &b.compute_bind_group, &[offset]);
+                pass.set_pipeline(&p.triangles);
+                pass.dispatch_workgroups(tri_x, tri_y, 1);
+                pass.set_pipeline(&p.edges);
+                pass.dispatch_workgroups(edge_x, edge_y, 1);
+            }
+            let (view, _) = ctx.visibility.target(light);
+            let (_, channel) = ctx.visibility.slots.slot(light);
+            {
+                let name = volume_pass_name(light);
+                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(&name),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &ctx.gbuffer.depth_view,
+                        depth_ops: None,
+                        stencil_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+                pass.set_pipeline(&p.volume);
+                pass.set_vertex_buffer(0, b.volume.slice(..));
+                pass.draw_indirect(&b.args, 0);
+                pass.set_pipeline(&p.resolve[channel as usize]);
+                pass.set_stencil_reference(0);
+                pass.draw(0..3, 0..1);
+            }
+            recorder.encoder().copy_buffer_to_buffer(
+                &b.args,
+                0,
+                &b.stats,
+                light as u64 * ARGS_BYTES,
+                ARGS_BYTES,
+            );
+            if light as u32 == self.params.debug_light {
+                let name = debug_pass_name(light);
+                let clear = |view| {
+                    Some(wgpu::RenderPassColorAttachment {
+                        view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })
+                };
+                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(&name),
+                    color_attachments: &[clear(&debug.counts.1), clear(&debug.overlay.1)],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &ctx.gbuffer.depth_view,
+                        depth_ops: None,
+                        stencil_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        }),
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+                // Any non-zero count first (level 9), then the exact levels.
+                pass.set_pipeline(&p.count_any);
+                pass.set_stencil_reference(0);
+                pass.set_bind_group(1, &b.levels_bind_group, &[0]);
+                pass.draw(0..3, 0..1);
+                pass.set_pipeline(&p.count_equal);
+                for (k, level) in COUNT_LEVELS.iter().enumerate() {
+                    pass.set_stencil_reference(*level);
+                    pass.set_bind_group(1, &b.levels_bind_group, &[((k as u64 + 1) * SLOT) as u32]);
+                    pass.draw(0..3, 0..1);
+                }
+                pass.set_pipeline(&p.overlay);
+                pass.set_vertex_buffer(0, b.volume.slice(..));
+                pass.draw_indirect(&b.args, 0);
+            }
+        }
+        Ok(())
+    }
+
+    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let debug = self.debug.as_ref()?;
+        match resource {
+            "stencil counts" => Some(DebugImage {
+                view: &debug.counts.1,
+                mapping: ViewMapping::Integer,
+            }),
+            "volumes" => Some(DebugImage {
+                view: &debug.overlay.1,
+                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
+            }),
+            _ => None,
+        }
+    }
+
+    fn counters(&self) -> Vec<(String, f64)> {
+        self.workload()
+            .into_iter()
+            .enumerate()
+            .flat_map(|(light, (silhouettes, triangles))| {
+                [
+                    (
+                        format!("light {light} silhouette edges"),
+                        silhouettes as f64,
+                    ),
+                    (format!("light {light} volume triangles"), triangles as f64),
+                ]
+            })
+            .collect()
+    }
+}
+
+fn create(
+    gpu: &GpuContext,
+    values: &ParamValues,
+) -> Result<Box<dyn ShadowTechnique>, TechniqueError> {
+    Ok(Box::new(ShadowVolumes {
+        params: SvParams::from_values(values)?,
+        device: gpu.device.clone(),
+        pipelines: None,
+        buffers: None,
+        debug: None,
+        lights: 0,
+        triangles: 0,
+        edges: 0,
+    }))
+}
+
+zoo_host::register_technique! {
+    id: "sv-zfail",
+    name: "Stencil shadow volumes (z-fail)",
+    description: "Silhouette volumes built on the GPU, extruded to infinity, counted with two-sided z-fail stencil",
+    source: "seed 000 section 8; seed 004 sections 2.4-3.5 and 9.2 (Crow 1977; Carmack, Everitt & Kilgard 2002)",
+    light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
+    required_features: || wgpu::Features::DEPTH_CLIP_CONTROL,
+    optional_features: wgpu::Features::empty,
+    required_limits: || wgpu::Limits {
+        max_storage_buffers_per_shader_stage: 8,
+        ..wgpu::Limits::downlevel_defaults()
+    },
+    params: SvParams::schema,
+    create: create,
+}

@@ -1,0 +1,183 @@
+// Shadow-volume generation for one light.
+//
+// `triangles`: every shadow-casting triangle gets a weight: +1 when it faces the light, -1 when
+// it faces away and belongs to an open (or non-manifold) mesh, whose triangles all block light
+// and are oriented toward it, 0 otherwise. Weighted triangles emit a near cap (the triangle
+// oriented toward the light) and a far cap (extruded to infinity, reversed).
+// `edges`: each edge emits |m| side quads, m = sum over its faces of weight x traversal sign,
+// so sides shared by two emitting triangles cancel and boundary or non-manifold edges close
+// the volume exactly as per-triangle volumes would.
+
+#import "common/frame.wgsl"
+
+const FLAG_CASTS: u32 = 1u;
+const FLAG_CLOSED: u32 = 2u;
+const MODE_PER_TRIANGLE: u32 = 1u;
+
+struct Params {
+    light: u32,
+    mode: u32,
+    triangle_count: u32,
+    edge_count: u32,
+    capacity: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+struct DrawArgs {
+    vertex_count: atomic<u32>,
+    instance_count: u32,
+    first_vertex: u32,
+    first_instance: u32,
+    silhouette_edges: atomic<u32>,
+}
+
+@group(1) @binding(0) var<storage, read> vertices: array<f32>;
+@group(1) @binding(1) var<storage, read> indices: array<u32>;
+@group(1) @binding(2) var<storage, read> edges: array<vec4<u32>>;
+@group(1) @binding(3) var<storage, read> edge_faces: array<u32>;
+@group(1) @binding(4) var<storage, read> triangle_flags: array<u32>;
+@group(1) @binding(5) var<storage, read_write> weights: array<i32>;
+@group(1) @binding(6) var<storage, read_write> volume: array<vec4<f32>>;
+@group(1) @binding(7) var<storage, read_write> draw: DrawArgs;
+@group(1) @binding(8) var<uniform> params: Params;
+
+fn position(index: u32) -> vec3<f32> {
+    let base = index * 6u;
+    return vec3<f32>(vertices[base], vertices[base + 1u], vertices[base + 2u]);
+}
+
+fn directional() -> bool {
+    return lights[params.light].kind == LIGHT_DIRECTIONAL;
+}
+
+// A point at infinity away from the light.
+fn extrude(p: vec3<f32>) -> vec4<f32> {
+    let light = lights[params.light];
+    if light.kind == LIGHT_DIRECTIONAL {
+        return vec4<f32>(light.direction, 0.0);
+    }
+    return vec4<f32>(p - light.position, 0.0);
+}
+
+fn allocate(count: u32) -> u32 {
+    let base = atomicAdd(&draw.vertex_count, count);
+    if base + count > params.capacity {
+        return 0xffffffffu;
+    }
+    return base;
+}
+
+fn emit_triangle(base: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) {
+    volume[base] = a;
+    volume[base + 1u] = b;
+    volume[base + 2u] = c;
+}
+
+// Outward side of the volume along the directed edge u -> v of a triangle facing the light.
+fn emit_side(u: vec3<f32>, v: vec3<f32>) {
+    if directional() {
+        // Both far vertices are the same point at infinity: one triangle.
+        let base = allocate(3u);
+        if base != 0xffffffffu {
+            emit_triangle(base, vec4<f32>(v, 1.0), vec4<f32>(u, 1.0), extrude(u));
+        }
+        return;
+    }
+    let base = allocate(6u);
+    if base != 0xffffffffu {
+        emit_triangle(base, vec4<f32>(v, 1.0), vec4<f32>(u, 1.0), extrude(u));
+        emit_triangle(base + 3u, vec4<f32>(v, 1.0), extrude(u), extrude(v));
+    }
+}
+
+// Invocation index over a 2D dispatch (more than 65535 workgroups).
+fn invocation(id: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return id.y * groups.x * 64u + id.x;
+}
+
+@compute @workgroup_size(64)
+fn triangles(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let t = invocation(id, groups);
+    if t >= params.triangle_count {
+        return;
+    }
+    let flags = triangle_flags[t];
+    var a = position(indices[3u * t]);
+    var b = position(indices[3u * t + 1u]);
+    var c = position(indices[3u * t + 2u]);
+    let light = lights[params.light];
+    var toward_light = -light.direction;
+    if light.kind != LIGHT_DIRECTIONAL {
+        toward_light = light.position - (a + b + c) / 3.0;
+    }
+    let facing = dot(cross(b - a, c - a), toward_light) > 0.0;
+    var weight = 0;
+    if (flags & FLAG_CASTS) != 0u {
+        if facing {
+            weight = 1;
+        } else if (flags & FLAG_CLOSED) == 0u {
+            weight = -1;
+        }
+    }
+    weights[t] = weight;
+    if weight == 0 {
+        return;
+    }
+    if weight < 0 {
+        let swap = b;
+        b = c;
+        c = swap;
+    }
+    // Near cap, and (for point and spot lights) the far cap at infinity, reversed.
+    var count = 3u;
+    if !directional() {
+        count = 6u;
+    }
+    let base = allocate(count);
+    if base != 0xffffffffu {
+        emit_triangle(base, vec4<f32>(a, 1.0), vec4<f32>(b, 1.0), vec4<f32>(c, 1.0));
+        if !directional() {
+            emit_triangle(base + 3u, extrude(a), extrude(c), extrude(b));
+        }
+    }
+    if params.mode == MODE_PER_TRIANGLE {
+        emit_side(a, b);
+        emit_side(b, c);
+        emit_side(c, a);
+    }
+}
+
+@compute @workgroup_size(64)
+fn edges_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = invocation(id, groups);
+    if e >= params.edge_count || params.mode == MODE_PER_TRIANGLE {
+        return;
+    }
+    let edge = edges[e];
+    let count = edge.w & 0x00ffffffu;
+    var m = 0;
+    for (var k = 0u; k < count; k++) {
+        let incidence = edge_faces[edge.z + k];
+        let weight = weights[incidence >> 1u];
+        if (incidence & 1u) == 1u {
+            m -= weight;
+        } else {
+            m += weight;
+        }
+    }
+    if m == 0 {
+        return;
+    }
+    atomicAdd(&draw.silhouette_edges, 1u);
+    let p0 = position(edge.x);
+    let p1 = position(edge.y);
+    for (var k = 0; k < abs(m); k++) {
+        if m > 0 {
+            emit_side(p0, p1);
+        } else {
+            emit_side(p1, p0);
+        }
+    }
+}
