@@ -23,6 +23,48 @@ pub enum Command {
     /// Render techniques, judge them against ray-traced visibility, and write results.csv,
     /// report.md and per-light error maps.
     Compare(CompareArgs),
+    /// Benchmark techniques along the scene's camera and light paths: per-pass GPU times,
+    /// CPU frame times, counters and flicker, as CSV, markdown and PNG plots.
+    Bench(BenchArgs),
+}
+
+/// Arguments of `shadow-zoo bench`.
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// Scene file (RON) with keyframed paths.
+    #[arg(long, required_unless_present = "suite")]
+    pub scene: Option<PathBuf>,
+    /// Run a suite from `scenes/bench/NAME.ron` instead (reproduces a seed's experiment).
+    #[arg(long, conflicts_with = "scene")]
+    pub suite: Option<String>,
+    /// Comma-separated technique ids, or `all` (`unshadowed` is always added as the baseline).
+    #[arg(long, default_value = "all")]
+    pub techniques: String,
+    /// Output size as WIDTHxHEIGHT.
+    #[arg(long, default_value = "256x256", value_parser = parse_size)]
+    pub size: UVec2,
+    /// Measured frames per configuration (default 30; a suite's own count otherwise).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Frames rendered before measuring.
+    #[arg(long, default_value_t = 3)]
+    pub warmup: u32,
+    /// What moves along the scene's paths.
+    #[arg(long, value_enum, default_value = "camera")]
+    pub path: crate::bench::PathMode,
+    /// Sweep a quantity: `size=256x256,512x512`, `scene.tessellation=0.5,1,2` or
+    /// `TECHNIQUE.PARAM=v1,v2` (repeatable; configurations are the cartesian product).
+    #[arg(long = "sweep", value_name = "KEY=v1,v2,...", value_parser = parse_assignment)]
+    pub sweep: Vec<(String, String)>,
+    /// Fix a technique parameter, e.g. `--set sm-pcf.filter=Pcss` (repeatable).
+    #[arg(long = "set", value_name = "ID.KEY=VALUE", value_parser = parse_assignment)]
+    pub set: Vec<(String, String)>,
+    /// Skip the flicker index (it traces the reference for every measured frame).
+    #[arg(long)]
+    pub no_flicker: bool,
+    /// Folder for bench.csv, summary.csv, bench.md and the plots.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// Arguments of `shadow-zoo compare`.

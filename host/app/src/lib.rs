@@ -3,6 +3,7 @@
 //! This library links every technique plugin listed in the package's `Cargo.toml`, so the
 //! binary and the workspace integration tests see the same registry.
 
+pub mod bench;
 pub mod cli;
 pub mod commands;
 pub mod compare;

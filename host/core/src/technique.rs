@@ -42,6 +42,15 @@ pub struct TechniqueRegistration {
 
 inventory::collect!(TechniqueRegistration);
 
+impl std::fmt::Debug for TechniqueRegistration {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TechniqueRegistration")
+            .field("id", &self.id)
+            .field("package", &self.package)
+            .finish_non_exhaustive()
+    }
+}
+
 impl TechniqueRegistration {
     /// Whether it supports lights of `kind`.
     pub fn supports(&self, kind: LightKind) -> bool {
@@ -311,6 +320,9 @@ pub struct RenderContext<'a> {
     pub lights: &'a [Light],
     /// Output size in pixels.
     pub size: glam::UVec2,
+    /// The technique resource being shown this frame, if any: work that only feeds a debug
+    /// view can be skipped otherwise.
+    pub debug_view: Option<&'a str>,
 }
 
 /// A shadow technique instance. Created by its registration's factory; dropping it frees its

@@ -291,3 +291,33 @@ pub struct LightKey {
     pub time: f32,
     pub value: Vec3,
 }
+
+impl SceneDescription {
+    /// The same scene with every procedural mesh's segment, ring and subdivision counts scaled
+    /// by `factor` (for triangle-count sweeps). OBJ meshes are unchanged.
+    pub fn with_tessellation(&self, factor: f32) -> SceneDescription {
+        let scale = |n: u32, min: u32| ((n as f32 * factor).round() as u32).clamp(min, 4096);
+        let mut out = self.clone();
+        for object in &mut out.objects {
+            match &mut object.mesh {
+                MeshDesc::Plane { subdivisions, .. } => {
+                    *subdivisions = scale(*subdivisions, 1).min(1024)
+                }
+                MeshDesc::Sphere {
+                    segments, rings, ..
+                }
+                | MeshDesc::Torus {
+                    segments, rings, ..
+                } => {
+                    *segments = scale(*segments, 3);
+                    *rings = scale(*rings, 3);
+                }
+                MeshDesc::Cylinder { segments, .. } | MeshDesc::Cone { segments, .. } => {
+                    *segments = scale(*segments, 3)
+                }
+                MeshDesc::Box { .. } | MeshDesc::Obj(_) => {}
+            }
+        }
+        out
+    }
+}

@@ -4,6 +4,7 @@
 pub mod adjacency;
 pub mod description;
 pub mod mesh;
+pub mod paths;
 pub mod shading;
 
 use std::ops::Range;
@@ -366,6 +367,25 @@ impl Scene {
         }
         out
     }
+}
+
+/// Parses a scene description without building it.
+pub fn parse_description(text: &str, path: &Path) -> Result<SceneDescription, SceneError> {
+    ron::from_str(text).map_err(|e| SceneError::Parse {
+        path: path.to_path_buf(),
+        line: e.span.start.line,
+        col: e.span.start.col,
+        message: e.code.to_string(),
+    })
+}
+
+/// Reads and parses a scene file's description.
+pub fn read_description(path: &Path) -> Result<SceneDescription, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    parse_description(&text, path)
 }
 
 type FieldError = (String, &'static str);

@@ -249,3 +249,33 @@ fn real_meshes_load() {
         );
     }
 }
+
+#[test]
+fn tessellation_scales_procedural_meshes() {
+    let desc = parse_description(
+        &MINIMAL.replace(
+            "Box(size: (1, 1, 1))",
+            "Sphere(radius: 1, segments: 32, rings: 16)",
+        ),
+        Path::new("t.ron"),
+    )
+    .unwrap();
+    let base = Scene::from_description(&desc, Path::new("t.ron"), Path::new(".")).unwrap();
+    let finer = Scene::from_description(
+        &desc.with_tessellation(2.0),
+        Path::new("t.ron"),
+        Path::new("."),
+    )
+    .unwrap();
+    let coarser = Scene::from_description(
+        &desc.with_tessellation(0.25),
+        Path::new("t.ron"),
+        Path::new("."),
+    )
+    .unwrap();
+    let sphere = |s: &Scene| s.objects[1].indices.len() / 3;
+    // A UV sphere has 2 * segments * (rings - 1) triangles.
+    assert_eq!(sphere(&base), 2 * 32 * 15);
+    assert_eq!(sphere(&finer), 2 * 64 * 31);
+    assert_eq!(sphere(&coarser), 2 * 8 * 3);
+}

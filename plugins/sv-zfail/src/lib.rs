@@ -650,9 +650,7 @@ impl ShadowTechnique for ShadowVolumes {
         for light in 0..self.lights {
             out.push(PassInfo::compute(generation_pass_name(light)));
             out.push(PassInfo::render(volume_pass_name(light)));
-            if light as u32 == self.params.debug_light {
-                out.push(PassInfo::render(debug_pass_name(light)));
-            }
+            // The debug pass is recorded only while a debug view is shown.
         }
         out
     }
@@ -775,7 +773,8 @@ impl ShadowTechnique for ShadowVolumes {
                 light as u64 * ARGS_BYTES,
                 ARGS_BYTES,
             );
-            if light as u32 == self.params.debug_light {
+            let showing_debug = matches!(ctx.debug_view, Some("stencil counts" | "volumes"));
+            if showing_debug && light as u32 == self.params.debug_light {
                 let name = debug_pass_name(light);
                 let clear = |view| {
                     Some(wgpu::RenderPassColorAttachment {

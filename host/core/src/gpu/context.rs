@@ -63,7 +63,8 @@ impl GpuContext {
     pub fn wanted_features(adapter: &wgpu::Adapter) -> wgpu::Features {
         let mut wanted = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
-            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
+            | wgpu::Features::PIPELINE_STATISTICS_QUERY;
         for registration in technique::registry() {
             wanted |= (registration.required_features)() | (registration.optional_features)();
         }

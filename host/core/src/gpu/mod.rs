@@ -7,7 +7,7 @@ mod shaders;
 
 pub use context::{GpuContext, GpuError};
 pub use recorder::{
-    FrameTimings, MAX_TIMED_PASSES, PassOwner, PassRecorder, PassTiming, TimestampQueries,
-    TimingSource,
+    FrameTimings, MAX_TIMED_PASSES, PassOwner, PassRecorder, PassTiming, RecordedComputePass,
+    RecordedRenderPass, StatisticsQueries, TimestampQueries, TimingSource,
 };
 pub use shaders::{ComposedShader, ShaderError, ShaderLibrary};

@@ -45,6 +45,8 @@ pub struct PassTiming {
     pub name: String,
     pub owner: PassOwner,
     pub milliseconds: f64,
+    /// Vertex, fragment and compute shader invocations, when pipeline statistics are on.
+    pub invocations: Option<[u64; 3]>,
 }
 
 /// Times of one frame's passes, in recording order.
@@ -110,11 +112,110 @@ impl TimestampQueries {
     }
 }
 
+/// Pipeline-statistics query storage: vertex, fragment and compute invocations per pass.
+pub struct StatisticsQueries {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    readback: wgpu::Buffer,
+}
+
+impl StatisticsQueries {
+    /// Creates the query set, or `None` when the device lacks `PIPELINE_STATISTICS_QUERY`.
+    pub fn new(gpu: &GpuContext) -> Option<StatisticsQueries> {
+        if !gpu
+            .device
+            .features()
+            .contains(wgpu::Features::PIPELINE_STATISTICS_QUERY)
+        {
+            return None;
+        }
+        let size = MAX_TIMED_PASSES as u64 * 24;
+        Some(StatisticsQueries {
+            set: gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass pipeline statistics"),
+                ty: wgpu::QueryType::PipelineStatistics(
+                    wgpu::PipelineStatisticsTypes::VERTEX_SHADER_INVOCATIONS
+                        | wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS
+                        | wgpu::PipelineStatisticsTypes::COMPUTE_SHADER_INVOCATIONS,
+                ),
+                count: MAX_TIMED_PASSES,
+            }),
+            resolve: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pass statistics resolve"),
+                size,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            readback: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pass statistics readback"),
+                size,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            }),
+        })
+    }
+}
+
+/// A render pass opened by a [`PassRecorder`]; use it like a `wgpu::RenderPass`.
+pub struct RecordedRenderPass<'p> {
+    pass: wgpu::RenderPass<'p>,
+    statistics: bool,
+}
+
+impl<'p> std::ops::Deref for RecordedRenderPass<'p> {
+    type Target = wgpu::RenderPass<'p>;
+    fn deref(&self) -> &Self::Target {
+        &self.pass
+    }
+}
+
+impl std::ops::DerefMut for RecordedRenderPass<'_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.pass
+    }
+}
+
+impl Drop for RecordedRenderPass<'_> {
+    fn drop(&mut self) {
+        if self.statistics {
+            self.pass.end_pipeline_statistics_query();
+        }
+    }
+}
+
+/// A compute pass opened by a [`PassRecorder`]; use it like a `wgpu::ComputePass`.
+pub struct RecordedComputePass<'p> {
+    pass: wgpu::ComputePass<'p>,
+    statistics: bool,
+}
+
+impl<'p> std::ops::Deref for RecordedComputePass<'p> {
+    type Target = wgpu::ComputePass<'p>;
+    fn deref(&self) -> &Self::Target {
+        &self.pass
+    }
+}
+
+impl std::ops::DerefMut for RecordedComputePass<'_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.pass
+    }
+}
+
+impl Drop for RecordedComputePass<'_> {
+    fn drop(&mut self) {
+        if self.statistics {
+            self.pass.end_pipeline_statistics_query();
+        }
+    }
+}
+
 /// Opens the passes of one frame and times them.
 pub struct PassRecorder<'a> {
     gpu: &'a GpuContext,
     encoder: Option<wgpu::CommandEncoder>,
     queries: Option<&'a TimestampQueries>,
+    statistics: Option<&'a StatisticsQueries>,
     owner: PassOwner,
     names: Vec<(String, PassOwner)>,
     cpu_times: Vec<f64>,
@@ -127,10 +228,20 @@ impl<'a> PassRecorder<'a> {
             gpu,
             encoder: None,
             queries,
+            statistics: None,
             owner: PassOwner::Host,
             names: Vec::new(),
             cpu_times: Vec::new(),
         }
+    }
+
+    /// Also counts shader invocations per pass.
+    pub fn with_statistics(
+        mut self,
+        statistics: Option<&'a StatisticsQueries>,
+    ) -> PassRecorder<'a> {
+        self.statistics = statistics;
+        self
     }
 
     /// The device and queue.
@@ -180,9 +291,11 @@ impl<'a> PassRecorder<'a> {
     }
 
     /// Opens a render pass; `desc.label` names it in timings and captures.
-    pub fn render_pass(&mut self, desc: &wgpu::RenderPassDescriptor<'_>) -> wgpu::RenderPass<'_> {
+    pub fn render_pass(&mut self, desc: &wgpu::RenderPassDescriptor<'_>) -> RecordedRenderPass<'_> {
         let name = desc.label.unwrap_or("unnamed render pass").to_string();
         let slots = self.next_pass(&name);
+        let index = self.names.len() as u32 - 1;
+        let statistics = self.statistics.filter(|_| index < MAX_TIMED_PASSES);
         let queries = self.queries;
         let timestamp_writes = match (slots, queries) {
             (Some((begin, end)), Some(q)) => Some(wgpu::RenderPassTimestampWrites {
@@ -200,12 +313,21 @@ impl<'a> PassRecorder<'a> {
             occlusion_query_set: desc.occlusion_query_set,
             multiview_mask: desc.multiview_mask,
         };
-        self.encoder().begin_render_pass(&desc)
+        let mut pass = self.encoder().begin_render_pass(&desc);
+        if let Some(s) = statistics {
+            pass.begin_pipeline_statistics_query(&s.set, index);
+        }
+        RecordedRenderPass {
+            pass,
+            statistics: statistics.is_some(),
+        }
     }
 
     /// Opens a compute pass named `label`.
-    pub fn compute_pass(&mut self, label: &str) -> wgpu::ComputePass<'_> {
+    pub fn compute_pass(&mut self, label: &str) -> RecordedComputePass<'_> {
         let slots = self.next_pass(label);
+        let index = self.names.len() as u32 - 1;
+        let statistics = self.statistics.filter(|_| index < MAX_TIMED_PASSES);
         let queries = self.queries;
         let timestamp_writes = match (slots, queries) {
             (Some((begin, end)), Some(q)) => Some(wgpu::ComputePassTimestampWrites {
@@ -215,11 +337,19 @@ impl<'a> PassRecorder<'a> {
             }),
             _ => None,
         };
-        self.encoder()
+        let mut pass = self
+            .encoder()
             .begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(label),
                 timestamp_writes,
-            })
+            });
+        if let Some(s) = statistics {
+            pass.begin_pipeline_statistics_query(&s.set, index);
+        }
+        RecordedComputePass {
+            pass,
+            statistics: statistics.is_some(),
+        }
     }
 
     /// Submits the frame, waits for it and returns the pass times.
@@ -231,6 +361,13 @@ impl<'a> PassRecorder<'a> {
             let encoder = self.encoder();
             encoder.resolve_query_set(&q.set, 0..pass_count * 2, &q.resolve, 0);
             encoder.copy_buffer_to_buffer(&q.resolve, 0, &q.readback, 0, pass_count as u64 * 16);
+        }
+        if let Some(s) = self.statistics
+            && pass_count > 0
+        {
+            let encoder = self.encoder();
+            encoder.resolve_query_set(&s.set, 0..pass_count, &s.resolve, 0);
+            encoder.copy_buffer_to_buffer(&s.resolve, 0, &s.readback, 0, pass_count as u64 * 24);
         }
         self.flush();
         self.gpu.wait_idle();
@@ -255,16 +392,31 @@ impl<'a> PassRecorder<'a> {
                 std::mem::take(&mut self.cpu_times),
             ),
         };
+        let invocations: Vec<[u64; 3]> = match self.statistics {
+            Some(s) if pass_count > 0 => super::readback::map_buffer(self.gpu, &s.readback)
+                .chunks_exact(24)
+                .take(pass_count as usize)
+                .map(|b| {
+                    let word = |k: usize| {
+                        u64::from_le_bytes(b[8 * k..8 * k + 8].try_into().expect("8 bytes"))
+                    };
+                    [word(0), word(1), word(2)]
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
         FrameTimings {
             source,
             passes: self
                 .names
                 .into_iter()
                 .zip(times.into_iter().chain(std::iter::repeat(0.0)))
-                .map(|((name, owner), milliseconds)| PassTiming {
+                .enumerate()
+                .map(|(i, ((name, owner), milliseconds))| PassTiming {
                     name,
                     owner,
                     milliseconds,
+                    invocations: invocations.get(i).copied(),
                 })
                 .collect(),
         }

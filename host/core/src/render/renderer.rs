@@ -14,7 +14,7 @@ use super::scene_buffers::SceneBuffers;
 use super::visibility::{IndirectTarget, SlotAssignment, VisibilityTargets};
 use crate::gpu::{
     FrameTimings, GpuContext, PassOwner, PassRecorder, ShaderError, ShaderLibrary,
-    TimestampQueries, readback,
+    StatisticsQueries, TimestampQueries, readback,
 };
 use crate::params::{self, ParamValues};
 use crate::scene::{Camera, Light, Scene};
@@ -116,6 +116,7 @@ pub struct Renderer {
     lighting_inputs: wgpu::BindGroup,
     debug: DebugViewPass,
     timestamps: Option<TimestampQueries>,
+    statistics: Option<StatisticsQueries>,
     technique: ActiveTechnique,
 }
 
@@ -213,7 +214,7 @@ fn instantiate(
 
 /// Borrows the renderer's fields (not the technique) as a [`RenderContext`].
 macro_rules! render_context {
-    ($renderer:ident) => {
+    ($renderer:ident, $view:expr) => {
         RenderContext {
             gpu: &$renderer.gpu,
             shaders: &$renderer.shaders,
@@ -226,6 +227,10 @@ macro_rules! render_context {
             camera: &$renderer.camera,
             lights: &$renderer.lights,
             size: $renderer.size,
+            debug_view: match $view {
+                View::Resource(name) => Some(name.as_str()),
+                _ => None,
+            },
         }
     };
 }
@@ -281,6 +286,7 @@ impl Renderer {
             lighting_inputs,
             debug,
             timestamps,
+            statistics: None,
             technique,
         };
         renderer.update_slots();
@@ -340,6 +346,17 @@ impl Renderer {
         self.technique = next;
         self.update_slots();
         Ok(())
+    }
+
+    /// Counts vertex, fragment and compute invocations per pass (where the device has
+    /// pipeline-statistics queries). Returns whether counting is on.
+    pub fn set_pipeline_statistics(&mut self, enabled: bool) -> bool {
+        self.statistics = if enabled {
+            StatisticsQueries::new(&self.gpu)
+        } else {
+            None
+        };
+        self.statistics.is_some()
     }
 
     /// Changes the output size.
@@ -412,7 +429,7 @@ impl Renderer {
         let id = self.technique.registration.id;
         if self.technique.pending != Changes::default() {
             let changes = self.technique.pending;
-            let ctx = render_context!(self);
+            let ctx = render_context!(self, view);
             let active = &mut self.technique;
             let prepared = guarded(&self.gpu, id, || active.instance.prepare(&ctx, changes));
             if let Err(e) = prepared {
@@ -421,8 +438,9 @@ impl Renderer {
             self.technique.pending = Changes::default();
         }
 
-        let ctx = render_context!(self);
-        let mut recorder = PassRecorder::new(&self.gpu, self.timestamps.as_ref());
+        let ctx = render_context!(self, view);
+        let mut recorder = PassRecorder::new(&self.gpu, self.timestamps.as_ref())
+            .with_statistics(self.statistics.as_ref());
         self.gbuffer_pass.record(
             &mut recorder,
             &self.gbuffer,

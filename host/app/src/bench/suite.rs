@@ -1,0 +1,125 @@
+//! Benchmark suites (`scenes/bench/*.ron`) that reproduce the seeds' experiments.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::PathMode;
+
+/// A suite: runs, plus ratios to place beside the seed's figures.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Suite {
+    pub name: String,
+    pub description: String,
+    pub runs: Vec<SuiteRun>,
+    #[serde(default)]
+    pub ratios: Vec<SuiteRatio>,
+    /// What the seeds report, quoted beside this project's numbers.
+    #[serde(default)]
+    pub seed_figures: Vec<String>,
+}
+
+/// One benchmark run of a suite.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuiteRun {
+    pub name: String,
+    /// Scene file, relative to the suite file.
+    pub scene: String,
+    pub techniques: Vec<String>,
+    #[serde(default = "default_size")]
+    pub size: (u32, u32),
+    #[serde(default = "default_frames")]
+    pub frames: u32,
+    #[serde(default = "default_warmup")]
+    pub warmup: u32,
+    #[serde(default)]
+    pub path: PathMode,
+    /// (key, values) as for `--sweep KEY=v1,v2`.
+    #[serde(default)]
+    pub sweeps: Vec<(String, Vec<String>)>,
+    /// Technique parameters as `ID.KEY` = value.
+    #[serde(default)]
+    pub set: Vec<(String, String)>,
+}
+
+fn default_size() -> (u32, u32) {
+    (256, 256)
+}
+fn default_frames() -> u32 {
+    10
+}
+fn default_warmup() -> u32 {
+    2
+}
+
+/// What a ratio divides: a run's technique, optionally one configuration, and a measure.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Measure {
+    pub run: String,
+    pub technique: String,
+    /// `frame`, `technique` (its passes), or a pass-name prefix.
+    #[serde(default = "default_measure")]
+    pub passes: String,
+}
+
+fn default_measure() -> String {
+    "frame".into()
+}
+
+/// A ratio to report beside the seed's figure; computed for every matching pair of
+/// configurations (same size and tessellation).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuiteRatio {
+    pub label: String,
+    pub numerator: Measure,
+    pub denominator: Measure,
+    /// The seed's figure for the same ratio.
+    pub seed: String,
+}
+
+/// Where suite `name` lives: `scenes/bench/NAME.ron` under the current folder, or under the
+/// workspace the binary was built from.
+pub fn locate(name: &str) -> anyhow::Result<PathBuf> {
+    let relative = Path::new("scenes/bench").join(format!("{name}.ron"));
+    let built = Path::new(env!("CARGO_MANIFEST_DIR")).join(&relative);
+    [relative.clone(), built]
+        .into_iter()
+        .find(|p| p.is_file())
+        .ok_or_else(|| {
+            let known: Vec<String> =
+                std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bench"))
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|e| e.ok())
+                    .filter_map(|e| {
+                        e.path()
+                            .file_stem()
+                            .map(|s| s.to_string_lossy().into_owned())
+                    })
+                    .collect();
+            anyhow::anyhow!(
+                "no suite `{name}` ({} not found; suites: {})",
+                relative.display(),
+                known.join(", ")
+            )
+        })
+}
+
+/// Loads and parses a suite file.
+pub fn load(path: &Path) -> anyhow::Result<Suite> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    ron::from_str(&text).map_err(|e| {
+        anyhow::anyhow!(
+            "{}:{}:{}: {}",
+            path.display(),
+            e.span.start.line,
+            e.span.start.col,
+            e.code
+        )
+    })
+}
