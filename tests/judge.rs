@@ -1,7 +1,83 @@
 //! The reference judge on rendered frames, and the plugin-test helper built on it.
 
 use glam::UVec2;
+use zoo_host::params::{ParamSpec, ParamValues};
 use zoo_host::test_support::{Metric, judge};
+use zoo_host::{
+    Changes, GpuContext, LightKind, PassInfo, PassRecorder, RenderContext, ShadowTechnique,
+    TechniqueError,
+};
+
+/// A test-only technique that supports point lights only (and shadows nothing).
+struct PointOnly;
+
+impl ShadowTechnique for PointOnly {
+    fn passes(&self) -> Vec<PassInfo> {
+        Vec::new()
+    }
+    fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> Result<(), TechniqueError> {
+        Ok(())
+    }
+    fn record(
+        &mut self,
+        _: &RenderContext<'_>,
+        _: &mut PassRecorder<'_>,
+    ) -> Result<(), TechniqueError> {
+        Ok(())
+    }
+}
+
+fn create_point_only(
+    _: &GpuContext,
+    _: &ParamValues,
+) -> Result<Box<dyn ShadowTechnique>, TechniqueError> {
+    Ok(Box::new(PointOnly))
+}
+
+zoo_host::register_technique! {
+    id: "test-point-only",
+    name: "Test: point lights only",
+    description: "Supports point lights only (test only)",
+    source: "test",
+    light_kinds: &[LightKind::Point],
+    required_features: zoo_host::wgpu::Features::empty,
+    optional_features: zoo_host::wgpu::Features::empty,
+    required_limits: zoo_host::wgpu::Limits::downlevel_defaults,
+    params: Vec::<ParamSpec>::new,
+    create: create_point_only,
+}
+
+#[test]
+fn unsupported_light_kinds_are_reported_not_scored() {
+    let run = judge(
+        "planar-room.ron",
+        "test-point-only",
+        &[],
+        UVec2::new(96, 96),
+    );
+    let kinds: Vec<(LightKind, bool)> = run
+        .judged
+        .scores
+        .iter()
+        .map(|s| (s.kind, s.metrics.is_some()))
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![
+            (LightKind::Point, true),
+            (LightKind::Spot, false),
+            (LightKind::Directional, false)
+        ]
+    );
+    let csv = shadow_zoo::compare::results_csv("planar-room", std::slice::from_ref(&run.judged));
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert!(rows[0].starts_with("planar-room,test-point-only,0,point,") && !rows[0].contains(",,"));
+    assert!(
+        rows[1].starts_with("planar-room,test-point-only,1,spot,,,,,,,,"),
+        "{}",
+        rows[1]
+    );
+}
 
 #[test]
 fn unshadowed_misses_exactly_the_reference_shadows() {

@@ -133,6 +133,9 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
     );
     if args.timings {
         print!("{}", format_timings(&timings));
+        for (name, value) in renderer.technique_instance().counters() {
+            println!("  counter {name}: {value}");
+        }
     }
     Ok(())
 }
