@@ -325,26 +325,13 @@ impl ShadowTechnique for Planar {
             self.plan(ctx)?;
         }
         if changes.resolution || self.plane_ids.is_none() {
-            let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("planar plane ids"),
-                size: wgpu::Extent3d {
-                    width: ctx.size.x,
-                    height: ctx.size.y,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: PLANE_IDS_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some("planar plane ids view"),
-                ..Default::default()
-            });
-            self.plane_ids = Some((texture, view));
+            self.plane_ids = Some(zoo_host::gpu::render_target(
+                &ctx.gpu.device,
+                "planar plane ids",
+                ctx.size,
+                PLANE_IDS_FORMAT,
+                wgpu::TextureUsages::empty(),
+            ));
         }
         Ok(())
     }
@@ -369,37 +356,16 @@ impl ShadowTechnique for Planar {
             let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(&name),
                 color_attachments: &[
-                    Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: plane_ids,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: if k == 0 {
-                                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
-                            } else {
-                                wgpu::LoadOp::Load
-                            },
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
+                    zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Load),
+                    zoo_host::gpu::color_attachment(
+                        plane_ids,
+                        zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT),
+                    ),
                 ],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &ctx.gbuffer.depth_view,
-                    depth_ops: None,
-                    stencil_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                }),
+                depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
+                    &ctx.gbuffer.depth_view,
+                    wgpu::LoadOp::Clear(0),
+                ),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,

@@ -668,25 +668,13 @@ impl ShadowMaps {
         device: &wgpu::Device,
         size: UVec2,
     ) -> (wgpu::Texture, wgpu::TextureView) {
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("sm-pcf diagnostics"),
-            size: wgpu::Extent3d {
-                width: size.x,
-                height: size.y,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DIAGNOSTICS_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("sm-pcf diagnostics view"),
-            ..Default::default()
-        });
-        (texture, view)
+        zoo_host::gpu::render_target(
+            device,
+            "sm-pcf diagnostics",
+            size,
+            DIAGNOSTICS_FORMAT,
+            wgpu::TextureUsages::empty(),
+        )
     }
 }
 
@@ -828,28 +816,11 @@ impl ShadowTechnique for ShadowMaps {
             let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(&name),
                 color_attachments: &[
-                    Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: diagnostics,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: if k == 0 {
-                                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
-                            } else {
-                                wgpu::LoadOp::Load
-                            },
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
+                    zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Load),
+                    zoo_host::gpu::color_attachment(
+                        diagnostics,
+                        zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT),
+                    ),
                 ],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,

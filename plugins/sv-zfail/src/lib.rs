@@ -566,26 +566,7 @@ impl ShadowVolumes {
 
     fn create_debug_targets(device: &wgpu::Device, size: zoo_host::glam::UVec2) -> DebugTargets {
         let make = |label: &str, format| {
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: size.x,
-                    height: size.y,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some(&format!("{label} view")),
-                ..Default::default()
-            });
-            (texture, view)
+            zoo_host::gpu::render_target(device, label, size, format, wgpu::TextureUsages::empty())
         };
         DebugTargets {
             counts: make("sv-zfail stencil counts", COUNTS_FORMAT),
@@ -737,23 +718,11 @@ impl ShadowTechnique for ShadowVolumes {
                 let name = volume_pass_name(light);
                 let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&name),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &ctx.gbuffer.depth_view,
-                        depth_ops: None,
-                        stencil_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                    }),
+                    color_attachments: &[zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Load)],
+                    depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
+                        &ctx.gbuffer.depth_view,
+                        wgpu::LoadOp::Clear(0),
+                    ),
                     timestamp_writes: None,
                     occlusion_query_set: None,
                     multiview_mask: None,
@@ -777,27 +746,15 @@ impl ShadowTechnique for ShadowVolumes {
             if showing_debug && light as u32 == self.params.debug_light {
                 let name = debug_pass_name(light);
                 let clear = |view| {
-                    Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })
+                    zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::BLACK))
                 };
                 let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&name),
                     color_attachments: &[clear(&debug.counts.1), clear(&debug.overlay.1)],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &ctx.gbuffer.depth_view,
-                        depth_ops: None,
-                        stencil_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        }),
-                    }),
+                    depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
+                        &ctx.gbuffer.depth_view,
+                        wgpu::LoadOp::Load,
+                    ),
                     timestamp_writes: None,
                     occlusion_query_set: None,
                     multiview_mask: None,

@@ -4,6 +4,7 @@ mod context;
 pub mod readback;
 mod recorder;
 mod shaders;
+mod targets;
 
 pub use context::{GpuContext, GpuError};
 pub use recorder::{
@@ -11,3 +12,4 @@ pub use recorder::{
     RecordedRenderPass, StatisticsQueries, TimestampQueries, TimingSource,
 };
 pub use shaders::{ComposedShader, ShaderError, ShaderLibrary};
+pub use targets::{clear_first, color_attachment, render_target, stencil_attachment};

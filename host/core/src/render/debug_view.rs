@@ -138,15 +138,10 @@ impl DebugViewPass {
         });
         let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
             label: Some("Debug view"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
+            color_attachments: &[crate::gpu::color_attachment(
+                target,
+                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+            )],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,

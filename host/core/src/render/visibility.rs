@@ -182,24 +182,13 @@ pub const INDIRECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Floa
 impl IndirectTarget {
     /// Creates the target at `size`.
     pub fn new(gpu: &GpuContext, size: UVec2) -> IndirectTarget {
-        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("indirect radiance"),
-            size: wgpu::Extent3d {
-                width: size.x,
-                height: size.y,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: INDIRECT_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("indirect radiance view"),
-            ..Default::default()
-        });
+        let (texture, view) = crate::gpu::render_target(
+            &gpu.device,
+            "indirect radiance",
+            size,
+            INDIRECT_FORMAT,
+            wgpu::TextureUsages::empty(),
+        );
         IndirectTarget { texture, view }
     }
 }
