@@ -47,6 +47,9 @@ zoo_host::technique_params! {
         normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
         /// Cull front faces in the depth pass (stores back faces).
         cull_front: bool = false;
+        /// Keep directional maps stable as the camera moves (extent on a geometric ladder, centre
+        /// snapped to whole texels), so shadow edges do not shimmer.
+        stable_fit: bool = true;
         /// Poisson disc radius in texels.
         kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
         /// Largest PCSS blocker search and penumbra radius, in texels.
@@ -469,6 +472,7 @@ impl ShadowMaps {
                         aspect,
                         &self.object_bounds,
                         &self.caster_bounds,
+                        self.params.stable_fit.then_some(resolution),
                     )],
                 };
                 let maps = LightMaps {

@@ -179,12 +179,17 @@ pub fn camera_frustum_corners(camera: &Camera, aspect: f32, far: f32) -> [Vec3; 
 /// An orthographic frustum for a directional light travelling along `direction`: its sides
 /// fit the receivers the camera can see (each object's box clipped to the box around the camera
 /// frustum), and its depth range reaches back to every caster that can shadow them.
+///
+/// With `stable_texels` = Some(resolution), the extent is rounded up to a step of a geometric
+/// ladder (ratio 1.25) and the centre snapped to whole texels, so small camera moves leave the
+/// map unchanged and larger ones move it by whole texels: shadow edges do not shimmer.
 pub fn directional_frustum(
     direction: Vec3,
     camera: &Camera,
     aspect: f32,
     objects: &[Aabb],
     casters: &[Aabb],
+    stable_texels: Option<u32>,
 ) -> LightFrustum {
     let view = look_to_mat4(Vec3::ZERO, direction, up_for(direction));
     let all = objects.iter().fold(
@@ -219,18 +224,26 @@ pub fn directional_frustum(
         }
     }
     // Square extent centred on the receivers (the map is square).
-    let extent = (hi.x - lo.x).max(hi.y - lo.y).max(1e-3) * 1.02;
-    let center = (lo + hi) * 0.5;
+    let mut extent = (hi.x - lo.x).max(hi.y - lo.y).max(1e-3) * 1.02;
+    let mut center = (lo + hi) * 0.5;
+    if let Some(resolution) = stable_texels {
+        extent = 1.25f32.powf(extent.ln().div_euclid(1.25f32.ln()) + 1.0);
+        let texel = extent / resolution as f32;
+        center.x = (center.x / texel).round() * texel;
+        center.y = (center.y / texel).round() * texel;
+        // Rounding the centre moves the receivers by up to half a texel: keep them inside.
+        extent += 2.0 * texel;
+    }
     let margin = (nearest - lo.z).max(1e-3) * 0.01;
+    let (mut near, mut far) = (-nearest - margin, -lo.z + margin);
+    if stable_texels.is_some() {
+        // The depth range moves outward in coarse steps too.
+        let step = extent / 16.0;
+        near = (near / step).floor() * step;
+        far = (far / step).ceil() * step;
+    }
     let view = Mat4::from_translation(Vec3::new(-center.x, -center.y, 0.0)) * view;
-    LightFrustum::new(
-        view,
-        Projection::Orthographic {
-            extent,
-            near: -nearest - margin,
-            far: -lo.z + margin,
-        },
-    )
+    LightFrustum::new(view, Projection::Orthographic { extent, near, far })
 }
 
 #[cfg(test)]
@@ -308,6 +321,7 @@ mod tests {
             1.0,
             &[bounds],
             &[],
+            None,
         );
         let Projection::Orthographic { extent, .. } = f.projection else {
             unreachable!()
@@ -329,7 +343,7 @@ mod tests {
         let far_away = (Vec3::new(100.0, 0.0, 100.0), Vec3::new(101.0, 50.0, 101.0));
         let direction = Vec3::new(0.4, -1.0, -0.3).normalize();
         let objects = [floor, tall, far_away];
-        let f = directional_frustum(direction, &camera, 1.5, &objects, &objects);
+        let f = directional_frustum(direction, &camera, 1.5, &objects, &objects, None);
         // Every visible floor point (sampled on a grid of rays from the camera) is covered.
         let inverse = (camera.projection(1.5) * camera.view()).inverse();
         for i in 0..=10 {
@@ -362,6 +376,49 @@ mod tests {
             unreachable!()
         };
         assert!(extent < 100.0, "extent {extent} covers the whole scene");
+    }
+
+    #[test]
+    fn stable_fit_ignores_small_camera_moves_and_snaps_to_texels() {
+        let camera = |x: f32| Camera {
+            position: Vec3::new(3.0 + x, 4.0, 6.0),
+            target: Vec3::new(x, 0.0, 0.0),
+            fov_y: 50f32.to_radians(),
+            near: 0.1,
+            far: 200.0,
+        };
+        let floor = (Vec3::new(-20.0, -0.01, -20.0), Vec3::new(20.0, 0.0, 20.0));
+        let post = (Vec3::new(-0.2, 0.0, -0.2), Vec3::new(0.2, 3.0, 0.2));
+        let objects = [floor, post];
+        let direction = Vec3::new(0.4, -1.0, -0.3).normalize();
+        let fit = |x: f32| {
+            directional_frustum(direction, &camera(x), 1.5, &objects, &objects, Some(1024))
+        };
+        let (a, b) = (fit(0.0), fit(0.001));
+        let Projection::Orthographic { extent, .. } = a.projection else {
+            unreachable!()
+        };
+        assert_eq!(a.projection, b.projection, "a tiny move keeps the extent");
+        // A world point's texel coordinate changes by whole texels (or not at all).
+        let p = Vec3::new(0.3, 0.0, 0.7);
+        for x in [0.001, 0.05, 0.3] {
+            let c = fit(x);
+            let Projection::Orthographic { extent: e, .. } = c.projection else {
+                unreachable!()
+            };
+            if e == extent {
+                let texel_a = (a.view_proj.project_point3(p).truncate() * 512.0).x;
+                let texel_c = (c.view_proj.project_point3(p).truncate() * 512.0).x;
+                let shift = texel_c - texel_a;
+                assert!(
+                    (shift - shift.round()).abs() < 1e-2,
+                    "moved by {shift} texels"
+                );
+            }
+        }
+        // The snapped fit still covers the visible floor around the post.
+        assert!(a.contains(Vec3::new(0.0, 0.0, 0.0)));
+        assert!(a.contains(post.1));
     }
 
     #[test]
