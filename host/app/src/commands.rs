@@ -4,7 +4,6 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{Context, bail};
-use clap::CommandFactory;
 use zoo_host::gpu::{FrameTimings, PassOwner};
 use zoo_host::{GpuContext, Renderer, Scene, View, params};
 
@@ -13,12 +12,7 @@ use crate::cli::{Cli, Command, RenderArgs};
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        None => {
-            // The interactive viewer will open here; until then, show the commands.
-            Cli::command().print_help()?;
-            println!();
-            Ok(())
-        }
+        None => crate::viewer::run(),
         Some(Command::List) => {
             print!("{}", list_techniques());
             Ok(())

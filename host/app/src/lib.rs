@@ -7,6 +7,7 @@ pub mod bench;
 pub mod cli;
 pub mod commands;
 pub mod compare;
+pub mod viewer;
 
 mod linked {
     include!(concat!(env!("OUT_DIR"), "/linked_plugins.rs"));

@@ -575,6 +575,11 @@ impl Renderer {
         })
     }
 
+    /// The output image's view (sRGB RGBA8), e.g. to show it in a UI.
+    pub fn output_view(&self) -> &wgpu::TextureView {
+        &self.output_view
+    }
+
     /// The output image (sRGB RGBA8).
     pub fn read_output(&self) -> image::RgbaImage {
         let bytes = readback::read_texture(&self.gpu, &self.output, 0, wgpu::TextureAspect::All, 4);
