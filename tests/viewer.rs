@@ -2,7 +2,9 @@
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use shadow_zoo::viewer::ViewerState;
+use shadow_zoo::viewer::camera::CameraMode;
+use shadow_zoo::viewer::split::SplitMode;
+use shadow_zoo::viewer::{ViewImages, ViewerState};
 use zoo_host::glam::UVec2;
 use zoo_host::params::{ParamSpec, ParamValue, ParamValues};
 use zoo_host::test_support::{gpu, scene_path};
@@ -56,11 +58,11 @@ fn harness() -> Harness<'static, ViewerState> {
     let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
     let state = ViewerState::new(gpu(), scene, SIZE).unwrap();
     Harness::builder()
-        .with_size(egui::vec2(1200.0, 1400.0))
+        .with_size(egui::vec2(1600.0, 2000.0))
         .build_ui_state(
             |ui, state: &mut ViewerState| {
                 state.render(SIZE);
-                state.ui(ui, None);
+                state.ui(ui, ViewImages::default());
             },
             state,
         )
@@ -169,11 +171,11 @@ fn switching_two_hundred_times_frees_the_old_resources() {
     let own = std::sync::Arc::new(GpuContext::new_headless().unwrap());
     let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
     let mut harness = Harness::builder()
-        .with_size(egui::vec2(1200.0, 1400.0))
+        .with_size(egui::vec2(1600.0, 2000.0))
         .build_ui_state(
             |ui, state: &mut ViewerState| {
                 state.render(SIZE);
-                state.ui(ui, None);
+                state.ui(ui, ViewImages::default());
             },
             ViewerState::new(own, scene, SIZE).unwrap(),
         );
@@ -224,4 +226,380 @@ fn switching_two_hundred_times_frees_the_old_resources() {
             after[k]
         );
     }
+}
+
+#[test]
+fn lights_panel_adds_edits_and_removes_lights() {
+    let mut harness = harness();
+    harness.run();
+    assert_eq!(harness.state().renderer.lights().len(), 3);
+    harness.get_by_label("Add light").click();
+    harness.run();
+    let state = harness.state();
+    assert_eq!(state.lights.len(), 4);
+    assert_eq!(state.selected_light, 3);
+    assert_eq!(
+        state.renderer.lights().len(),
+        4,
+        "the renderer draws the new light"
+    );
+    // The new light's fields are in the panel; editing them reaches the renderer.
+    for field in ["intensity", "range", "radius"] {
+        assert!(
+            harness.query_all_by_label(field).next().is_some(),
+            "{field}"
+        );
+    }
+    harness.state_mut().lights[3].radiance = zoo_host::glam::Vec3::new(1.0, 2.0, 3.0);
+    harness.run();
+    assert_eq!(
+        harness.state().renderer.lights()[3].radiance,
+        zoo_host::glam::Vec3::new(1.0, 2.0, 3.0)
+    );
+    // The spot light (light 1) shows its cone angle.
+    harness.get_by_label("1: spot").click();
+    harness.run();
+    assert!(
+        harness
+            .query_all_by_label("spot angle (°)")
+            .next()
+            .is_some()
+    );
+    harness.get_by_label("Remove light").click();
+    harness.run();
+    let state = harness.state();
+    assert_eq!(state.lights.len(), 3);
+    assert_eq!(state.renderer.lights().len(), 3);
+    let kinds: Vec<_> = state.lights.iter().map(|l| l.kind).collect();
+    use zoo_host::LightKind::{Directional, Point};
+    assert_eq!(
+        kinds,
+        [Point, Directional, Point],
+        "the spot light was removed"
+    );
+}
+
+#[test]
+fn dragging_a_light_handle_moves_the_light() {
+    let mut harness = harness();
+    harness.run();
+    let (index, pos) = *harness
+        .state()
+        .light_handles
+        .first()
+        .expect("a light has a handle in the view");
+    let before = harness.state().lights[index];
+    let camera = harness.state().camera;
+    harness.hover_at(pos);
+    harness.drag_at(pos);
+    harness.step();
+    harness.hover_at(pos + egui::vec2(40.0, 0.0));
+    harness.step();
+    harness.drop_at(pos + egui::vec2(40.0, 0.0));
+    harness.run();
+    let state = harness.state();
+    let after = state.lights[index];
+    assert_ne!(before, after, "the light moved");
+    assert_eq!(
+        state.camera, camera,
+        "dragging a handle does not orbit the camera"
+    );
+    assert_eq!(state.selected_light, index);
+    assert_eq!(state.renderer.lights()[index], after);
+    // Away from any handle, a drag orbits the camera instead.
+    let corner = pos + egui::vec2(-200.0, 150.0);
+    assert!(
+        state
+            .light_handles
+            .iter()
+            .all(|(_, p)| p.distance(corner) > 20.0)
+    );
+    harness.hover_at(corner);
+    harness.drag_at(corner);
+    harness.step();
+    harness.hover_at(corner + egui::vec2(30.0, 10.0));
+    harness.step();
+    harness.drop_at(corner + egui::vec2(30.0, 10.0));
+    harness.run();
+    assert_ne!(harness.state().camera, camera);
+    assert_eq!(harness.state().lights[index], after);
+}
+
+#[test]
+fn fly_camera_moves_with_the_keys_and_bookmarks_return() {
+    let mut harness = harness();
+    harness.run();
+    let name_field = || (egui::accesskit::Role::TextInput, "bookmark name");
+    harness
+        .get_by_role_and_label(name_field().0, name_field().1)
+        .focus();
+    harness.step();
+    harness
+        .get_by_role_and_label(name_field().0, name_field().1)
+        .type_text("start");
+    harness.run();
+    harness.get_by_label("Add bookmark").click();
+    harness.run();
+    let start = harness.state().camera;
+    harness.get_by_label("fly").click();
+    harness.run();
+    assert_eq!(harness.state().camera.mode, CameraMode::Fly);
+    let forward = harness.state().camera.forward();
+    harness.key_down(egui::Key::W);
+    harness.run_steps(5);
+    harness.key_up(egui::Key::W);
+    harness.run();
+    let moved = harness.state().camera.position - start.position;
+    assert!(
+        moved.length() > 1e-3 && moved.normalize().dot(forward) > 0.999,
+        "W moves along the view: {moved}"
+    );
+    harness.get_by_label("Go to start").click();
+    harness.run();
+    let back = harness.state().camera;
+    assert!(back.position.abs_diff_eq(start.position, 1e-4));
+    assert!(back.pivot().abs_diff_eq(start.pivot(), 1e-3));
+    // Bookmarks are saved with the settings, per scene.
+    let path = std::env::temp_dir().join(format!("zoo-viewer-marks-{}.ron", std::process::id()));
+    harness.state().save_settings(&path).unwrap();
+    harness.state_mut().bookmarks.clear();
+    harness.state_mut().load_settings(&path).unwrap();
+    assert_eq!(harness.state().bookmarks["planar-room"][0].name, "start");
+}
+
+#[test]
+fn reference_overlay_judges_in_the_background() {
+    let mut harness = harness();
+    harness.run();
+    harness.get_by_label("sm-pcf").click();
+    harness.run();
+    harness.get_by_label("Judge view").click();
+    harness.step();
+    // The frame after the click returned while tracing runs on its own thread.
+    assert!(harness.state().reference.is_running() || harness.state().reference.result.is_some());
+    harness.state_mut().reference.wait().unwrap();
+    harness.run();
+    let state = harness.state();
+    let result = state.reference.result.as_ref().unwrap();
+    assert_eq!(result.view.technique, "sm-pcf");
+    assert_eq!(result.metrics.len(), 3);
+    for metrics in &result.metrics {
+        let m = metrics.as_ref().unwrap();
+        assert!(m.pixels > 0);
+        assert!(
+            m.false_shadow_core <= 0.005 && m.false_lit_core <= 0.01,
+            "{m:?}"
+        );
+    }
+    assert_eq!(result.error_maps[0].dimensions(), (SIZE.x, SIZE.y));
+    harness.get_by_label("show error map");
+    harness.get_by_label("false shadow");
+    assert!(!state.reference.is_stale(&state.renderer));
+    // Moving the camera makes the verdict stale.
+    harness
+        .state_mut()
+        .camera
+        .drag(zoo_host::glam::Vec2::new(10.0, 0.0));
+    harness.run();
+    assert!(
+        harness
+            .state()
+            .reference
+            .is_stale(&harness.state().renderer)
+    );
+    harness.get_by_label("stale: the view changed since it was judged");
+}
+
+#[test]
+fn ab_split_and_difference_compare_two_techniques() {
+    let mut harness = harness();
+    harness.run();
+    harness.get_by_label("compare with B").click();
+    harness.run();
+    harness.get_by_label("B: sm-pcf").click();
+    harness.run();
+    {
+        let state = harness.state();
+        let ab = state.ab.as_ref().unwrap();
+        assert_eq!(ab.renderer.technique().id, "sm-pcf");
+        assert_eq!(state.technique_b, "sm-pcf");
+        assert_eq!(ab.renderer.camera(), state.renderer.camera());
+        assert!(state.b_timings.is_some());
+    }
+    harness.get_by_label("difference").click();
+    harness.run();
+    let state = harness.state();
+    let ab = state.ab.as_ref().unwrap();
+    assert_eq!(ab.mode, SplitMode::Difference);
+    // A = unshadowed is never darker than B = sm-pcf: only blue differences.
+    let diff = ab.difference.read(state.renderer.gpu()).unwrap();
+    let blue = diff
+        .pixels()
+        .filter(|p| p[2] as i32 > p[0] as i32 + 40)
+        .count();
+    let red = diff
+        .pixels()
+        .filter(|p| p[0] as i32 > p[2] as i32 + 40)
+        .count();
+    assert!(
+        blue > diff.pixels().len() / 50,
+        "B's shadows show as blue: {blue}"
+    );
+    assert_eq!(red, 0, "A is never darker than B");
+    // The same technique on both sides: no difference at all.
+    harness.get_by_label("B: unshadowed").click();
+    harness.run();
+    let state = harness.state();
+    let ab = state.ab.as_ref().unwrap();
+    let diff = ab.difference.read(state.renderer.gpu()).unwrap();
+    assert!(
+        diff.pixels().all(|p| p[0] == p[2]),
+        "identical sides differ"
+    );
+    harness.get_by_label("compare with B").click();
+    harness.run();
+    assert!(harness.state().ab.is_none());
+}
+
+#[test]
+fn debug_views_can_be_overlaid_on_the_final_image() {
+    let mut harness = harness();
+    harness.run();
+    let final_image = harness.state().renderer.read_output();
+    harness.get_by_label("normals").click();
+    harness.run();
+    let normals = harness.state().renderer.read_output();
+    harness.get_by_label("overlay").click();
+    harness.run();
+    let state = harness.state();
+    let overlaid = state.renderer.read_output();
+    let passes: Vec<_> = state
+        .timings
+        .as_ref()
+        .unwrap()
+        .passes
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    assert!(passes.iter().any(|p| p == "Lighting"), "{passes:?}");
+    assert!(passes.iter().any(|p| p == "Debug overlay"), "{passes:?}");
+    // At half opacity every pixel lies between the final image and the normals view.
+    let mut between = 0;
+    for ((o, f), n) in overlaid
+        .pixels()
+        .zip(final_image.pixels())
+        .zip(normals.pixels())
+    {
+        let ok = (0..3).all(|c| {
+            let (lo, hi) = (f[c].min(n[c]) as i32, f[c].max(n[c]) as i32);
+            (lo - 2..=hi + 2).contains(&(o[c] as i32))
+        });
+        between += ok as usize;
+    }
+    assert!(between * 100 >= overlaid.pixels().len() * 99, "{between}");
+    assert_ne!(overlaid, final_image);
+    assert_ne!(overlaid, normals);
+}
+
+#[test]
+fn settings_buttons_save_and_load_ron() {
+    let mut harness = harness();
+    harness.run();
+    let path = std::env::temp_dir().join(format!("zoo-viewer-buttons-{}.ron", std::process::id()));
+    harness.state_mut().settings_file = path.display().to_string();
+    harness.get_by_label("planar").click();
+    harness.run();
+    harness
+        .state_mut()
+        .set_param("opacity", ParamValue::Float(0.25));
+    harness.get_by_label("Save settings").click();
+    harness.run();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("opacity") && text.contains("0.25"), "{text}");
+    harness.get_by_label("unshadowed").click();
+    harness.run();
+    harness.state_mut().settings.clear();
+    harness.get_by_label("Load settings").click();
+    harness.run();
+    let state = harness.state();
+    assert_eq!(state.technique, "planar", "the saved technique is selected");
+    assert_eq!(
+        state.renderer.technique_params()["opacity"],
+        ParamValue::Float(0.25)
+    );
+    assert!(state.status.starts_with("loaded"), "{}", state.status);
+}
+
+/// Copies the embedded shaders into a fresh folder the viewer reads and watches.
+fn shader_folder(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("zoo-viewer-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let library = zoo_host::ShaderLibrary::embedded();
+    for name in zoo_host::ShaderLibrary::names() {
+        let path = dir.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, library.source(name).unwrap()).unwrap();
+    }
+    dir
+}
+
+#[test]
+fn editing_a_shader_reloads_it_and_errors_keep_the_old_pipeline() {
+    let dir = shader_folder("hot-reload");
+    let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
+    let library = zoo_host::ShaderLibrary::from_disk(dir.clone());
+    let state = ViewerState::with_shaders(gpu(), scene, SIZE, library).unwrap();
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1600.0, 2000.0))
+        .build_ui_state(
+            |ui, state: &mut ViewerState| {
+                state.render(SIZE);
+                state.ui(ui, ViewImages::default());
+            },
+            state,
+        );
+    harness.run();
+    let lit = harness.state().renderer.read_output();
+    assert!(lit.pixels().any(|p| p[0] > 20));
+    // Waits (up to 10 s) for the watcher to notice and the viewer to react.
+    let settle = |harness: &mut Harness<'_, ViewerState>, done: &dyn Fn(&ViewerState) -> bool| {
+        for _ in 0..200 {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            harness.run();
+            if done(harness.state()) {
+                return;
+            }
+        }
+        panic!("the viewer did not react to the shader edit");
+    };
+    // A broken edit: the error names file, line and column; the old pipeline keeps running.
+    let lighting = dir.join("host/lighting.wgsl");
+    let original = std::fs::read_to_string(&lighting).unwrap();
+    std::fs::write(
+        &lighting,
+        format!("{original}\nfn broken() -> f32 {{ return nope; }}\n"),
+    )
+    .unwrap();
+    settle(&mut harness, &|s| s.shader_error.is_some());
+    let error = harness.state().shader_error.clone().unwrap();
+    let line = original.lines().count() + 2;
+    assert!(
+        error.starts_with(&format!("shaders/host/lighting.wgsl:{line}:")),
+        "{error}"
+    );
+    harness.get_by_label(&format!("Shader error: {error}"));
+    assert_eq!(harness.state().renderer.read_output(), lit);
+    // A working edit replaces the pipeline: the lighting now writes black.
+    let entry = original.find("@fragment").unwrap();
+    let body = original[entry..].find('{').unwrap() + entry + 1;
+    let dark = format!(
+        "{}\n    if true {{ return vec4<f32>(0.0, 0.0, 0.0, 1.0); }}{}",
+        &original[..body],
+        &original[body..]
+    );
+    std::fs::write(&lighting, dark).unwrap();
+    settle(&mut harness, &|s| s.shader_error.is_none());
+    let black = harness.state().renderer.read_output();
+    assert!(black.pixels().all(|p| p[0] == 0 && p[1] == 0 && p[2] == 0));
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -10,7 +10,9 @@ struct ViewParams {
     max_value: f32,
     near: f32,
     far: f32,
-    _pad: vec2<f32>,
+    // Alpha of the output: 1 full screen, less when blended over the final image.
+    opacity: f32,
+    _pad: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: ViewParams;
@@ -30,9 +32,9 @@ fn remap(v: f32) -> f32 {
 fn fs_float(in: FullscreenOut) -> @location(0) vec4<f32> {
     let texel = textureLoad(source_float, source_pixel(in, textureDimensions(source_float)), 0);
     if params.mode == 1u {
-        return vec4<f32>(vec3<f32>(remap(texel[params.channel])), 1.0);
+        return vec4<f32>(vec3<f32>(remap(texel[params.channel])), params.opacity);
     }
-    return vec4<f32>(remap(texel.r), remap(texel.g), remap(texel.b), 1.0);
+    return vec4<f32>(remap(texel.r), remap(texel.g), remap(texel.b), params.opacity);
 }
 
 @fragment
@@ -41,21 +43,21 @@ fn fs_depth(in: FullscreenOut) -> @location(0) vec4<f32> {
     var v = d;
     if params.mode == 3u {
         if d >= 1.0 {
-            return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+            return vec4<f32>(0.0, 0.0, 0.0, params.opacity);
         }
         v = params.near * params.far / (params.far - d * (params.far - params.near));
     }
-    return vec4<f32>(vec3<f32>(1.0 - remap(v)), 1.0);
+    return vec4<f32>(vec3<f32>(1.0 - remap(v)), params.opacity);
 }
 
 @fragment
 fn fs_uint(in: FullscreenOut) -> @location(0) vec4<f32> {
     let v = textureLoad(source_uint, source_pixel(in, textureDimensions(source_uint)), 0).r;
     if v == 0u || params.mode != 4u {
-        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return vec4<f32>(0.0, 0.0, 0.0, params.opacity);
     }
     // Distinct hues for small integers.
     let h = fract(f32(v) * 0.618034);
     let c = saturate(abs(fract(vec3<f32>(h) + vec3<f32>(0.0, 2.0 / 3.0, 1.0 / 3.0)) * 6.0 - 3.0) - 1.0);
-    return vec4<f32>(c, 1.0);
+    return vec4<f32>(c, params.opacity);
 }

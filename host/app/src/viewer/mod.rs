@@ -1,24 +1,79 @@
 //! The interactive viewer: `shadow-zoo` with no arguments. The 3D view renders off-screen
 //! through the same renderer as the CLI and is shown in egui; panels switch techniques, edit
-//! their generated parameters, pick debug views and show per-pass timings.
+//! their generated parameters and the lights, pick debug views (full screen or overlaid),
+//! compare two techniques (A/B split or difference), judge the view against the ray-traced
+//! reference in the background, and show per-pass timings. Edits under `shaders/` are
+//! reloaded while it runs.
 
+pub mod camera;
+pub mod hot_reload;
+pub mod lights;
+mod panels;
+pub mod reference;
+pub mod split;
 pub mod state;
+mod view;
 
 use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::Context as _;
-use zoo_host::GpuContext;
 use zoo_host::glam::UVec2;
+use zoo_host::{GpuContext, ShaderLibrary};
 
 pub use state::ViewerState;
+pub use view::ViewImages;
+
+/// A renderer image registered with egui, re-registered when its view changes size.
+#[derive(Default)]
+struct NativeTexture {
+    id: Option<egui::TextureId>,
+    size: UVec2,
+}
+
+impl NativeTexture {
+    /// Points egui at `view` (of `size`) and returns the texture id; `None` frees it.
+    fn update(
+        &mut self,
+        render_state: &egui_wgpu::RenderState,
+        view: Option<(&wgpu::TextureView, UVec2)>,
+    ) -> Option<egui::TextureId> {
+        let mut renderer = render_state.renderer.write();
+        let Some((view, size)) = view else {
+            if let Some(id) = self.id.take() {
+                renderer.free_texture(&id);
+            }
+            return None;
+        };
+        match self.id {
+            Some(id) if self.size == size => renderer.update_egui_texture_from_wgpu_texture(
+                &render_state.device,
+                view,
+                wgpu::FilterMode::Linear,
+                id,
+            ),
+            _ => {
+                if let Some(id) = self.id.take() {
+                    renderer.free_texture(&id);
+                }
+                self.id = Some(renderer.register_native_texture(
+                    &render_state.device,
+                    view,
+                    wgpu::FilterMode::Linear,
+                ));
+                self.size = size;
+            }
+        }
+        self.id
+    }
+}
 
 /// The eframe application around [`ViewerState`].
 struct ViewerApp {
     state: ViewerState,
-    texture: Option<egui::TextureId>,
-    /// The output view the texture was registered for (re-registered after a resize).
-    registered_size: UVec2,
+    a: NativeTexture,
+    b: NativeTexture,
+    difference: NativeTexture,
 }
 
 impl eframe::App for ViewerApp {
@@ -26,40 +81,42 @@ impl eframe::App for ViewerApp {
         let Some(render_state) = frame.wgpu_render_state() else {
             return;
         };
-        // Render at the size the image area had last frame (the side and bottom panels
-        // take the rest).
-        let available = ui.available_size();
-        let size = UVec2::new(
-            ((available.x - 300.0).max(64.0) * ui.pixels_per_point()) as u32,
-            ((available.y - 200.0).max(64.0) * ui.pixels_per_point()) as u32,
-        )
-        .min(UVec2::splat(4096));
-        self.state.render(size);
-        let view = self.state.renderer.output_view();
-        let mut renderer = render_state.renderer.write();
-        match self.texture {
-            Some(id) if self.registered_size == self.state.renderer.size() => {
-                renderer.update_egui_texture_from_wgpu_texture(
-                    &render_state.device,
-                    view,
-                    wgpu::FilterMode::Linear,
-                    id,
-                );
-            }
-            _ => {
-                if let Some(id) = self.texture.take() {
-                    renderer.free_texture(&id);
-                }
-                self.texture = Some(renderer.register_native_texture(
-                    &render_state.device,
-                    view,
-                    wgpu::FilterMode::Linear,
-                ));
-                self.registered_size = self.state.renderer.size();
-            }
+        // Render at the size the central view had last frame.
+        let points = self.state.view_points();
+        let size = if points.x < 16.0 || points.y < 16.0 {
+            UVec2::new(960, 640)
+        } else {
+            UVec2::new(
+                (points.x * ui.pixels_per_point()) as u32,
+                (points.y * ui.pixels_per_point()) as u32,
+            )
         }
-        drop(renderer);
-        self.state.ui(ui, self.texture);
+        .clamp(UVec2::splat(16), UVec2::splat(4096));
+        self.state.render(size);
+        let state = &self.state;
+        let output_size = state.renderer.size();
+        let images = ViewImages {
+            a: self.a.update(
+                render_state,
+                Some((state.renderer.output_view(), output_size)),
+            ),
+            b: self.b.update(
+                render_state,
+                state
+                    .ab
+                    .as_ref()
+                    .map(|ab| (ab.renderer.output_view(), output_size)),
+            ),
+            difference: self.difference.update(
+                render_state,
+                state
+                    .ab
+                    .as_ref()
+                    .and_then(|ab| ab.difference.view())
+                    .map(|v| (v, output_size)),
+            ),
+        };
+        self.state.ui(ui, images);
         ui.ctx().request_repaint();
     }
 
@@ -68,6 +125,20 @@ impl eframe::App for ViewerApp {
         if let Err(e) = self.state.save_settings(&settings_path()) {
             zoo_host::log::warn!("cannot save viewer settings: {e}");
         }
+    }
+}
+
+/// Shaders from the working folder's `shaders/` (or the build's), for hot reload; the
+/// embedded copies when neither exists.
+fn shader_library() -> ShaderLibrary {
+    let local = Path::new("shaders");
+    if local.is_dir() {
+        let root = local.canonicalize().unwrap_or_else(|_| local.to_path_buf());
+        return ShaderLibrary::from_disk(root);
+    }
+    match ShaderLibrary::build_time_root() {
+        Some(root) => ShaderLibrary::from_disk(root),
+        None => ShaderLibrary::embedded(),
     }
 }
 
@@ -106,7 +177,8 @@ pub fn run() -> anyhow::Result<()> {
                 render_state.queue.clone(),
             ));
             let scene = crate::commands::load_scene(None)?;
-            let mut state = ViewerState::new(gpu, scene, UVec2::new(960, 640))?;
+            let mut state =
+                ViewerState::with_shaders(gpu, scene, UVec2::new(960, 640), shader_library())?;
             let settings = settings_path();
             if settings.is_file()
                 && let Err(e) = state.load_settings(&settings)
@@ -115,8 +187,9 @@ pub fn run() -> anyhow::Result<()> {
             }
             Ok(Box::new(ViewerApp {
                 state,
-                texture: None,
-                registered_size: UVec2::ZERO,
+                a: NativeTexture::default(),
+                b: NativeTexture::default(),
+                difference: NativeTexture::default(),
             }))
         }),
     );

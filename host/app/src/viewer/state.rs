@@ -1,89 +1,146 @@
-//! The viewer's state and panels, independent of the window so they can be tested headless.
+//! The viewer's state and actions, independent of the window so they can be tested headless.
 
 use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use egui_plot::{Bar, BarChart, Line, Plot, PlotPoints};
-use zoo_host::gpu::{FrameTimings, GpuContext, PassOwner};
-use zoo_host::params::{self, ParamKind, ParamValue, ParamValues};
-use zoo_host::scene::Camera;
-use zoo_host::{Renderer, Scene, View};
+use serde::{Deserialize, Serialize};
+use zoo_host::glam::UVec2;
+use zoo_host::gpu::{FrameTimings, GpuContext};
+use zoo_host::params::{self, ParamValue, ParamValues};
+use zoo_host::render::Overlay;
+use zoo_host::scene::Light;
+use zoo_host::{Renderer, Scene, ShaderLibrary, View};
+
+use super::camera::{Bookmark, CameraController};
+use super::hot_reload::ShaderWatcher;
+use super::lights;
+use super::reference::ReferenceOverlay;
+use super::split::{AbCompare, SplitMode};
 
 /// Settings remembered per technique: parameter values by technique id.
 pub type Settings = BTreeMap<String, ParamValues>;
 
-/// An orbit around the scene camera's target.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Orbit {
-    pub yaw: f32,
-    pub pitch: f32,
-    pub distance: f32,
-}
-
-impl Orbit {
-    fn from_camera(camera: &Camera) -> Orbit {
-        let offset = camera.position - camera.target;
-        let distance = offset.length().max(0.1);
-        Orbit {
-            yaw: offset.x.atan2(offset.z),
-            pitch: (offset.y / distance).clamp(-1.0, 1.0).asin(),
-            distance,
-        }
-    }
-
-    fn apply(&self, camera: &Camera) -> Camera {
-        let (sy, cy) = self.yaw.sin_cos();
-        let (sp, cp) = self.pitch.sin_cos();
-        let offset = zoo_host::glam::Vec3::new(sy * cp, sp, cy * cp) * self.distance;
-        Camera {
-            position: camera.target + offset,
-            ..*camera
-        }
-    }
+/// What the settings file holds.
+#[derive(Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SettingsFile {
+    /// The technique shown last.
+    pub technique: Option<String>,
+    /// Parameter values per technique.
+    pub techniques: Settings,
+    /// Camera bookmarks per scene name.
+    pub bookmarks: BTreeMap<String, Vec<Bookmark>>,
 }
 
 /// Everything the viewer shows and edits.
 pub struct ViewerState {
     pub renderer: Renderer,
+    /// Where shaders come from (the `shaders/` folder when present, for hot reload).
+    pub shaders: ShaderLibrary,
     /// Scene files offered by the picker.
     pub scene_files: Vec<PathBuf>,
     pub technique: String,
     pub settings: Settings,
+    /// Camera bookmarks per scene name.
+    pub bookmarks: BTreeMap<String, Vec<Bookmark>>,
     pub view: View,
+    /// Show `view` blended over the final image instead of full screen.
+    pub overlay_mode: bool,
+    pub overlay_opacity: f32,
     /// The last technique failure, shown as a banner.
     pub error: Option<String>,
+    /// The last shader reload failure (file:line:col), shown while the old pipelines run.
+    pub shader_error: Option<String>,
     pub timings: Option<FrameTimings>,
     /// Recent frame times (ms) for the rolling plot.
     pub history: VecDeque<f64>,
-    pub orbit: Orbit,
-    base_camera: Camera,
+    pub camera: CameraController,
+    /// The lights being rendered (edited in the lights panel).
+    pub lights: Vec<Light>,
+    pub selected_light: usize,
+    /// The A/B comparison, when on.
+    pub ab: Option<AbCompare>,
+    /// Technique shown on the B side.
+    pub technique_b: String,
+    pub b_timings: Option<FrameTimings>,
+    pub reference: ReferenceOverlay,
+    watcher: Option<ShaderWatcher>,
     /// A message for the status line.
     pub status: String,
+    /// Path typed into the settings save/load field.
+    pub settings_file: String,
+    /// Name typed for the next bookmark.
+    pub bookmark_name: String,
+    /// Screen positions (points) of the light handles drawn last frame.
+    pub light_handles: Vec<(usize, egui::Pos2)>,
+    /// The light whose handle is being dragged.
+    pub(super) dragging_light: Option<usize>,
+    /// The scene's diagonal, for default light ranges and speeds.
+    pub(super) extent: f32,
+    /// Size in points of the central view last frame.
+    pub(super) view_size: egui::Vec2,
     frame: u64,
 }
 
 impl ViewerState {
-    /// A viewer on `scene` at `size`.
-    pub fn new(
+    /// A viewer on `scene` at `size` with the embedded shaders.
+    pub fn new(gpu: Arc<GpuContext>, scene: Scene, size: UVec2) -> anyhow::Result<ViewerState> {
+        Self::with_shaders(gpu, scene, size, ShaderLibrary::embedded())
+    }
+
+    /// A viewer whose shaders come from `shaders`; when that reads a folder, edits there are
+    /// watched and reloaded.
+    pub fn with_shaders(
         gpu: Arc<GpuContext>,
         scene: Scene,
-        size: zoo_host::glam::UVec2,
+        size: UVec2,
+        shaders: ShaderLibrary,
     ) -> anyhow::Result<ViewerState> {
-        let base_camera = scene.camera;
-        let renderer = Renderer::new(gpu, scene, size)?;
+        let (lo, hi) = scene.bounds();
+        let extent = lo.distance(hi).max(1.0);
+        let camera = CameraController::new(&scene.camera, extent);
+        let lights = scene.lights.clone();
+        let renderer = Renderer::with_shaders(gpu, scene, size, shaders.clone())?;
+        let (watcher, status) = match shaders.disk_root() {
+            Some(root) => match ShaderWatcher::new(root) {
+                Ok(w) => (
+                    Some(w),
+                    format!("watching {} for shader edits", root.display()),
+                ),
+                Err(e) => (None, format!("no shader hot reload: {e}")),
+            },
+            None => (None, String::new()),
+        };
         Ok(ViewerState {
             technique: renderer.technique().id.to_string(),
             renderer,
+            shaders,
             scene_files: scene_files(),
             settings: Settings::new(),
+            bookmarks: BTreeMap::new(),
             view: View::Final,
+            overlay_mode: false,
+            overlay_opacity: 0.5,
             error: None,
+            shader_error: None,
             timings: None,
             history: VecDeque::new(),
-            orbit: Orbit::from_camera(&base_camera),
-            base_camera,
-            status: String::new(),
+            camera,
+            lights,
+            selected_light: 0,
+            ab: None,
+            technique_b: zoo_host::builtin::UNSHADOWED_ID.to_string(),
+            b_timings: None,
+            reference: ReferenceOverlay::new(),
+            watcher,
+            status,
+            settings_file: "shadow-zoo-settings.ron".to_string(),
+            bookmark_name: String::new(),
+            light_handles: Vec::new(),
+            dragging_light: None,
+            extent,
+            view_size: egui::Vec2::ZERO,
             frame: 0,
         })
     }
@@ -126,6 +183,7 @@ impl ViewerState {
         self.settings.insert(self.technique.clone(), values);
         let id = self.technique.clone();
         self.select_technique(&id);
+        self.refresh_b();
     }
 
     /// Back to the current technique's defaults.
@@ -133,22 +191,30 @@ impl ViewerState {
         self.settings.remove(&self.technique);
         let id = self.technique.clone();
         self.select_technique(&id);
+        self.refresh_b();
     }
 
-    /// Writes the remembered settings as RON.
+    /// Writes the remembered settings (technique parameters, current technique, bookmarks)
+    /// as RON.
     pub fn save_settings(&self, path: &Path) -> anyhow::Result<()> {
-        let text = ron::ser::to_string_pretty(&self.settings, ron::ser::PrettyConfig::default())?;
+        let file = SettingsFile {
+            technique: Some(self.technique.clone()),
+            techniques: self.settings.clone(),
+            bookmarks: self.bookmarks.clone(),
+        };
+        let text = ron::ser::to_string_pretty(&file, ron::ser::PrettyConfig::default())?;
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)?;
+            std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
         }
         std::fs::write(path, text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
     }
 
-    /// Reads settings written by [`Self::save_settings`] and applies the current technique's.
+    /// Reads settings written by [`Self::save_settings`] and switches to the saved technique
+    /// with its parameters (out-of-range values are clamped).
     pub fn load_settings(&mut self, path: &Path) -> anyhow::Result<()> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        self.settings = ron::from_str(&text).map_err(|e| {
+        let file: SettingsFile = ron::from_str(&text).map_err(|e| {
             anyhow::anyhow!(
                 "{}:{}:{}: {}",
                 path.display(),
@@ -157,42 +223,213 @@ impl ViewerState {
                 e.code
             )
         })?;
-        let id = self.technique.clone();
+        self.settings = file
+            .techniques
+            .into_iter()
+            .map(|(id, values)| {
+                let values = clamp_to_schema(&id, values);
+                (id, values)
+            })
+            .collect();
+        self.bookmarks = file.bookmarks;
+        let id = file
+            .technique
+            .filter(|id| zoo_host::find_technique(id).is_ok())
+            .unwrap_or_else(|| self.technique.clone());
         self.select_technique(&id);
+        self.refresh_b();
         Ok(())
     }
 
-    /// Opens another scene.
+    /// Opens another scene: its camera and lights replace the current ones.
     pub fn open_scene(&mut self, path: &Path) {
-        match Scene::load(path) {
-            Ok(scene) => {
-                self.base_camera = scene.camera;
-                self.orbit = Orbit::from_camera(&scene.camera);
-                let size = self.renderer.size();
-                match Renderer::new(self.renderer.gpu().clone(), scene, size) {
-                    Ok(renderer) => {
-                        self.renderer = renderer;
-                        let id = self.technique.clone();
-                        self.select_technique(&id);
-                        self.status = format!("opened {}", path.display());
-                    }
-                    Err(e) => self.error = Some(e.to_string()),
-                }
+        let scene = match Scene::load(path) {
+            Ok(scene) => scene,
+            Err(e) => {
+                self.error = Some(e.to_string());
+                return;
             }
-            Err(e) => self.error = Some(e.to_string()),
+        };
+        let size = self.renderer.size();
+        let gpu = self.renderer.gpu().clone();
+        let renderer = match Renderer::with_shaders(gpu, scene.clone(), size, self.shaders.clone())
+        {
+            Ok(renderer) => renderer,
+            Err(e) => {
+                self.error = Some(e.to_string());
+                return;
+            }
+        };
+        let (lo, hi) = scene.bounds();
+        self.extent = lo.distance(hi).max(1.0);
+        self.camera = CameraController::new(&scene.camera, self.extent);
+        self.lights = scene.lights.clone();
+        self.selected_light = 0;
+        self.renderer = renderer;
+        self.reference = ReferenceOverlay::new();
+        let id = self.technique.clone();
+        self.select_technique(&id);
+        if self.ab.is_some() {
+            self.ab = None;
+            self.set_ab(true);
+        }
+        self.status = format!("opened {}", path.display());
+    }
+
+    /// Turns the A/B comparison on or off.
+    pub fn set_ab(&mut self, on: bool) {
+        if !on {
+            self.ab = None;
+            self.b_timings = None;
+            return;
+        }
+        if self.ab.is_some() {
+            return;
+        }
+        let gpu = self.renderer.gpu().clone();
+        let scene = self.renderer.scene().clone();
+        match AbCompare::new(gpu, scene, self.renderer.size(), self.shaders.clone()) {
+            Ok(ab) => {
+                self.ab = Some(ab);
+                let id = self.technique_b.clone();
+                self.select_technique_b(&id);
+            }
+            Err(e) => self.error = Some(format!("cannot start the A/B view: {e}")),
         }
     }
 
-    /// Renders one frame at `size` and records its timings; a failing technique is replaced
-    /// by `unshadowed` and its error shown.
-    pub fn render(&mut self, size: zoo_host::glam::UVec2) {
+    /// Chooses the B side's technique (with its remembered parameters).
+    pub fn select_technique_b(&mut self, id: &str) {
+        let values = self.params_for(id);
+        let Some(ab) = &mut self.ab else {
+            self.technique_b = id.to_string();
+            return;
+        };
+        match ab.renderer.set_technique(id, &values) {
+            Ok(()) => self.technique_b = id.to_string(),
+            Err(e) => self.error = Some(format!("B: {e}")),
+        }
+    }
+
+    /// Re-applies B's remembered parameters (after A's changed, if they are the same technique).
+    fn refresh_b(&mut self) {
+        if self.ab.is_some() && self.technique_b == self.technique {
+            let id = self.technique_b.clone();
+            self.select_technique_b(&id);
+        }
+    }
+
+    /// Adds a point light above the camera's pivot and selects it.
+    pub fn add_light(&mut self) {
+        if self.lights.len() >= zoo_host::MAX_LIGHTS {
+            return;
+        }
+        let position = self.camera.pivot() + zoo_host::glam::Vec3::Y * self.extent * 0.25;
+        self.lights
+            .push(lights::new_point_light(position, self.extent));
+        self.selected_light = self.lights.len() - 1;
+    }
+
+    /// Removes light `index` (a scene keeps at least one).
+    pub fn remove_light(&mut self, index: usize) {
+        if self.lights.len() > 1 && index < self.lights.len() {
+            self.lights.remove(index);
+            self.selected_light = self.selected_light.min(self.lights.len() - 1);
+            if let View::Visibility { light } = self.view
+                && light >= self.lights.len()
+            {
+                self.view = View::Final;
+            }
+        }
+    }
+
+    /// Stores the current camera as a bookmark of this scene.
+    pub fn add_bookmark(&mut self, name: &str) {
+        let list = self
+            .bookmarks
+            .entry(self.renderer.scene().name.clone())
+            .or_default();
+        let name = if name.trim().is_empty() {
+            format!("view {}", list.len() + 1)
+        } else {
+            name.trim().to_string()
+        };
+        list.retain(|b| b.name != name);
+        list.push(Bookmark::of(&name, &self.camera));
+    }
+
+    /// Moves the camera to the bookmark called `name` of this scene.
+    pub fn go_to_bookmark(&mut self, name: &str) -> bool {
+        let scene = &self.renderer.scene().name;
+        match self
+            .bookmarks
+            .get(scene)
+            .and_then(|l| l.iter().find(|b| b.name == name))
+        {
+            Some(mark) => {
+                mark.apply(&mut self.camera);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Re-reads the shaders and rebuilds the pipelines of A (and B). On a WGSL error the
+    /// message (file:line:col) is kept in `shader_error` and the old pipelines keep running.
+    pub fn reload_shaders(&mut self) {
+        let mut result = self.renderer.reload_shaders();
+        if result.is_ok()
+            && let Some(ab) = &mut self.ab
+        {
+            result = ab.renderer.reload_shaders();
+        }
+        match result {
+            Ok(()) => {
+                self.shader_error = None;
+                self.status = "shaders reloaded".to_string();
+            }
+            Err(e) => self.shader_error = Some(e.to_string()),
+        }
+    }
+
+    /// The debug view blended over the final image, when overlay mode is on.
+    fn overlay(&self) -> Option<Overlay> {
+        (self.overlay_mode && self.view != View::Final).then(|| Overlay {
+            view: self.view.clone(),
+            opacity: self.overlay_opacity,
+        })
+    }
+
+    /// The view the main renderer draws (final when the debug view is an overlay).
+    fn main_view(&self) -> View {
+        if self.overlay_mode {
+            View::Final
+        } else {
+            self.view.clone()
+        }
+    }
+
+    /// Renders one frame at `size` (both sides in A/B mode) and records its timings; a
+    /// failing technique is replaced by `unshadowed` and its error shown.
+    pub fn render(&mut self, size: UVec2) {
+        if self.watcher.as_mut().is_some_and(ShaderWatcher::poll) {
+            self.reload_shaders();
+        }
+        if let Err(e) = self.reference.poll() {
+            self.error = Some(e.to_string());
+        }
         if let Err(e) = self.renderer.set_size(size) {
             self.error = Some(e.to_string());
             return;
         }
-        self.renderer
-            .set_camera(self.orbit.apply(&self.base_camera));
-        match self.renderer.render(&self.view) {
+        let camera = self.camera.camera();
+        self.renderer.set_camera(camera);
+        self.renderer.set_lights(self.lights.clone());
+        let view = self.main_view();
+        match self
+            .renderer
+            .render_with_overlay(&view, self.overlay().as_ref())
+        {
             Ok(timings) => {
                 self.history.push_back(timings.frame_total());
                 if self.history.len() > 240 {
@@ -206,7 +443,41 @@ impl ViewerState {
                 self.view = View::Final;
             }
         }
+        self.render_b(size, camera, &view);
         self.frame += 1;
+    }
+
+    /// Renders the B side and, in difference mode, the difference image.
+    fn render_b(&mut self, size: UVec2, camera: zoo_host::Camera, view: &View) {
+        let Some(ab) = &mut self.ab else {
+            return;
+        };
+        // B shows the same view where it has it; technique resources are A's own.
+        let view_b = match view {
+            View::Resource(_) => View::Final,
+            other => other.clone(),
+        };
+        let rendered = ab.renderer.set_size(size).and_then(|()| {
+            ab.renderer.set_camera(camera);
+            ab.renderer.set_lights(self.lights.clone());
+            ab.renderer.render(&view_b)
+        });
+        match rendered {
+            Ok(timings) => self.b_timings = Some(timings),
+            Err(e) => {
+                self.error = Some(format!("B: {e}"));
+                self.technique_b = ab.renderer.technique().id.to_string();
+            }
+        }
+        if ab.mode == SplitMode::Difference {
+            ab.difference.update(
+                self.renderer.gpu(),
+                self.renderer.output_view(),
+                ab.renderer.output_view(),
+                size,
+                ab.gain,
+            );
+        }
     }
 
     /// Saves the current image as PNG in the working folder and returns its path.
@@ -216,255 +487,21 @@ impl ViewerState {
         self.status = format!("saved {}", path.display());
         Ok(path)
     }
+}
 
-    /// The side panel: scene, technique, parameters, view and settings.
-    pub fn controls(&mut self, ui: &mut egui::Ui) {
-        if let Some(error) = &self.error {
-            ui.colored_label(
-                egui::Color32::from_rgb(230, 60, 60),
-                format!("Technique failed: {error}"),
-            );
-            if ui.button("Dismiss").clicked() {
-                self.error = None;
-            }
-            ui.separator();
-        }
-        let mut open = None;
-        egui::ComboBox::from_label("Scene")
-            .selected_text(self.renderer.scene().name.clone())
-            .show_ui(ui, |ui| {
-                for file in &self.scene_files {
-                    let name = file
-                        .file_stem()
-                        .map(|s| s.to_string_lossy().into_owned())
-                        .unwrap_or_default();
-                    if ui.selectable_label(false, name).clicked() {
-                        open = Some(file.clone());
-                    }
-                }
-            });
-        if let Some(path) = open {
-            self.open_scene(&path);
-        }
-        ui.heading("Technique");
-        let mut chosen = None;
-        for r in zoo_host::registry() {
-            let response = ui
-                .selectable_label(self.technique == r.id, r.id)
-                .on_hover_text(format!(
-                    "{}\n{}\nlights: {}",
-                    r.name,
-                    r.description,
-                    r.light_kind_names()
-                ));
-            if response.clicked() {
-                chosen = Some(r.id);
-            }
-        }
-        if let Some(id) = chosen {
-            self.select_technique(id);
-        }
-        self.parameter_panel(ui);
-        ui.heading("View");
-        let mut views = vec![("final".to_string(), View::Final)];
-        for light in 0..self.renderer.lights().len() {
-            views.push((format!("visibility:{light}"), View::Visibility { light }));
-        }
-        for (name, view) in [
-            ("normals", View::Normals),
-            ("depth", View::Depth),
-            ("albedo", View::Albedo),
-        ] {
-            views.push((name.to_string(), view));
-        }
-        for r in self
-            .renderer
-            .technique_instance()
-            .resources()
-            .into_iter()
-            .filter(|r| r.viewable)
-        {
-            views.push((r.name.clone(), View::Resource(r.name)));
-        }
-        for (name, view) in views {
-            if ui.selectable_label(self.view == view, name).clicked() {
-                self.view = view;
-            }
-        }
-        ui.separator();
-        ui.horizontal(|ui| {
-            if ui.button("Screenshot (F12)").clicked()
-                && let Err(e) = self.screenshot()
-            {
-                self.status = e.to_string();
-            }
-        });
-        if !self.status.is_empty() {
-            ui.label(&self.status);
-        }
-    }
-
-    fn parameter_panel(&mut self, ui: &mut egui::Ui) {
-        let Ok(registration) = zoo_host::find_technique(&self.technique) else {
-            return;
-        };
-        let schema = (registration.params)();
-        if schema.is_empty() {
-            return;
-        }
-        ui.heading("Parameters");
-        let values = self.params_for(&self.technique);
-        let mut changed: Option<(String, ParamValue)> = None;
-        for spec in &schema {
-            let current = values
-                .get(spec.key)
-                .cloned()
-                .unwrap_or_else(|| spec.default.clone());
-            let response = match (&spec.kind, current) {
-                (ParamKind::Bool, ParamValue::Bool(mut v)) => {
-                    let r = ui.checkbox(&mut v, spec.key);
-                    if r.changed() {
-                        changed = Some((spec.key.to_string(), ParamValue::Bool(v)));
-                    }
-                    r
-                }
-                (ParamKind::Int { min, max, step }, ParamValue::Int(mut v)) => {
-                    let r = ui.add(
-                        egui::Slider::new(&mut v, *min..=*max)
-                            .step_by(*step as f64)
-                            .text(spec.key),
-                    );
-                    if r.drag_stopped() || (r.changed() && !r.dragged()) {
-                        changed = Some((spec.key.to_string(), ParamValue::Int(v)));
-                    }
-                    r
-                }
-                (ParamKind::Float { min, max, step }, ParamValue::Float(mut v)) => {
-                    let r = ui.add(
-                        egui::Slider::new(&mut v, *min..=*max)
-                            .step_by(*step)
-                            .text(spec.key),
-                    );
-                    if r.drag_stopped() || (r.changed() && !r.dragged()) {
-                        changed = Some((spec.key.to_string(), ParamValue::Float(v)));
-                    }
-                    r
-                }
-                (ParamKind::Choice { options }, ParamValue::Choice(v)) => {
-                    let mut picked = None;
-                    let r = egui::ComboBox::from_label(spec.key)
-                        .selected_text(v.clone())
-                        .show_ui(ui, |ui| {
-                            for option in options.iter() {
-                                if ui.selectable_label(v == *option, *option).clicked() {
-                                    picked = Some(option.to_string());
-                                }
-                            }
-                        })
-                        .response;
-                    if let Some(p) = picked {
-                        changed = Some((spec.key.to_string(), ParamValue::Choice(p)));
-                    }
-                    r
-                }
-                (_, other) => ui.label(format!("{} = {other}", spec.key)),
-            };
-            response.on_hover_text(spec.doc);
-        }
-        if ui.button("Reset to defaults").clicked() {
-            self.reset_params();
-        } else if let Some((key, value)) = changed {
-            self.set_param(&key, value);
-        }
-    }
-
-    /// The bottom panel: per-pass times, a rolling frame-time plot, counters and memory.
-    pub fn timing_panel(&self, ui: &mut egui::Ui) {
-        let Some(timings) = &self.timings else {
-            return;
-        };
-        ui.horizontal(|ui| {
-            ui.label(format!(
-                "frame {:.2} ms ({}), technique {:.2} ms",
-                timings.frame_total(),
-                timings.source.label(),
-                timings.total(PassOwner::Technique)
-            ));
-        });
-        ui.columns(3, |columns| {
-            let bars: Vec<Bar> = timings
-                .passes
-                .iter()
-                .enumerate()
-                .map(|(i, p)| Bar::new(i as f64, p.milliseconds).name(&p.name))
-                .collect();
-            Plot::new("pass times")
-                .height(140.0)
-                .allow_scroll(false)
-                .show(&mut columns[0], |plot| {
-                    plot.bar_chart(BarChart::new("passes (ms)", bars))
-                });
-            let points: PlotPoints<'_> = self
-                .history
-                .iter()
-                .enumerate()
-                .map(|(i, v)| [i as f64, *v])
-                .collect();
-            Plot::new("frame history")
-                .height(140.0)
-                .allow_scroll(false)
-                .show(&mut columns[1], |plot| {
-                    plot.line(Line::new("frame (ms)", points))
-                });
-            let instance = self.renderer.technique_instance();
-            egui::ScrollArea::vertical()
-                .max_height(140.0)
-                .show(&mut columns[2], |ui| {
-                    for r in instance.resources() {
-                        ui.label(format!(
-                            "{}: {:?} {} {:.1} MiB",
-                            r.name,
-                            r.size,
-                            r.format,
-                            r.bytes as f64 / 1048576.0
-                        ));
-                    }
-                    for (name, value) in instance.counters() {
-                        ui.label(format!("{name}: {value}"));
-                    }
-                });
-        });
-    }
-
-    /// The whole window: controls at the left, timings at the bottom, the image (if any) in
-    /// the middle, orbiting with the mouse.
-    pub fn ui(&mut self, ui: &mut egui::Ui, image: Option<egui::TextureId>) {
-        egui::Panel::left("controls").show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| self.controls(ui));
-        });
-        egui::Panel::bottom("timings").show(ui, |ui| self.timing_panel(ui));
-        egui::CentralPanel::default().show(ui, |ui| {
-            let size = ui.available_size();
-            let response = match image {
-                Some(id) => ui.add(egui::Image::new((id, size)).sense(egui::Sense::drag())),
-                None => ui.allocate_response(size, egui::Sense::drag()),
-            };
-            let delta = response.drag_delta();
-            if delta != egui::Vec2::ZERO {
-                self.orbit.yaw -= delta.x * 0.01;
-                self.orbit.pitch = (self.orbit.pitch + delta.y * 0.01).clamp(-1.5, 1.5);
-            }
-            if response.hovered() {
-                let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-                self.orbit.distance = (self.orbit.distance * (1.0 - scroll * 0.002)).max(0.2);
-            }
-        });
-        if ui.input(|i| i.key_pressed(egui::Key::F12))
-            && let Err(e) = self.screenshot()
-        {
-            self.status = e.to_string();
-        }
-    }
+/// `values` of technique `id` with each known parameter clamped into its range.
+fn clamp_to_schema(id: &str, values: ParamValues) -> ParamValues {
+    let Ok(registration) = zoo_host::find_technique(id) else {
+        return values;
+    };
+    let schema = (registration.params)();
+    values
+        .into_iter()
+        .filter_map(|(key, value)| {
+            let spec = params::find_spec(&schema, &key).ok()?;
+            Some((key, spec.clamp(&value)))
+        })
+        .collect()
 }
 
 /// Scene files in `scenes/` (the working folder's, else the build's).

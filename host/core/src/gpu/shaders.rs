@@ -87,6 +87,23 @@ impl ShaderLibrary {
         embedded::EMBEDDED.iter().map(|(n, _)| *n)
     }
 
+    /// The folder files are read from first, if any.
+    pub fn disk_root(&self) -> Option<&std::path::Path> {
+        self.disk_root.as_deref()
+    }
+
+    /// Names of every file this library can load: the embedded ones and any `.wgsl` file under
+    /// the disk folder (sorted, without duplicates).
+    pub fn file_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = Self::names().map(str::to_string).collect();
+        if let Some(root) = &self.disk_root {
+            collect_wgsl(root, root, &mut names);
+        }
+        names.sort();
+        names.dedup();
+        names
+    }
+
     /// The text of one file.
     pub fn source(&self, name: &str) -> Result<String, ShaderError> {
         if let Some(root) = &self.disk_root
@@ -198,6 +215,22 @@ impl ShaderLibrary {
                 label: name.to_string(),
                 message: e.to_string(),
             }),
+        }
+    }
+}
+
+/// Appends the `/`-separated paths of `.wgsl` files under `dir`, relative to `root`.
+fn collect_wgsl(dir: &std::path::Path, root: &std::path::Path, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for path in entries.filter_map(Result::ok).map(|e| e.path()) {
+        if path.is_dir() {
+            collect_wgsl(&path, root, out);
+        } else if path.extension().is_some_and(|e| e == "wgsl")
+            && let Ok(relative) = path.strip_prefix(root)
+        {
+            out.push(relative.to_string_lossy().replace('\\', "/"));
         }
     }
 }

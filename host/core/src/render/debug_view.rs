@@ -15,7 +15,8 @@ struct ViewParams {
     max_value: f32,
     near: f32,
     far: f32,
-    _pad: [f32; 2],
+    opacity: f32,
+    _pad: f32,
 }
 
 /// The sampled type of the texture being shown.
@@ -67,7 +68,12 @@ impl DebugViewPass {
                     module: &module,
                     entry_point: Some(entry),
                     compilation_options: Default::default(),
-                    targets: &[Some(DEBUG_TARGET_FORMAT.into())],
+                    // Alpha carries the opacity: 1 for a full-screen view, less for an overlay.
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: DEBUG_TARGET_FORMAT,
+                        blend: Some(wgpu::BlendState::ALPHA_BLENDING),
+                        write_mask: wgpu::ColorWrites::COLOR,
+                    })],
                 }),
                 multiview_mask: None,
                 cache: None,
@@ -86,13 +92,15 @@ impl DebugViewPass {
         })
     }
 
-    /// Records a pass that draws `source` into `target` (a non-sRGB view).
+    /// Records a pass that draws `source` into `target` (a non-sRGB view): full-screen when
+    /// `overlay_opacity` is `None`, otherwise blended over what `target` holds.
     pub fn record(
         &self,
         gpu: &GpuContext,
         recorder: &mut PassRecorder<'_>,
         target: &wgpu::TextureView,
         source: &DebugSource<'_>,
+        overlay_opacity: Option<f32>,
     ) {
         let (kind, params) = match source.mapping {
             ViewMapping::Color { min, max } => (SourceKind::Float, (0, 0, min, max)),
@@ -113,7 +121,8 @@ impl DebugViewPass {
             max_value: params.3,
             near,
             far,
-            _pad: [0.0; 2],
+            opacity: overlay_opacity.unwrap_or(1.0).clamp(0.0, 1.0),
+            _pad: 0.0,
         };
         gpu.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&values));
@@ -136,12 +145,13 @@ impl DebugViewPass {
                 },
             ],
         });
+        let (label, load) = match overlay_opacity {
+            None => ("Debug view", wgpu::LoadOp::Clear(wgpu::Color::BLACK)),
+            Some(_) => ("Debug overlay", wgpu::LoadOp::Load),
+        };
         let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("Debug view"),
-            color_attachments: &[crate::gpu::color_attachment(
-                target,
-                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-            )],
+            label: Some(label),
+            color_attachments: &[crate::gpu::color_attachment(target, load)],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,

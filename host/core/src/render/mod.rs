@@ -1,6 +1,7 @@
 //! The deferred renderer shared by every technique.
 
 pub mod debug_view;
+pub mod difference;
 pub mod frame;
 pub mod gbuffer;
 pub mod lighting;
@@ -8,8 +9,9 @@ mod renderer;
 pub mod scene_buffers;
 pub mod visibility;
 
+pub use difference::ImageDifference;
 pub use frame::{CameraMatrices, FrameBindings};
 pub use gbuffer::GBuffer;
-pub use renderer::{GBufferData, MAX_OUTPUT_SIDE, RenderError, Renderer, View};
+pub use renderer::{GBufferData, MAX_OUTPUT_SIDE, Overlay, RenderError, Renderer, View};
 pub use scene_buffers::{SceneBuffers, Vertex};
 pub use visibility::{IndirectTarget, SlotAssignment, VisibilityTargets, channel_writes};

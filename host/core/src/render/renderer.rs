@@ -63,6 +63,14 @@ impl FromStr for View {
     }
 }
 
+/// A debug view blended over the final image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Overlay {
+    pub view: View,
+    /// 0 (invisible) to 1 (opaque).
+    pub opacity: f32,
+}
+
 /// Errors creating the renderer.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
@@ -214,7 +222,7 @@ fn instantiate(
 
 /// Borrows the renderer's fields (not the technique) as a [`RenderContext`].
 macro_rules! render_context {
-    ($renderer:ident, $view:expr) => {
+    ($renderer:ident, $resource:expr) => {
         RenderContext {
             gpu: &$renderer.gpu,
             shaders: &$renderer.shaders,
@@ -227,10 +235,7 @@ macro_rules! render_context {
             camera: &$renderer.camera,
             lights: &$renderer.lights,
             size: $renderer.size,
-            debug_view: match $view {
-                View::Resource(name) => Some(name.as_str()),
-                _ => None,
-            },
+            debug_view: $resource,
         }
     };
 }
@@ -418,6 +423,27 @@ impl Renderer {
     /// fails (error, panic or GPU validation error) it is replaced by `unshadowed` and the error
     /// is returned; the next frame renders normally.
     pub fn render(&mut self, view: &View) -> Result<FrameTimings, RenderError> {
+        self.render_with_overlay(view, None)
+    }
+
+    /// As [`Renderer::render`], blending `overlay` (a debug view) over the final image.
+    pub fn render_with_overlay(
+        &mut self,
+        view: &View,
+        overlay: Option<&Overlay>,
+    ) -> Result<FrameTimings, RenderError> {
+        let overlay = overlay.filter(|o| *view == View::Final && o.view != View::Final);
+        let resource = match (view, overlay) {
+            (View::Resource(name), _) => Some(name.as_str()),
+            (
+                _,
+                Some(Overlay {
+                    view: View::Resource(name),
+                    ..
+                }),
+            ) => Some(name.as_str()),
+            _ => None,
+        };
         self.frame.update(
             &self.gpu,
             &self.camera,
@@ -429,7 +455,7 @@ impl Renderer {
         let id = self.technique.registration.id;
         if self.technique.pending != Changes::default() {
             let changes = self.technique.pending;
-            let ctx = render_context!(self, view);
+            let ctx = render_context!(self, resource);
             let active = &mut self.technique;
             let prepared = guarded(&self.gpu, id, || active.instance.prepare(&ctx, changes));
             if let Err(e) = prepared {
@@ -438,7 +464,7 @@ impl Renderer {
             self.technique.pending = Changes::default();
         }
 
-        let ctx = render_context!(self, view);
+        let ctx = render_context!(self, resource);
         let mut recorder = PassRecorder::new(&self.gpu, self.timestamps.as_ref())
             .with_statistics(self.statistics.as_ref());
         self.gbuffer_pass.record(
@@ -470,9 +496,24 @@ impl Renderer {
             ),
             other => {
                 let source = self.debug_source(other)?;
-                self.debug
-                    .record(&self.gpu, &mut recorder, &self.output_debug_view, &source);
+                self.debug.record(
+                    &self.gpu,
+                    &mut recorder,
+                    &self.output_debug_view,
+                    &source,
+                    None,
+                );
             }
+        }
+        if let Some(overlay) = overlay {
+            let source = self.debug_source(&overlay.view)?;
+            self.debug.record(
+                &self.gpu,
+                &mut recorder,
+                &self.output_debug_view,
+                &source,
+                Some(overlay.opacity),
+            );
         }
         let timings = recorder.finish();
         let errors = self.gpu.take_uncaptured_errors();
@@ -483,6 +524,35 @@ impl Renderer {
             }));
         }
         Ok(timings)
+    }
+
+    /// Re-reads the shader library (after files under `shaders/` changed) and rebuilds the host
+    /// pipelines and the technique's. Every shader is validated first and the technique is
+    /// prepared before anything is swapped, so on error (returned with file, line and column)
+    /// the previous pipelines keep running.
+    pub fn reload_shaders(&mut self) -> Result<(), RenderError> {
+        for name in self.shaders.file_names() {
+            // Shared modules are checked through the shaders that import them.
+            if !name.starts_with("common/") {
+                self.shaders.validate(&name)?;
+            }
+        }
+        let gbuffer_pass = GBufferPass::new(&self.gpu, &self.shaders, &self.frame)?;
+        let lighting = LightingPass::new(&self.gpu, &self.shaders, &self.frame, &self.gbuffer)?;
+        let debug = DebugViewPass::new(&self.gpu, &self.shaders)?;
+        let registration = self.technique.registration;
+        let mut next = instantiate(&self.gpu, registration, &self.technique.params)?;
+        let ctx = render_context!(self, None);
+        guarded(&self.gpu, registration.id, || {
+            next.instance.prepare(&ctx, Changes::ALL)
+        })?;
+        next.pending = Changes::default();
+        self.lighting_inputs = lighting.inputs(&self.gpu, &self.visibility, &self.indirect);
+        self.gbuffer_pass = gbuffer_pass;
+        self.lighting = lighting;
+        self.debug = debug;
+        self.technique = next;
+        Ok(())
     }
 
     /// Swaps in `unshadowed` after a failure and passes the error on.

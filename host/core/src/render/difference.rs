@@ -1,0 +1,146 @@
+//! The A/B difference image: two rendered images of the same view compared per pixel.
+
+use bytemuck::{Pod, Zeroable};
+use glam::UVec2;
+
+use super::lighting::OUTPUT_FORMAT;
+use crate::gpu::{GpuContext, ShaderError, ShaderLibrary, readback, render_target};
+
+/// `DifferenceParams` in `host/difference.wgsl`.
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+struct DifferenceParams {
+    gain: f32,
+    context: f32,
+    _pad: [f32; 2],
+}
+
+/// Renders |B - A| in luminance: red where A is darker (A shadows more), blue where B is
+/// darker, amplified by a gain, over a dim copy of A.
+pub struct ImageDifference {
+    pipeline: wgpu::RenderPipeline,
+    params: wgpu::Buffer,
+    output: Option<(UVec2, wgpu::Texture, wgpu::TextureView)>,
+}
+
+impl ImageDifference {
+    /// Builds the pipeline from `host/difference.wgsl`.
+    pub fn new(gpu: &GpuContext, shaders: &ShaderLibrary) -> Result<ImageDifference, ShaderError> {
+        let device = &gpu.device;
+        let module = shaders.create_module(device, "host/difference.wgsl")?;
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("A/B difference pipeline"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("fullscreen_vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_difference"),
+                compilation_options: Default::default(),
+                targets: &[Some(OUTPUT_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("A/B difference params"),
+            size: size_of::<DifferenceParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(ImageDifference {
+            pipeline,
+            params,
+            output: None,
+        })
+    }
+
+    /// Compares `a` and `b` (views of two output images of `size`) with `gain` and submits
+    /// the work. The result is [`Self::view`].
+    pub fn update(
+        &mut self,
+        gpu: &GpuContext,
+        a: &wgpu::TextureView,
+        b: &wgpu::TextureView,
+        size: UVec2,
+        gain: f32,
+    ) {
+        if self.output.as_ref().is_none_or(|(s, _, _)| *s != size) {
+            let (texture, view) = render_target(
+                &gpu.device,
+                "A/B difference image",
+                size,
+                OUTPUT_FORMAT,
+                wgpu::TextureUsages::COPY_SRC,
+            );
+            self.output = Some((size, texture, view));
+        }
+        let (_, _, target) = self.output.as_ref().expect("created above");
+        let values = DifferenceParams {
+            gain,
+            context: 0.25,
+            _pad: [0.0; 2],
+        };
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&values));
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("A/B difference bind group"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(a),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(b),
+                },
+            ],
+        });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("A/B difference encoder"),
+            });
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("A/B difference"),
+                color_attachments: &[crate::gpu::color_attachment(
+                    target,
+                    wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                )],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// The last difference image, if any.
+    pub fn view(&self) -> Option<&wgpu::TextureView> {
+        self.output.as_ref().map(|(_, _, view)| view)
+    }
+
+    /// Reads the last difference image back (sRGB RGBA8).
+    pub fn read(&self, gpu: &GpuContext) -> Option<image::RgbaImage> {
+        let (size, texture, _) = self.output.as_ref()?;
+        let bytes = readback::read_texture(gpu, texture, 0, wgpu::TextureAspect::All, 4);
+        image::RgbaImage::from_raw(size.x, size.y, bytes)
+    }
+}
