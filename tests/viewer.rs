@@ -407,7 +407,7 @@ fn reference_overlay_judges_in_the_background() {
             .reference
             .is_stale(&harness.state().renderer)
     );
-    harness.get_by_label("stale: the view changed since it was judged");
+    harness.get_by_label("stale: the view changed since it was judged (map hidden)");
 }
 
 #[test]
@@ -601,5 +601,45 @@ fn editing_a_shader_reloads_it_and_errors_keep_the_old_pipeline() {
     settle(&mut harness, &|s| s.shader_error.is_none());
     let black = harness.state().renderer.read_output();
     assert!(black.pixels().all(|p| p[0] == 0 && p[1] == 0 && p[2] == 0));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn any_scene_file_opens_and_bad_ones_say_why() {
+    let mut harness = harness();
+    harness.run();
+    let dir = std::env::temp_dir().join(format!("zoo-viewer-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("broken.ron");
+    std::fs::write(&bad, "(\n  camera: (position: (0, 1, 2)\n").unwrap();
+    harness.state_mut().scene_file = bad.display().to_string();
+    harness.get_by_label("Open").click();
+    harness.run();
+    let state = harness.state();
+    let error = state.scene_error.clone().unwrap();
+    assert!(error.starts_with(&format!("{}:", bad.display())), "{error}");
+    assert_eq!(
+        state.renderer.scene().name,
+        "planar-room",
+        "the old scene stays"
+    );
+    harness.get_by_label(&format!("Scene error: {error}"));
+    // A scene outside scenes/ opens, with its own camera and lights.
+    let other = scene_path("curved.ron");
+    let copy = dir.join("elsewhere.ron");
+    let text = std::fs::read_to_string(&other).unwrap();
+    std::fs::write(&copy, &text).unwrap();
+    harness.state_mut().scene_file = copy.display().to_string();
+    harness.get_by_label("Open").click();
+    harness.run();
+    let state = harness.state();
+    assert!(state.scene_error.is_none());
+    let curved = Scene::load(&other).unwrap();
+    assert_eq!(state.lights, curved.lights);
+    assert_eq!(state.renderer.lights(), curved.lights.as_slice());
+    assert_eq!(
+        state.renderer.scene().triangle_count(),
+        curved.triangle_count()
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -89,8 +89,23 @@ impl ViewerState {
                     }
                 }
             });
+        ui.horizontal(|ui| {
+            let label = ui.label("scene file");
+            ui.add(
+                egui::TextEdit::singleline(&mut self.scene_file)
+                    .hint_text("any .ron scene")
+                    .desired_width(150.0),
+            )
+            .labelled_by(label.id);
+            if ui.button("Open").clicked() {
+                open = Some(std::path::PathBuf::from(self.scene_file.trim()));
+            }
+        });
         if let Some(path) = open {
             self.open_scene(&path);
+        }
+        if let Some(error) = &self.scene_error {
+            ui.colored_label(ERROR_RED, format!("Scene error: {error}"));
         }
     }
 

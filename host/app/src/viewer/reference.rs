@@ -236,7 +236,7 @@ impl ReferenceOverlay {
         if stale {
             ui.colored_label(
                 egui::Color32::from_rgb(230, 160, 40),
-                "stale: the view changed since it was judged",
+                "stale: the view changed since it was judged (map hidden)",
             );
         }
         ui.label(format!(

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use zoo_host::glam::UVec2;
 use zoo_host::gpu::{FrameTimings, GpuContext};
 use zoo_host::params::{self, ParamValue, ParamValues};
-use zoo_host::render::Overlay;
+use zoo_host::render::{ImageDifference, Overlay};
 use zoo_host::scene::Light;
 use zoo_host::{Renderer, Scene, ShaderLibrary, View};
 
@@ -50,6 +50,10 @@ pub struct ViewerState {
     pub overlay_opacity: f32,
     /// The last technique failure, shown as a banner.
     pub error: Option<String>,
+    /// The last scene that failed to open, with the reason (file:line:col where known).
+    pub scene_error: Option<String>,
+    /// Path typed into the "open scene" field.
+    pub scene_file: String,
     /// The last shader reload failure (file:line:col), shown while the old pipelines run.
     pub shader_error: Option<String>,
     pub timings: Option<FrameTimings>,
@@ -124,6 +128,8 @@ impl ViewerState {
             overlay_opacity: 0.5,
             error: None,
             shader_error: None,
+            scene_error: None,
+            scene_file: String::new(),
             timings: None,
             history: VecDeque::new(),
             camera,
@@ -241,12 +247,13 @@ impl ViewerState {
         Ok(())
     }
 
-    /// Opens another scene: its camera and lights replace the current ones.
+    /// Opens another scene: its camera and lights replace the current ones. On error the
+    /// current scene stays and `scene_error` says why.
     pub fn open_scene(&mut self, path: &Path) {
         let scene = match Scene::load(path) {
             Ok(scene) => scene,
             Err(e) => {
-                self.error = Some(e.to_string());
+                self.scene_error = Some(e.to_string());
                 return;
             }
         };
@@ -256,10 +263,11 @@ impl ViewerState {
         {
             Ok(renderer) => renderer,
             Err(e) => {
-                self.error = Some(e.to_string());
+                self.scene_error = Some(format!("{}: {e}", path.display()));
                 return;
             }
         };
+        self.scene_error = None;
         let (lo, hi) = scene.bounds();
         self.extent = lo.distance(hi).max(1.0);
         self.camera = CameraController::new(&scene.camera, self.extent);
@@ -377,11 +385,18 @@ impl ViewerState {
     /// Re-reads the shaders and rebuilds the pipelines of A (and B). On a WGSL error the
     /// message (file:line:col) is kept in `shader_error` and the old pipelines keep running.
     pub fn reload_shaders(&mut self) {
-        let mut result = self.renderer.reload_shaders();
+        let mut result = self.renderer.reload_shaders().map_err(anyhow::Error::from);
         if result.is_ok()
             && let Some(ab) = &mut self.ab
         {
-            result = ab.renderer.reload_shaders();
+            result = ab
+                .renderer
+                .reload_shaders()
+                .map_err(Into::into)
+                .and_then(|()| {
+                    ab.difference = ImageDifference::new(ab.renderer.gpu(), &self.shaders)?;
+                    Ok(())
+                });
         }
         match result {
             Ok(()) => {

@@ -62,7 +62,9 @@ impl ViewerState {
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 0.0, egui::Color32::BLACK);
         self.paint_images(ui, &painter, rect, images);
-        if let Some(texture) = self.reference.overlay_texture(ui.ctx()) {
+        // A stale error map would hide the live image; the metrics stay in the panel.
+        let fresh = !self.reference.is_stale(&self.renderer);
+        if let Some(texture) = self.reference.overlay_texture(ui.ctx()).filter(|_| fresh) {
             let tint = egui::Color32::from_white_alpha((self.reference.opacity * 255.0) as u8);
             painter.image(texture, rect, FULL_UV, tint);
         }

@@ -12,4 +12,7 @@ pub use recorder::{
     RecordedRenderPass, StatisticsQueries, TimestampQueries, TimingSource,
 };
 pub use shaders::{ComposedShader, ShaderError, ShaderLibrary};
-pub use targets::{clear_first, color_attachment, render_target, stencil_attachment};
+pub use targets::{
+    clear_first, color_attachment, color_pass, fullscreen_pipeline, render_target,
+    stencil_attachment,
+};

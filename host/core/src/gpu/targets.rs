@@ -74,3 +74,52 @@ pub fn clear_first(first: bool, color: wgpu::Color) -> wgpu::LoadOp<wgpu::Color>
         wgpu::LoadOp::Load
     }
 }
+
+/// A pipeline that draws the full-screen triangle of `common/fullscreen.wgsl`
+/// (`fullscreen_vs`, three vertices, no buffers) with fragment entry `entry` of `module` into
+/// one colour `target`. `layout: None` derives the bind group layouts from the shader.
+pub fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: Option<&wgpu::PipelineLayout>,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    target: wgpu::ColorTargetState,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("fullscreen_vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: &[Some(target)],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// A render pass writing only the colour `attachments` (no depth, queries or timestamps).
+pub fn color_pass<'a>(
+    label: &'a str,
+    attachments: &'a [Option<wgpu::RenderPassColorAttachment<'a>>],
+) -> wgpu::RenderPassDescriptor<'a> {
+    wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: attachments,
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    }
+}

@@ -51,33 +51,21 @@ impl DebugViewPass {
     pub fn new(gpu: &GpuContext, shaders: &ShaderLibrary) -> Result<DebugViewPass, ShaderError> {
         let device = &gpu.device;
         let module = shaders.create_module(device, "host/debug_view.wgsl")?;
+        // Alpha carries the opacity: 1 for a full-screen view, less for an overlay.
+        let target = wgpu::ColorTargetState {
+            format: DEBUG_TARGET_FORMAT,
+            blend: Some(wgpu::BlendState::ALPHA_BLENDING),
+            write_mask: wgpu::ColorWrites::COLOR,
+        };
         let pipeline = |entry: &str| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(&format!("debug view pipeline ({entry})")),
-                layout: None,
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("fullscreen_vs"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    // Alpha carries the opacity: 1 for a full-screen view, less for an overlay.
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: DEBUG_TARGET_FORMAT,
-                        blend: Some(wgpu::BlendState::ALPHA_BLENDING),
-                        write_mask: wgpu::ColorWrites::COLOR,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            crate::gpu::fullscreen_pipeline(
+                device,
+                &format!("debug view pipeline ({entry})"),
+                None,
+                &module,
+                entry,
+                target.clone(),
+            )
         };
         Ok(DebugViewPass {
             float: pipeline("fs_float"),
@@ -149,14 +137,8 @@ impl DebugViewPass {
             None => ("Debug view", wgpu::LoadOp::Clear(wgpu::Color::BLACK)),
             Some(_) => ("Debug overlay", wgpu::LoadOp::Load),
         };
-        let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(label),
-            color_attachments: &[crate::gpu::color_attachment(target, load)],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let attachments = [crate::gpu::color_attachment(target, load)];
+        let mut pass = recorder.render_pass(&crate::gpu::color_pass(label, &attachments));
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);

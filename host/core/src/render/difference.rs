@@ -28,27 +28,14 @@ impl ImageDifference {
     pub fn new(gpu: &GpuContext, shaders: &ShaderLibrary) -> Result<ImageDifference, ShaderError> {
         let device = &gpu.device;
         let module = shaders.create_module(device, "host/difference.wgsl")?;
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("A/B difference pipeline"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("fullscreen_vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_difference"),
-                compilation_options: Default::default(),
-                targets: &[Some(OUTPUT_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::gpu::fullscreen_pipeline(
+            device,
+            "A/B difference pipeline",
+            None,
+            &module,
+            "fs_difference",
+            OUTPUT_FORMAT.into(),
+        );
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("A/B difference params"),
             size: size_of::<DifferenceParams>() as u64,
@@ -114,17 +101,12 @@ impl ImageDifference {
                 label: Some("A/B difference encoder"),
             });
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("A/B difference"),
-                color_attachments: &[crate::gpu::color_attachment(
-                    target,
-                    wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                )],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let attachments = [crate::gpu::color_attachment(
+                target,
+                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+            )];
+            let mut pass =
+                encoder.begin_render_pass(&crate::gpu::color_pass("A/B difference", &attachments));
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.draw(0..3, 0..1);

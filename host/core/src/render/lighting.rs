@@ -50,31 +50,14 @@ impl LightingPass {
             ],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("lighting pipeline"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("fullscreen_vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: OUTPUT_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::gpu::fullscreen_pipeline(
+            device,
+            "lighting pipeline",
+            Some(&layout),
+            &module,
+            "fs_main",
+            OUTPUT_FORMAT.into(),
+        );
         Ok(LightingPass {
             pipeline,
             inputs_layout,
@@ -113,17 +96,11 @@ impl LightingPass {
         gbuffer: &GBuffer,
         inputs: &wgpu::BindGroup,
     ) {
-        let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("Lighting"),
-            color_attachments: &[crate::gpu::color_attachment(
-                output,
-                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-            )],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let attachments = [crate::gpu::color_attachment(
+            output,
+            wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+        )];
+        let mut pass = recorder.render_pass(&crate::gpu::color_pass("Lighting", &attachments));
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &frame.bind_group, &[]);
         pass.set_bind_group(1, &gbuffer.bind_group, &[]);
