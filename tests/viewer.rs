@@ -54,9 +54,14 @@ zoo_host::register_technique! {
 
 const SIZE: UVec2 = UVec2::new(96, 64);
 
+/// The viewer on planar-room with the embedded shaders.
 fn harness() -> Harness<'static, ViewerState> {
     let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
-    let state = ViewerState::new(gpu(), scene, SIZE).unwrap();
+    harness_for(ViewerState::new(gpu(), scene, SIZE).unwrap())
+}
+
+/// Drives `state` headless: each frame renders at `SIZE`, then draws the whole window.
+fn harness_for(state: ViewerState) -> Harness<'static, ViewerState> {
     Harness::builder()
         .with_size(egui::vec2(1600.0, 2000.0))
         .build_ui_state(
@@ -170,15 +175,7 @@ fn switching_two_hundred_times_frees_the_old_resources() {
     // A device of its own, so other tests' resources do not move the counts.
     let own = std::sync::Arc::new(GpuContext::new_headless().unwrap());
     let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
-    let mut harness = Harness::builder()
-        .with_size(egui::vec2(1600.0, 2000.0))
-        .build_ui_state(
-            |ui, state: &mut ViewerState| {
-                state.render(SIZE);
-                state.ui(ui, ViewImages::default());
-            },
-            ViewerState::new(own, scene, SIZE).unwrap(),
-        );
+    let mut harness = harness_for(ViewerState::new(own, scene, SIZE).unwrap());
     harness.run();
     let ids = ["sm-pcf", "sv-zfail", "planar", "unshadowed"];
     let cycle = |harness: &mut Harness<'_, ViewerState>, switches: usize| {
@@ -375,7 +372,12 @@ fn reference_overlay_judges_in_the_background() {
     harness.run();
     harness.get_by_label("Judge view").click();
     harness.step();
-    // The frame after the click returned while tracing runs on its own thread.
+    // The click started a judgement (traced on its own thread) without an error.
+    assert!(
+        harness.state().error.is_none(),
+        "{:?}",
+        harness.state().error
+    );
     assert!(harness.state().reference.is_running() || harness.state().reference.result.is_some());
     harness.state_mut().reference.wait().unwrap();
     harness.run();
@@ -548,16 +550,7 @@ fn editing_a_shader_reloads_it_and_errors_keep_the_old_pipeline() {
     let dir = shader_folder("hot-reload");
     let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
     let library = zoo_host::ShaderLibrary::from_disk(dir.clone());
-    let state = ViewerState::with_shaders(gpu(), scene, SIZE, library).unwrap();
-    let mut harness = Harness::builder()
-        .with_size(egui::vec2(1600.0, 2000.0))
-        .build_ui_state(
-            |ui, state: &mut ViewerState| {
-                state.render(SIZE);
-                state.ui(ui, ViewImages::default());
-            },
-            state,
-        );
+    let mut harness = harness_for(ViewerState::with_shaders(gpu(), scene, SIZE, library).unwrap());
     harness.run();
     let lit = harness.state().renderer.read_output();
     assert!(lit.pixels().any(|p| p[0] > 20));
