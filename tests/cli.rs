@@ -78,8 +78,28 @@ fn bad_input_exits_non_zero_with_a_message_and_no_panic() {
             "missing.ron: cannot read scene",
         ),
         (
-            &["render", "--set", "bias=1", "--out", "x.png"],
+            &[
+                "render",
+                "--technique",
+                "unshadowed",
+                "--set",
+                "bias=1",
+                "--out",
+                "x.png",
+            ],
             "unknown parameter `bias`",
+        ),
+        (
+            &["render", "--set", "bias=1", "--out", "x.png"],
+            "--set bias: expected ID.KEY=VALUE",
+        ),
+        (
+            &["render", "--set", "sm-pcf.nope=1", "--out", "x.png"],
+            "unknown parameter `nope`",
+        ),
+        (
+            &["render", "--view", "normals", "--out", "x.png"],
+            "views other than `final` need --technique",
         ),
         (
             &["render", "--size", "12", "--out", "x.png"],
@@ -90,7 +110,15 @@ fn bad_input_exits_non_zero_with_a_message_and_no_panic() {
             "folder no/such/dir does not exist",
         ),
         (
-            &["render", "--view", "visibility:7", "--out", "x.png"],
+            &[
+                "render",
+                "--technique",
+                "unshadowed",
+                "--view",
+                "visibility:7",
+                "--out",
+                "x.png",
+            ],
             "the scene has 3 lights",
         ),
     ];
@@ -228,4 +256,67 @@ fn compare_rejects_bad_input_clearly() {
     let all = text(&out);
     assert!(!out.status.success());
     assert!(all.contains("cannot create output folder"), "{all}");
+}
+
+#[test]
+fn render_without_a_technique_writes_the_contact_sheet_and_its_table() {
+    let dir = std::env::temp_dir().join(format!("zoo-cli-sheet-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("sheet.png");
+    let out = shadow_zoo(&["render", "--size", "96x64", "--out", png.to_str().unwrap()]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    assert!(
+        all.contains("false shadow core") && all.contains("mae"),
+        "{all}"
+    );
+    let table_rows: Vec<&str> = all
+        .lines()
+        .filter(|l| {
+            l.starts_with("reference (") || zoo_host::registry().iter().any(|r| l.starts_with(r.id))
+        })
+        .collect();
+    assert_eq!(table_rows.len(), zoo_host::registry().len() + 2, "{all}");
+    let layout = shadow_zoo::contact_sheet::Layout::new((96, 64), zoo_host::registry().len() + 2);
+    let image = image::open(&png).unwrap();
+    assert_eq!((image.width(), image.height()), layout.size());
+}
+
+/// A backend the host cannot run on (wgpu's GL backend lacks what the host needs) gives one
+/// clear message listing the adapters and the fix, and no validation errors.
+#[test]
+fn an_unusable_backend_gives_one_clear_message() {
+    let out = Command::new(env!("CARGO_BIN_EXE_shadow-zoo"))
+        .args([
+            "render",
+            "--technique",
+            "unshadowed",
+            "--size",
+            "32x32",
+            "--out",
+        ])
+        .arg(std::env::temp_dir().join("zoo-gl-frame.png"))
+        .env("WGPU_BACKEND", "gl")
+        .current_dir(zoo_host::test_support::workspace_root())
+        .output()
+        .unwrap();
+    let all = text(&out);
+    eprintln!("{all}");
+    if out.status.success() {
+        // A GL driver that offers everything the host needs renders normally.
+        assert!(all.contains("wrote "), "{all}");
+        return;
+    }
+    assert!(all.contains("error: no "), "{all}");
+    assert!(
+        all.contains("Shadow Zoo needs a Vulkan, Metal or DX12 adapter"),
+        "{all}"
+    );
+    #[cfg(target_os = "linux")]
+    assert!(
+        all.contains("sudo apt-get install -y mesa-vulkan-drivers"),
+        "{all}"
+    );
+    assert!(!all.to_lowercase().contains("validation"), "{all}");
+    assert!(all.lines().count() < 12, "{all}");
 }

@@ -18,7 +18,9 @@ pub struct Cli {
 pub enum Command {
     /// List the registered techniques: id, description and supported light kinds.
     List,
-    /// Render one frame off-screen and write it as PNG.
+    /// Render off-screen and write a PNG: without `--technique`, a contact sheet of every
+    /// available technique beside the ray-traced reference, each tile labelled with its frame
+    /// time and judged error (also printed as a table); with `--technique`, that one frame.
     Render(RenderArgs),
     /// Render techniques, judge them against ray-traced visibility, and write results.csv,
     /// report.md and per-light error maps.
@@ -97,21 +99,27 @@ pub struct RenderArgs {
     /// Scene file (RON). Defaults to the built-in planar-room scene.
     #[arg(long)]
     pub scene: Option<PathBuf>,
-    /// Technique id (see `shadow-zoo list`).
-    #[arg(long, default_value = "unshadowed")]
-    pub technique: String,
-    /// Output size as WIDTHxHEIGHT.
+    /// Technique id (see `shadow-zoo list`). Without it, a contact sheet of all techniques.
+    #[arg(long)]
+    pub technique: Option<String>,
+    /// Output size as WIDTHxHEIGHT (of each tile on a contact sheet).
     #[arg(long, default_value = "512x512", value_parser = parse_size)]
     pub size: UVec2,
     /// PNG file to write.
     #[arg(long)]
     pub out: PathBuf,
-    /// Set a technique parameter, e.g. `--set map_size=4096` (repeatable).
+    /// Set a technique parameter: `KEY=VALUE` with `--technique`, `ID.KEY=VALUE` on a contact
+    /// sheet (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_assignment)]
     pub set: Vec<(String, String)>,
-    /// What to show: final, visibility[:LIGHT], normals, depth, albedo, or a technique resource.
+    /// What to show: final, visibility[:LIGHT], normals, depth, albedo, or a technique resource
+    /// (needs `--technique`).
     #[arg(long, default_value = "final")]
     pub view: String,
+    /// Area-light samples per pixel for the contact sheet's reference (rounded up to a square).
+    #[arg(long, default_value_t = zoo_host::judging::DEFAULT_SAMPLES,
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub samples: u32,
     /// Print per-pass GPU times.
     #[arg(long)]
     pub timings: bool,

@@ -8,6 +8,7 @@ use zoo_host::gpu::{FrameTimings, PassOwner};
 use zoo_host::{GpuContext, Renderer, Scene, View, params};
 
 use crate::cli::{Cli, Command, RenderArgs};
+use crate::contact_sheet;
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -59,7 +60,91 @@ pub fn headless_gpu() -> anyhow::Result<Arc<GpuContext>> {
 }
 
 fn render(args: &RenderArgs) -> anyhow::Result<()> {
-    let technique = zoo_host::find_technique(&args.technique)?;
+    match &args.technique {
+        Some(id) => render_one(args, id),
+        None => render_sheet(args),
+    }
+}
+
+/// Checks that `--out`'s folder exists before any work is done.
+fn check_out_folder(out: &Path) -> anyhow::Result<()> {
+    let out_dir = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."));
+    if !out_dir.is_dir() {
+        bail!(
+            "--out {}: folder {} does not exist",
+            out.display(),
+            out_dir.display()
+        );
+    }
+    Ok(())
+}
+
+fn print_scene(scene: &Scene) {
+    println!(
+        "scene: {} ({} triangles, {} lights, {} objects)",
+        scene.name,
+        scene.triangle_count(),
+        scene.lights.len(),
+        scene.objects.len()
+    );
+}
+
+/// `render` without `--technique`: the contact sheet.
+fn render_sheet(args: &RenderArgs) -> anyhow::Result<()> {
+    if args.view != "final" {
+        bail!(
+            "--view {}: views other than `final` need --technique",
+            args.view
+        );
+    }
+    let registry = zoo_host::registry();
+    let params = crate::compare::technique_params(&registry, &args.set)?;
+    let scene = load_scene(args.scene.as_deref())?;
+    check_out_folder(&args.out)?;
+    let gpu = headless_gpu()?;
+    print_scene(&scene);
+    let (available, unavailable) = contact_sheet::available_techniques(&gpu);
+    for (id, reason) in &unavailable {
+        println!("note: {id} is unavailable on this adapter: {reason}");
+    }
+    let techniques: Vec<_> = registry
+        .into_iter()
+        .zip(params)
+        .filter(|(r, _)| available.iter().any(|a| a.id == r.id))
+        .collect();
+    let mut renderer = Renderer::new(gpu, scene, args.size)?;
+    let sheet = contact_sheet::build(&mut renderer, &techniques, args.samples, |step| {
+        println!("rendering {step}...");
+    })?;
+    let image = contact_sheet::draw(&sheet)?;
+    image
+        .save(&args.out)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    print!("{}", contact_sheet::table(&sheet));
+    println!(
+        "false shadow / false lit: fractions of the pixels each light reaches, leaving out the \
+         one-pixel band at reference shadow edges; mae: against the area-light reference; \
+         weighted over the lights each technique supports"
+    );
+    println!(
+        "wrote {} ({}x{}, {} tiles of {}x{})",
+        args.out.display(),
+        image.width(),
+        image.height(),
+        sheet.rows.len(),
+        args.size.x,
+        args.size.y
+    );
+    Ok(())
+}
+
+/// `render --technique ID`: one frame.
+fn render_one(args: &RenderArgs, id: &str) -> anyhow::Result<()> {
+    let technique = zoo_host::find_technique(id)?;
     let schema = (technique.params)();
     let mut values = params::defaults(&schema);
     params::apply_assignments(&schema, &mut values, &args.set)
@@ -74,28 +159,10 @@ fn render(args: &RenderArgs) -> anyhow::Result<()> {
             scene.lights.len()
         );
     }
-    let out_dir = args
-        .out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."));
-    if !out_dir.is_dir() {
-        bail!(
-            "--out {}: folder {} does not exist",
-            args.out.display(),
-            out_dir.display()
-        );
-    }
+    check_out_folder(&args.out)?;
 
     let gpu = headless_gpu()?;
-    println!(
-        "scene: {} ({} triangles, {} lights, {} objects)",
-        scene.name,
-        scene.triangle_count(),
-        scene.lights.len(),
-        scene.objects.len()
-    );
+    print_scene(&scene);
     let unsupported: Vec<String> = scene
         .lights
         .iter()

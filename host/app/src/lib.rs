@@ -7,6 +7,8 @@ pub mod bench;
 pub mod cli;
 pub mod commands;
 pub mod compare;
+pub mod contact_sheet;
+pub mod font;
 pub mod viewer;
 
 mod linked {

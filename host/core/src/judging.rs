@@ -164,5 +164,39 @@ pub fn error_map(reference: &LightReference, visibility: &[f32], scene: &RgbaIma
     out
 }
 
+/// The deferred lighting evaluated on the CPU (the mirror of `shaders/host/lighting.wgsl`
+/// without indirect light) from a G-buffer and one visibility per light, for example the
+/// reference's. Background pixels keep the colour they have in `background`.
+pub fn shade_on_cpu(
+    renderer: &Renderer,
+    gbuffer: &GBufferData,
+    visibility: &[&[f32]],
+    background: &RgbaImage,
+) -> RgbaImage {
+    use crate::scene::shading;
+    let eye = renderer.camera().position;
+    let ambient = renderer.scene().ambient;
+    let mut out = background.clone();
+    for (i, pixel) in out.pixels_mut().enumerate() {
+        let p = gbuffer.positions[i];
+        if p.w < 0.5 {
+            continue;
+        }
+        let m = &gbuffer.materials[i];
+        let position = p.truncate();
+        let view_dir = (eye - position).normalize_or_zero();
+        let mut c = ambient * m.albedo;
+        for (light, v) in renderer.lights().iter().zip(visibility) {
+            if v[i] > 0.0 {
+                c += v[i] * shading::direct_light(light, position, gbuffer.normals[i], view_dir, m);
+            }
+        }
+        let srgb = shading::tonemap(c).map(shading::linear_to_srgb) * 255.0;
+        let [r, g, b] = srgb.to_array().map(|x| x.round().clamp(0.0, 255.0) as u8);
+        *pixel = Rgba([r, g, b, 255]);
+    }
+    out
+}
+
 /// Area samples per pixel used when none are given.
 pub const DEFAULT_SAMPLES: u32 = DEFAULT_AREA_SAMPLES;

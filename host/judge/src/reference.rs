@@ -27,7 +27,8 @@ pub struct LightReference {
     pub contributing: Vec<bool>,
     /// Point-light visibility: 0 or 1 (1 where not contributing).
     pub hard: Vec<f32>,
-    /// Fraction of the light's area visible (equals `hard` for lights of radius 0).
+    /// Fraction of the light's area visible, each part weighted by its cosine to the normal
+    /// (equals `hard` for lights of radius 0).
     pub area: Vec<f32>,
     /// Area samples used per contributing pixel.
     pub samples: u32,
@@ -68,6 +69,23 @@ fn visible_direction(occluders: &Occluders, origin: Vec3, direction: Vec3) -> bo
     !occluders.occluded(origin, direction, f32::INFINITY)
 }
 
+/// Cosine-weighted fraction of samples that are visible: each sample direction counts with
+/// max(0, n . direction), so the part of an emitter below the surface's horizon (which lights
+/// nothing, shadowed or not) does not count as shadow. For a light at grazing incidence the
+/// plain fraction would be about 0.5 (half the disk below the horizon) where the ratio of
+/// shadowed to unshadowed irradiance is 1. `None` when no sample lies above the horizon.
+fn weighted_fraction(samples: impl Iterator<Item = (Vec3, bool)>, normal: Vec3) -> Option<f32> {
+    let (mut visible, mut total) = (0.0f32, 0.0f32);
+    for (direction, seen) in samples {
+        let weight = normal.dot(direction).max(0.0);
+        total += weight;
+        if seen {
+            visible += weight;
+        }
+    }
+    (total > 0.0).then(|| visible / total)
+}
+
 /// Visibility of `light` from one surface point: (hard, area).
 fn point_visibility(
     occluders: &Occluders,
@@ -78,7 +96,6 @@ fn point_visibility(
 ) -> (f32, f32) {
     let origin = point.position + point.normal * occluders.epsilon();
     let as_f32 = |b: bool| if b { 1.0 } else { 0.0 };
-    let samples = |hits: usize| hits as f32 / (grid * grid) as f32;
     match light.kind {
         LightKind::Directional => {
             let toward = -light.direction;
@@ -88,13 +105,14 @@ fn point_visibility(
             }
             let (u, v) = basis(toward);
             let spread = light.radius.tan();
-            let hits = stratified_disk(grid, seed)
-                .filter(|d: &Vec2| {
-                    let dir = (toward + spread * (u * d.x + v * d.y)).normalize();
-                    visible_direction(occluders, origin, dir)
-                })
-                .count();
-            (hard, samples(hits))
+            let samples = stratified_disk(grid, seed).map(|d: Vec2| {
+                let dir = (toward + spread * (u * d.x + v * d.y)).normalize();
+                (dir, visible_direction(occluders, origin, dir))
+            });
+            (
+                hard,
+                weighted_fraction(samples, point.normal).unwrap_or(hard),
+            )
         }
         LightKind::Point | LightKind::Spot => {
             let hard = as_f32(visible(occluders, origin, light.position));
@@ -102,13 +120,15 @@ fn point_visibility(
                 return (hard, hard);
             }
             let (u, v) = basis((light.position - origin).normalize_or_zero());
-            let hits = stratified_disk(grid, seed)
-                .filter(|d: &Vec2| {
-                    let target = light.position + light.radius * (u * d.x + v * d.y);
-                    visible(occluders, origin, target)
-                })
-                .count();
-            (hard, samples(hits))
+            let samples = stratified_disk(grid, seed).map(|d: Vec2| {
+                let target = light.position + light.radius * (u * d.x + v * d.y);
+                let dir = (target - origin).normalize_or_zero();
+                (dir, visible(occluders, origin, target))
+            });
+            (
+                hard,
+                weighted_fraction(samples, point.normal).unwrap_or(hard),
+            )
         }
     }
 }

@@ -224,3 +224,37 @@ fn a_million_triangles_work() {
     let fraction = r.shadowed_fraction();
     assert!((fraction - 0.196).abs() < 0.01, "{fraction}");
 }
+
+/// A wall lit at grazing incidence by a sun with an angular radius: half of the sun's disk lies
+/// below the wall's horizon, but that half lights nothing shadowed or not, so the area
+/// visibility (the ratio of shadowed to unshadowed irradiance) is 1 on an unoccluded wall, as
+/// is the hard visibility. A point light above the wall's plane behaves the same way.
+#[test]
+fn a_wall_at_grazing_incidence_is_fully_visible() {
+    for light in [
+        "Directional(direction: (0.0, -1.0, 0.0), angular_radius_degrees: 3)",
+        "Point(position: (0, 20, 0.001), range: 100, radius: 1)",
+    ] {
+        // The back wall: the plane z = 0 facing +z, from y = 0 to 10.
+        let s = scene(
+            "(mesh: Plane(size: 10), transform: (translation: (0, 5, 0), rotation_degrees: (90, 0, 0)))",
+            light,
+        );
+        let occluders = Occluders::new(&s);
+        // Normals as a G-buffer stores them: a hair towards the light, so the light counts.
+        let points: Vec<Option<SurfacePoint>> = (0..64)
+            .map(|i| {
+                Some(SurfacePoint {
+                    position: Vec3::new(-3.0 + i as f32 * 0.1, 1.0 + i as f32 * 0.05, 0.0),
+                    normal: Vec3::new(0.0, 1e-6, 1.0).normalize(),
+                })
+            })
+            .collect();
+        let r = reference_visibility(&occluders, &s.lights[0], &points, 64);
+        for i in 0..points.len() {
+            assert!(r.contributing[i], "{light}: point {i}");
+            assert_eq!(r.hard[i], 1.0, "{light}: point {i}");
+            assert!(r.area[i] > 0.999, "{light}: point {i} area {}", r.area[i]);
+        }
+    }
+}

@@ -160,3 +160,80 @@ fn open_real_meshes_do_not_leak_light() {
         }
     }
 }
+
+/// planar-room lit only by a sun shining along `direction`.
+fn planar_room_with_sun(direction: [f32; 3]) -> Scene {
+    let text = std::fs::read_to_string(scene_path("planar-room.ron")).unwrap();
+    let start = text.find("lights: [").unwrap();
+    let end = text.find("objects: [").unwrap();
+    let [x, y, z] = direction;
+    let sun = format!(
+        "lights: [Directional(direction: ({x:?}, {y:?}, {z:?}), intensity: 1, \
+         angular_radius_degrees: 0.27)],\n    "
+    );
+    let text = format!("{}{sun}{}", &text[..start], &text[end..]);
+    zoo_host::test_support::scene_from_ron("planar-room-sun.ron", &text)
+}
+
+/// The judge must see shadows for any sun direction: straight down, along every axis (exact
+/// zero components become -0.0 when the judge negates the direction), and at random. Shadow
+/// volumes are exact up to raster edges, so they must agree within their core bound, and
+/// `unshadowed` must be wrong by exactly the reference's shadowed fraction.
+#[test]
+fn suns_along_the_axes_and_at_random_are_judged_exactly() {
+    let directions = [
+        [0.0, -1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [0.0, -0.35, 1.0],
+        [-0.35, -1.0, 0.0],
+        [0.31, -0.8, 0.52],
+        [-0.72, -0.41, -0.23],
+        [0.05, -0.6, -0.9],
+    ];
+    let size = UVec2::new(160, 160);
+    for direction in directions {
+        let run = judge_scene(planar_room_with_sun(direction), "sv-zfail", &[], size);
+        let reference = &run.reference.lights[0];
+        let shadowed = reference.shadowed_fraction();
+        let m = run.metrics(0);
+        eprintln!("sun {direction:?}: shadowed {shadowed:.4}, sv-zfail {m:?}");
+        assert!(
+            m.false_shadow_core + m.false_lit_core <= 0.001,
+            "sun {direction:?}: sv-zfail core errors {} + {}",
+            m.false_shadow_core,
+            m.false_lit_core
+        );
+        // Lights that shine down or onto a wall the camera sees must cast visible shadows.
+        if direction[1] < -0.3 || direction == [-1.0, 0.0, 0.0] || direction == [0.0, 0.0, -1.0] {
+            assert!(
+                shadowed > 0.01,
+                "sun {direction:?}: the reference finds only {shadowed} of the pixels shadowed"
+            );
+        }
+        let (width, height) = run.reference.size();
+        let all_lit = vec![1.0; width * height];
+        let unshadowed =
+            zoo_host::judge::Metrics::compute(reference, &all_lit, width, height, None);
+        assert_eq!(unshadowed.false_shadow, 0.0, "sun {direction:?}");
+        assert!(
+            (unshadowed.false_lit - shadowed).abs() < 1e-12,
+            "sun {direction:?}: unshadowed false_lit {} vs shadowed fraction {shadowed}",
+            unshadowed.false_lit
+        );
+        // The soft reference agrees with the hard one away from the thin penumbra of a
+        // 0.27-degree sun: almost no pixel in hard shadow sees most of the sun.
+        let contradicting = (0..width * height)
+            .filter(|&i| {
+                reference.contributing[i] && reference.hard[i] < 0.5 && reference.area[i] > 0.9
+            })
+            .count();
+        assert!(
+            contradicting as f64 <= 0.002 * reference.pixels() as f64,
+            "sun {direction:?}: {contradicting} hard-shadowed pixels see the whole sun"
+        );
+    }
+}

@@ -1,28 +1,11 @@
 //! PNG plots of benchmark results: per-pass bars and sweep lines.
 
 use std::path::Path;
-use std::sync::Once;
 
 use anyhow::Context;
 use plotters::prelude::*;
 
-const FONT: &str = "sans-serif";
-
-/// Registers the bundled font once (plots need no system fonts).
-fn register_font() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        if plotters::style::register_font(
-            FONT,
-            FontStyle::Normal,
-            epaint_default_fonts::UBUNTU_LIGHT,
-        )
-        .is_err()
-        {
-            zoo_host::log::warn!("bench plots: the bundled font could not be loaded");
-        }
-    });
-}
+use crate::font::{FONT, register as register_font};
 
 fn save(buffer: Vec<u8>, (width, height): (u32, u32), path: &Path) -> anyhow::Result<()> {
     image::RgbImage::from_raw(width, height, buffer)

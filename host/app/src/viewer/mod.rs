@@ -19,6 +19,7 @@ use std::sync::Arc;
 
 use anyhow::Context as _;
 use zoo_host::glam::UVec2;
+use zoo_host::gpu::adapter::choose_adapter_with;
 use zoo_host::{GpuContext, ShaderLibrary};
 
 pub use state::ViewerState;
@@ -161,6 +162,16 @@ pub fn run() -> anyhow::Result<()> {
             required_limits: adapter.limits(),
             ..Default::default()
         });
+        create.native_adapter_selector = Some(Arc::new(
+            |adapters: &[wgpu::Adapter], surface: Option<&wgpu::Surface<'_>>| {
+                choose_adapter_with(adapters, wgpu::Backends::all(), |adapter| {
+                    surface
+                        .filter(|s| !adapter.is_surface_supported(s))
+                        .map(|_| "cannot present to the window".to_string())
+                })
+                .map_err(|e| e.to_string())
+            },
+        ));
     }
     let result = eframe::run_native(
         "Shadow Zoo",
@@ -180,10 +191,16 @@ pub fn run() -> anyhow::Result<()> {
             let mut state =
                 ViewerState::with_shaders(gpu, scene, UVec2::new(960, 640), shader_library())?;
             let settings = settings_path();
-            if settings.is_file()
-                && let Err(e) = state.load_settings(&settings)
-            {
-                state.status = format!("ignored saved settings: {e}");
+            let restored = settings.is_file()
+                && match state.load_settings(&settings) {
+                    Ok(()) => true,
+                    Err(e) => {
+                        state.status = format!("ignored saved settings: {e}");
+                        false
+                    }
+                };
+            if !restored && let Some(id) = first_run_technique(&state) {
+                state.select_technique(id);
             }
             Ok(Box::new(ViewerApp {
                 state,
@@ -200,6 +217,22 @@ pub fn run() -> anyhow::Result<()> {
              `shadow-zoo bench ...` (see `shadow-zoo --help`)"
         )
     })
+}
+
+/// The technique the viewer opens on when no settings remember one: the shadow-map
+/// technique when it is available, else the first available technique that casts shadows.
+pub fn first_run_technique(state: &ViewerState) -> Option<&'static str> {
+    let gpu = state.renderer.gpu();
+    let casting: Vec<&'static str> = zoo_host::registry()
+        .into_iter()
+        .filter(|r| r.id != "unshadowed" && r.unavailable_reason(gpu).is_none())
+        .map(|r| r.id)
+        .collect();
+    casting
+        .iter()
+        .find(|id| **id == "sm-pcf")
+        .or(casting.first())
+        .copied()
 }
 
 /// Where remembered settings live between runs.

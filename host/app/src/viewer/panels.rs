@@ -377,17 +377,29 @@ impl ViewerState {
             }
         });
         ui.columns(3, |columns| {
-            let bars: Vec<Bar> = timings
-                .passes
+            let families = pass_families(&timings.passes);
+            let bars: Vec<Bar> = families
                 .iter()
                 .enumerate()
-                .map(|(i, p)| Bar::new(i as f64, p.milliseconds).name(&p.name))
+                .map(|(i, f)| Bar::new(-(i as f64), f.milliseconds).name(f.label()))
                 .collect();
+            let labels: Vec<String> = families.iter().map(PassFamily::label).collect();
             Plot::new("pass times")
                 .height(140.0)
                 .allow_scroll(false)
+                .y_axis_min_width(120.0)
+                .y_axis_formatter(move |mark, _| {
+                    let index = -mark.value;
+                    if (index - index.round()).abs() > 1e-6 || index < 0.0 {
+                        return String::new();
+                    }
+                    labels
+                        .get(index.round() as usize)
+                        .cloned()
+                        .unwrap_or_default()
+                })
                 .show(&mut columns[0], |plot| {
-                    plot.bar_chart(BarChart::new("passes (ms)", bars))
+                    plot.bar_chart(BarChart::new("pass time (ms)", bars).horizontal())
                 });
             let points: PlotPoints<'_> = self
                 .history
@@ -425,6 +437,45 @@ impl ViewerState {
     }
 }
 
+/// Passes of one family (the part of their names before `:`, e.g. "Shadow map" for
+/// "Shadow map: light 2 face 3") and their summed time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassFamily {
+    pub name: String,
+    pub passes: usize,
+    pub milliseconds: f64,
+}
+
+impl PassFamily {
+    /// The bar label: the family name, with the pass count when there are several.
+    pub fn label(&self) -> String {
+        match self.passes {
+            1 => self.name.clone(),
+            n => format!("{} ×{n}", self.name),
+        }
+    }
+}
+
+/// Groups passes into families in the order they first ran.
+pub fn pass_families(passes: &[zoo_host::gpu::PassTiming]) -> Vec<PassFamily> {
+    let mut families: Vec<PassFamily> = Vec::new();
+    for pass in passes {
+        let name = pass.name.split(':').next().unwrap_or("").trim();
+        match families.iter_mut().find(|f| f.name == name) {
+            Some(family) => {
+                family.passes += 1;
+                family.milliseconds += pass.milliseconds;
+            }
+            None => families.push(PassFamily {
+                name: name.to_string(),
+                passes: 1,
+                milliseconds: pass.milliseconds,
+            }),
+        }
+    }
+    families
+}
+
 /// Every registered technique as a selectable list (labels prefixed with `prefix`); returns
 /// the one clicked.
 fn technique_list(ui: &mut egui::Ui, current: &str, prefix: &str) -> Option<&'static str> {
@@ -434,8 +485,8 @@ fn technique_list(ui: &mut egui::Ui, current: &str, prefix: &str) -> Option<&'st
             .selectable_label(current == r.id, format!("{prefix}{}", r.id))
             .on_hover_text(format!(
                 "{}\n{}\nlights: {}",
-                r.name,
                 r.description,
+                r.name,
                 r.light_kind_names()
             ));
         if response.clicked() {
@@ -443,4 +494,39 @@ fn technique_list(ui: &mut egui::Ui, current: &str, prefix: &str) -> Option<&'st
         }
     }
     chosen
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::{PassOwner, PassTiming};
+
+    fn pass(name: &str, milliseconds: f64) -> PassTiming {
+        PassTiming {
+            name: name.to_string(),
+            owner: PassOwner::Technique,
+            milliseconds,
+            invocations: None,
+        }
+    }
+
+    #[test]
+    fn passes_group_into_named_families_in_order() {
+        let passes = [
+            pass("G-buffer", 1.0),
+            pass("Shadow map: light 0 face 0", 2.0),
+            pass("Shadow map: light 0 face 1", 3.0),
+            pass("Shadow lookup: light 0", 0.5),
+            pass("Shadow map: light 1", 4.0),
+            pass("Lighting", 0.25),
+        ];
+        let families = pass_families(&passes);
+        let labels: Vec<String> = families.iter().map(PassFamily::label).collect();
+        assert_eq!(
+            labels,
+            ["G-buffer", "Shadow map ×3", "Shadow lookup", "Lighting"]
+        );
+        assert_eq!(families[1].milliseconds, 9.0);
+        assert_eq!(families[1].passes, 3);
+    }
 }

@@ -2,21 +2,15 @@
 
 use std::sync::{Arc, Mutex};
 
+use crate::gpu::adapter::{AdapterError, choose_adapter};
 use crate::technique;
 
 /// Why no GPU device could be created.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
-    /// No adapter on any enabled backend.
-    #[error(
-        "no graphics adapter found (backends: {backends}). Shadow Zoo needs a Vulkan, Metal or DX12 driver; \
-         on Linux without a GPU install the lavapipe software driver: \
-         `sudo apt-get install -y mesa-vulkan-drivers`"
-    )]
-    NoAdapter { backends: String },
-    /// `WGPU_ADAPTER_NAME` matched nothing.
-    #[error("WGPU_ADAPTER_NAME={wanted} matches no adapter; available: {available}")]
-    NoMatchingAdapter { wanted: String, available: String },
+    /// No adapter can run the host (each one found is listed with its reasons).
+    #[error(transparent)]
+    Adapter(#[from] AdapterError),
     /// The adapter refused the device.
     #[error("the adapter refused to create a device: {0}")]
     Device(String),
@@ -156,43 +150,7 @@ pub fn error_chain(error: &dyn std::error::Error) -> String {
 async fn select_adapter(
     instance: &wgpu::Instance,
     backends: wgpu::Backends,
-) -> Result<wgpu::Adapter, GpuError> {
+) -> Result<wgpu::Adapter, AdapterError> {
     let adapters = instance.enumerate_adapters(backends).await;
-    if adapters.is_empty() {
-        return Err(GpuError::NoAdapter {
-            backends: format!("{backends:?}"),
-        });
-    }
-    if let Ok(wanted) = std::env::var("WGPU_ADAPTER_NAME") {
-        let needle = wanted.to_lowercase();
-        let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
-        return adapters
-            .into_iter()
-            .find(|a| a.get_info().name.to_lowercase().contains(&needle))
-            .ok_or(GpuError::NoMatchingAdapter {
-                wanted,
-                available: names.join(", "),
-            });
-    }
-    let rank = |a: &wgpu::Adapter| {
-        let info = a.get_info();
-        let device = match info.device_type {
-            wgpu::DeviceType::DiscreteGpu => 0,
-            wgpu::DeviceType::IntegratedGpu => 1,
-            wgpu::DeviceType::VirtualGpu => 2,
-            wgpu::DeviceType::Cpu => 3,
-            wgpu::DeviceType::Other => 4,
-        };
-        let backend = match info.backend {
-            wgpu::Backend::Vulkan | wgpu::Backend::Metal | wgpu::Backend::Dx12 => 0,
-            _ => 1,
-        };
-        (device, backend)
-    };
-    adapters
-        .into_iter()
-        .min_by_key(rank)
-        .ok_or(GpuError::NoAdapter {
-            backends: format!("{backends:?}"),
-        })
+    choose_adapter(&adapters, backends)
 }

@@ -1,5 +1,6 @@
 //! Device, shaders, readback and per-pass timing.
 
+pub mod adapter;
 mod context;
 pub mod readback;
 mod recorder;
