@@ -171,6 +171,37 @@ fn settings_save_and_reload() {
 }
 
 #[test]
+fn the_viewer_opens_on_a_shadowing_technique_then_on_the_last_one_used() {
+    let dir = std::env::temp_dir().join(format!("zoo-viewer-first-run-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("settings.ron");
+    let _ = std::fs::remove_file(&path);
+    // First run: no settings, so the shadow-map technique rather than `unshadowed`.
+    let mut first = harness();
+    first.state_mut().restore_settings(&path);
+    first.run();
+    assert_eq!(first.state().technique, "sm-pcf");
+    assert_eq!(first.state().renderer.technique().id, "sm-pcf");
+    // The user switches and quits; the next run opens where they left off.
+    first.get_by_label("sv-zfail").click();
+    first.run();
+    first.state().save_settings(&path).unwrap();
+    let mut second = harness();
+    second.state_mut().restore_settings(&path);
+    assert_eq!(second.state().renderer.technique().id, "sv-zfail");
+    // Unreadable settings are reported and the first-run technique is used.
+    std::fs::write(&path, "(technique: ").unwrap();
+    let mut third = harness();
+    third.state_mut().restore_settings(&path);
+    assert_eq!(third.state().renderer.technique().id, "sm-pcf");
+    assert!(
+        third.state().status.contains("ignored saved settings"),
+        "{}",
+        third.state().status
+    );
+}
+
+#[test]
 fn switching_two_hundred_times_frees_the_old_resources() {
     // A device of its own, so other tests' resources do not move the counts.
     let own = std::sync::Arc::new(GpuContext::new_headless().unwrap());

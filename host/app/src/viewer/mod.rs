@@ -190,18 +190,7 @@ pub fn run() -> anyhow::Result<()> {
             let scene = crate::commands::load_scene(None)?;
             let mut state =
                 ViewerState::with_shaders(gpu, scene, UVec2::new(960, 640), shader_library())?;
-            let settings = settings_path();
-            let restored = settings.is_file()
-                && match state.load_settings(&settings) {
-                    Ok(()) => true,
-                    Err(e) => {
-                        state.status = format!("ignored saved settings: {e}");
-                        false
-                    }
-                };
-            if !restored && let Some(id) = first_run_technique(&state) {
-                state.select_technique(id);
-            }
+            state.restore_settings(&settings_path());
             Ok(Box::new(ViewerApp {
                 state,
                 a: NativeTexture::default(),
@@ -217,22 +206,6 @@ pub fn run() -> anyhow::Result<()> {
              `shadow-zoo bench ...` (see `shadow-zoo --help`)"
         )
     })
-}
-
-/// The technique the viewer opens on when no settings remember one: the shadow-map
-/// technique when it is available, else the first available technique that casts shadows.
-pub fn first_run_technique(state: &ViewerState) -> Option<&'static str> {
-    let gpu = state.renderer.gpu();
-    let casting: Vec<&'static str> = zoo_host::registry()
-        .into_iter()
-        .filter(|r| r.id != "unshadowed" && r.unavailable_reason(gpu).is_none())
-        .map(|r| r.id)
-        .collect();
-    casting
-        .iter()
-        .find(|id| **id == "sm-pcf")
-        .or(casting.first())
-        .copied()
 }
 
 /// Where remembered settings live between runs.

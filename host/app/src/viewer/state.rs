@@ -247,6 +247,39 @@ impl ViewerState {
         Ok(())
     }
 
+    /// Starts where the last run ended: the settings at `path` (technique, parameters,
+    /// bookmarks) when they exist and parse, else the first-run technique. A file that does not
+    /// parse is reported in the status line.
+    pub fn restore_settings(&mut self, path: &Path) {
+        let restored = path.is_file()
+            && match self.load_settings(path) {
+                Ok(()) => true,
+                Err(e) => {
+                    self.status = format!("ignored saved settings: {e}");
+                    false
+                }
+            };
+        if !restored && let Some(id) = self.first_run_technique() {
+            self.select_technique(id);
+        }
+    }
+
+    /// The technique to open on when no settings remember one: the shadow-map technique when
+    /// it is available, else the first available technique that casts shadows.
+    pub fn first_run_technique(&self) -> Option<&'static str> {
+        let gpu = self.renderer.gpu();
+        let casting: Vec<&'static str> = zoo_host::registry()
+            .into_iter()
+            .filter(|r| r.id != "unshadowed" && r.unavailable_reason(gpu).is_none())
+            .map(|r| r.id)
+            .collect();
+        casting
+            .iter()
+            .find(|id| **id == "sm-pcf")
+            .or(casting.first())
+            .copied()
+    }
+
     /// Opens another scene: its camera and lights replace the current ones. On error the
     /// current scene stays and `scene_error` says why.
     pub fn open_scene(&mut self, path: &Path) {
