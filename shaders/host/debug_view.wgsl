@@ -17,8 +17,16 @@ struct ViewParams {
 
 @group(0) @binding(0) var<uniform> params: ViewParams;
 @group(0) @binding(1) var source_float: texture_2d<f32>;
-@group(0) @binding(2) var source_depth: texture_depth_2d;
+// A depth texture bound as unfilterable float (GLSL cannot fetch texels of depth textures).
+@group(0) @binding(2) var source_depth: texture_2d<f32>;
 @group(0) @binding(3) var source_uint: texture_2d<u32>;
+
+// The output is sRGB-encoded on write; views show their values as they are, so they are
+// decoded first.
+fn display(c: vec3<f32>) -> vec4<f32> {
+    let linear = select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
+    return vec4<f32>(linear, params.opacity);
+}
 
 fn source_pixel(in: FullscreenOut, size: vec2<u32>) -> vec2<i32> {
     return vec2<i32>(min(vec2<u32>(in.uv * vec2<f32>(size)), size - vec2<u32>(1u)));
@@ -32,32 +40,32 @@ fn remap(v: f32) -> f32 {
 fn fs_float(in: FullscreenOut) -> @location(0) vec4<f32> {
     let texel = textureLoad(source_float, source_pixel(in, textureDimensions(source_float)), 0);
     if params.mode == 1u {
-        return vec4<f32>(vec3<f32>(remap(texel[params.channel])), params.opacity);
+        return display(vec3<f32>(remap(texel[params.channel])));
     }
-    return vec4<f32>(remap(texel.r), remap(texel.g), remap(texel.b), params.opacity);
+    return display(vec3<f32>(remap(texel.r), remap(texel.g), remap(texel.b)));
 }
 
 @fragment
 fn fs_depth(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let d = textureLoad(source_depth, source_pixel(in, textureDimensions(source_depth)), 0);
+    let d = textureLoad(source_depth, source_pixel(in, textureDimensions(source_depth)), 0).r;
     var v = d;
     if params.mode == 3u {
         if d >= 1.0 {
-            return vec4<f32>(0.0, 0.0, 0.0, params.opacity);
+            return display(vec3<f32>(0.0));
         }
         v = params.near * params.far / (params.far - d * (params.far - params.near));
     }
-    return vec4<f32>(vec3<f32>(1.0 - remap(v)), params.opacity);
+    return display(vec3<f32>(1.0 - remap(v)));
 }
 
 @fragment
 fn fs_uint(in: FullscreenOut) -> @location(0) vec4<f32> {
     let v = textureLoad(source_uint, source_pixel(in, textureDimensions(source_uint)), 0).r;
     if v == 0u || params.mode != 4u {
-        return vec4<f32>(0.0, 0.0, 0.0, params.opacity);
+        return display(vec3<f32>(0.0));
     }
     // Distinct hues for small integers.
     let h = fract(f32(v) * 0.618034);
     let c = saturate(abs(fract(vec3<f32>(h) + vec3<f32>(0.0, 2.0 / 3.0, 1.0 / 3.0)) * 6.0 - 3.0) - 1.0);
-    return vec4<f32>(c, params.opacity);
+    return display(c);
 }

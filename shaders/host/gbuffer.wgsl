@@ -1,4 +1,4 @@
-// G-buffer pass: world position, normal + shininess, albedo + specular.
+// G-buffer pass: view depth (f32 bits), normal + shininess, albedo + specular.
 
 #import "common/frame.wgsl"
 
@@ -27,7 +27,8 @@ fn vs_main(v: VertexIn) -> VertexOut {
 }
 
 struct GBufferOut {
-    @location(0) position: vec4<f32>,
+    // View-space depth (> 0) as bits; the clear value 0 marks the background.
+    @location(0) view_depth: u32,
     @location(1) normal: vec4<f32>,
     @location(2) albedo: vec4<f32>,
 }
@@ -41,7 +42,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
         n = -n;
     }
     var out: GBufferOut;
-    out.position = vec4<f32>(in.world, 1.0);
+    out.view_depth = bitcast<u32>(-(camera.view * vec4<f32>(in.world, 1.0)).z);
     out.normal = vec4<f32>(n, object.material.x / 256.0);
     out.albedo = object.color;
     return out;

@@ -59,6 +59,10 @@ struct Current {
 @group(2) @binding(3) var<storage, read> slots: array<Slot>;
 @group(2) @binding(4) var<storage, read> shadow_lights: array<ShadowLight>;
 @group(2) @binding(5) var<uniform> current: Current;
+// The maps again as plain floats: GLSL cannot fetch texels of depth textures.
+@group(2) @binding(6) var shadow_depths: texture_2d_array<f32>;
+// And once more for the nearest comparison sampler: GLSL pairs each texture with one sampler.
+@group(2) @binding(7) var shadow_maps_nearest: texture_depth_2d_array;
 
 // Poisson disc, 16 points in the unit disk, minimum spacing 0.423.
 const POISSON_16: array<vec2<f32>, 16> = array<vec2<f32>, 16>(
@@ -158,7 +162,7 @@ fn tap(sl: ShadowLight, p: vec3<f32>, linear: bool) -> f32 {
     if linear {
         return textureSampleCompareLevel(shadow_maps, compare_linear, m.uv, m.layer, m.depth);
     }
-    return textureSampleCompareLevel(shadow_maps, compare_nearest, m.uv, m.layer, m.depth);
+    return textureSampleCompareLevel(shadow_maps_nearest, compare_nearest, m.uv, m.layer, m.depth);
 }
 
 // Distance along the map's axis for a [0, 1] depth value.
@@ -172,7 +176,7 @@ fn linear_depth(sl: ShadowLight, d: f32) -> f32 {
 fn stored_depth(m: MapPoint) -> f32 {
     let size = vec2<i32>(textureDimensions(shadow_maps));
     let texel = clamp(vec2<i32>(m.uv * vec2<f32>(size)), vec2<i32>(0), size - vec2<i32>(1));
-    return textureLoad(shadow_maps, texel, m.layer, 0);
+    return textureLoad(shadow_depths, texel, m.layer, 0).r;
 }
 
 // Unit direction light rays travel at p.

@@ -15,7 +15,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         None => crate::viewer::run(),
         Some(Command::List) => {
-            print!("{}", list_techniques());
+            list();
             Ok(())
         }
         Some(Command::Render(args)) => render(&args),
@@ -24,20 +24,39 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
-/// One line per registered technique: id, description, supported light kinds.
-pub fn list_techniques() -> String {
+/// One line per registered technique: id, description, supported light kinds, and, when
+/// `gpu` is given, why a technique cannot run on it.
+pub fn list_techniques(gpu: Option<&GpuContext>) -> String {
     let all = zoo_host::registry();
     let width = all.iter().map(|r| r.id.len()).max().unwrap_or(0);
     all.iter()
         .map(|r| {
+            let unavailable = gpu
+                .and_then(|gpu| r.unavailable_reason(gpu))
+                .map(|reason| format!("  unavailable here: {reason}"))
+                .unwrap_or_default();
             format!(
-                "{:width$}  {}  [{}]\n",
+                "{:width$}  {}  [{}]{unavailable}\n",
                 r.id,
                 r.description,
                 r.light_kind_names()
             )
         })
         .collect()
+}
+
+/// `list`: the techniques, checked against the adapter when there is one.
+fn list() {
+    match GpuContext::new_headless() {
+        Ok(gpu) => {
+            println!("adapter: {}", gpu.describe());
+            print!("{}", list_techniques(Some(&gpu)));
+        }
+        Err(e) => {
+            print!("{}", list_techniques(None));
+            println!("(availability not checked: {e})");
+        }
+    }
 }
 
 /// Loads `path`, or the built-in default scene when `None`.

@@ -34,6 +34,9 @@ pub struct TechniqueRegistration {
     pub optional_features: fn() -> wgpu::Features,
     /// Device limits it needs.
     pub required_limits: fn() -> wgpu::Limits,
+    /// Downlevel capabilities it needs beyond the host's (compute shaders, indirect draws...),
+    /// for adapters that are not fully WebGPU-compliant such as wgpu's GL backend.
+    pub required_downlevel: fn() -> wgpu::DownlevelFlags,
     /// Its parameter schema (usually `MyParams::schema`).
     pub params: fn() -> Vec<ParamSpec>,
     /// Creates an instance for the given device and validated parameter values.
@@ -52,6 +55,27 @@ impl std::fmt::Debug for TechniqueRegistration {
 }
 
 impl TechniqueRegistration {
+    /// Values for the fields a registration leaves out (`register_technique!` fills them in):
+    /// no features, downlevel capabilities or parameters, and WebGPU's downlevel limits.
+    pub const DEFAULTS: TechniqueRegistration = TechniqueRegistration {
+        package: "",
+        id: "",
+        name: "",
+        description: "",
+        source: "",
+        light_kinds: &[],
+        required_features: wgpu::Features::empty,
+        optional_features: wgpu::Features::empty,
+        required_limits: wgpu::Limits::downlevel_defaults,
+        required_downlevel: wgpu::DownlevelFlags::empty,
+        params: Vec::new,
+        create: |_, _| {
+            Err(TechniqueError::Other(
+                "the registration names no factory".into(),
+            ))
+        },
+    };
+
     /// Whether it supports lights of `kind`.
     pub fn supports(&self, kind: LightKind) -> bool {
         self.light_kinds.contains(&kind)
@@ -62,6 +86,16 @@ impl TechniqueRegistration {
         let missing = (self.required_features)() - gpu.device.features();
         if !missing.is_empty() {
             return Some(format!("needs device features {missing:?}"));
+        }
+        let downlevel =
+            (self.required_downlevel)() - gpu.adapter.get_downlevel_capabilities().flags;
+        if !downlevel.is_empty() {
+            let names: Vec<&str> = downlevel.iter_names().map(|(name, _)| name).collect();
+            return Some(format!(
+                "needs downlevel capabilities {} ({:?} backend)",
+                names.join(", "),
+                gpu.info.backend
+            ));
         }
         let mut failed = Vec::new();
         (self.required_limits)().check_limits_with_fail_fn(
@@ -114,7 +148,9 @@ pub fn find_technique(id: &str) -> Result<&'static TechniqueRegistration, Techni
 }
 
 /// Registers a technique. Takes the fields of [`TechniqueRegistration`] except `package`,
-/// which is set to the calling crate's package name:
+/// which is set to the calling crate's package name; fields left out take their
+/// [`TechniqueRegistration::DEFAULTS`] (no features or downlevel needs, WebGPU's downlevel
+/// limits, no parameters):
 ///
 /// ```ignore
 /// zoo_host::register_technique! {
@@ -127,9 +163,15 @@ pub fn find_technique(id: &str) -> Result<&'static TechniqueRegistration, Techni
 macro_rules! register_technique {
     ($($field:ident : $value:expr),* $(,)?) => {
         $crate::inventory::submit! {
-            $crate::technique::TechniqueRegistration {
-                package: env!("CARGO_PKG_NAME"),
-                $($field: $value),*
+            {
+                // A registration that names every field leaves nothing to the defaults.
+                #[allow(clippy::needless_update)]
+                let registration = $crate::technique::TechniqueRegistration {
+                    package: env!("CARGO_PKG_NAME"),
+                    $($field: $value,)*
+                    ..$crate::technique::TechniqueRegistration::DEFAULTS
+                };
+                registration
             }
         }
     };

@@ -333,6 +333,26 @@ impl ShadowMaps {
                         min_binding_size: wgpu::BufferSize::new(16),
                     },
                 ),
+                // The same maps as plain floats, for reading stored depths (GLSL cannot fetch
+                // texels of depth textures).
+                texture_entry(
+                    6,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                ),
+                // And once more for the nearest comparison sampler (GLSL pairs each texture
+                // with one sampler).
+                texture_entry(
+                    7,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                ),
             ],
         });
         let lookup_pipeline_layout =
@@ -408,8 +428,10 @@ impl ShadowMaps {
         if let Some(note) = note {
             zoo_host::log::warn!("{note}");
         }
+        let layers_allocated =
+            zoo_host::gpu::array_layers(ctx.gpu, resolution, resolution, layers_needed);
         let reuse = self.maps.as_ref().is_some_and(|m| {
-            m.resolution == resolution && m.texture.depth_or_array_layers() == layers_needed
+            m.resolution == resolution && m.texture.depth_or_array_layers() == layers_allocated
         });
         if !reuse {
             let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
@@ -417,7 +439,7 @@ impl ShadowMaps {
                 size: wgpu::Extent3d {
                     width: resolution,
                     height: resolution,
-                    depth_or_array_layers: layers_needed,
+                    depth_or_array_layers: layers_allocated,
                 },
                 mip_level_count: 1,
                 sample_count: 1,
@@ -441,6 +463,7 @@ impl ShadowMaps {
             let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
                 label: Some("sm-pcf shadow maps (array)"),
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
+                array_layer_count: Some(layers_needed),
                 ..Default::default()
             });
             self.maps = Some(Maps {
@@ -635,6 +658,14 @@ impl ShadowMaps {
                         offset: 0,
                         size: wgpu::BufferSize::new(16),
                     }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&maps.array_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: wgpu::BindingResource::TextureView(&maps.array_view),
                 },
             ],
         });

@@ -5,25 +5,20 @@
 //! Vulkan, Metal and DX12 come before other backends, then discrete before integrated, virtual
 //! and CPU devices. When none qualifies, the error lists every adapter found with its reasons.
 
-use crate::render::gbuffer::{ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, POSITION_FORMAT};
+use crate::render::gbuffer::{ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, VIEW_DEPTH_FORMAT};
 use crate::render::lighting::OUTPUT_FORMAT;
 use crate::render::visibility::{INDIRECT_FORMAT, VISIBILITY_FORMAT};
 
-/// Downlevel capabilities the host's passes rely on.
-pub const HOST_DOWNLEVEL_FLAGS: wgpu::DownlevelFlags = wgpu::DownlevelFlags::VIEW_FORMATS
-    .union(wgpu::DownlevelFlags::VERTEX_STORAGE)
-    .union(wgpu::DownlevelFlags::FULL_DRAW_INDEX_UINT32)
-    .union(wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES)
-    .union(wgpu::DownlevelFlags::INDEPENDENT_BLEND)
-    .union(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE)
-    .union(wgpu::DownlevelFlags::COMPUTE_SHADERS);
+/// Downlevel capabilities the host's own passes rely on (storage buffers of per-frame data
+/// read in vertex shaders). Techniques declare what they need beyond this.
+pub const HOST_DOWNLEVEL_FLAGS: wgpu::DownlevelFlags = wgpu::DownlevelFlags::VERTEX_STORAGE;
 
 /// Usages the host needs for each of its texture formats.
 pub fn host_formats() -> [(wgpu::TextureFormat, wgpu::TextureUsages); 7] {
     use wgpu::TextureUsages as U;
     let target = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
     [
-        (POSITION_FORMAT, target),
+        (VIEW_DEPTH_FORMAT, target),
         (NORMAL_FORMAT, target),
         (ALBEDO_FORMAT, target),
         (DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING),
@@ -46,12 +41,6 @@ pub fn rejection_reasons(adapter: &wgpu::Adapter) -> Vec<String> {
     if !missing.is_empty() {
         let names: Vec<String> = missing.iter_names().map(|(n, _)| n.to_string()).collect();
         reasons.push(format!("lacks downlevel {}", names.join(", ")));
-    }
-    if downlevel.shader_model < wgpu::ShaderModel::Sm5 {
-        reasons.push(format!(
-            "shader model {:?} (needs Sm5)",
-            downlevel.shader_model
-        ));
     }
     for (format, usages) in host_formats() {
         let allowed = adapter.get_texture_format_features(format).allowed_usages;
@@ -224,7 +213,7 @@ mod tests {
             },
             Rejected {
                 adapter: "other (Gl backend, Other)".into(),
-                reasons: vec!["shader model Sm4 (needs Sm5)".into()],
+                reasons: vec!["limit max_bind_groups 2 < 4".into()],
             },
         ])
         .to_string();
@@ -239,7 +228,7 @@ mod tests {
             "{text}"
         );
         assert!(
-            text.contains("other (Gl backend, Other): rejected: shader model Sm4"),
+            text.contains("other (Gl backend, Other): rejected: limit max_bind_groups 2 < 4"),
             "{text}"
         );
         #[cfg(target_os = "linux")]

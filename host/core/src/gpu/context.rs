@@ -34,8 +34,19 @@ impl GpuContext {
         pollster::block_on(Self::new_headless_async())
     }
 
+    /// Creates a headless context on one of `backends` only (for example to run on wgpu's GL
+    /// backend beside Vulkan in one process); `WGPU_ADAPTER_NAME` still applies.
+    pub fn new_headless_on(backends: wgpu::Backends) -> Result<GpuContext, GpuError> {
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        descriptor.backends = backends;
+        pollster::block_on(Self::create(descriptor))
+    }
+
     async fn new_headless_async() -> Result<GpuContext, GpuError> {
-        let descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        Self::create(wgpu::InstanceDescriptor::new_without_display_handle_from_env()).await
+    }
+
+    async fn create(descriptor: wgpu::InstanceDescriptor) -> Result<GpuContext, GpuError> {
         let backends = descriptor.backends;
         let instance = wgpu::Instance::new(descriptor);
         let adapter = select_adapter(&instance, backends).await?;

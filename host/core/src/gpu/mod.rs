@@ -14,6 +14,6 @@ pub use recorder::{
 };
 pub use shaders::{ComposedShader, ShaderError, ShaderLibrary};
 pub use targets::{
-    clear_first, color_attachment, color_pass, fullscreen_pipeline, render_target,
+    array_layers, clear_first, color_attachment, color_pass, fullscreen_pipeline, render_target,
     stencil_attachment,
 };

@@ -123,3 +123,18 @@ pub fn color_pass<'a>(
         multiview_mask: None,
     }
 }
+
+/// Layers to allocate for a `width` x `height` array texture of `layers` layers that is viewed
+/// as `D2Array`. wgpu's GL backend picks the GL texture target from the size alone (one layer
+/// makes a 2D texture, a square multiple of six layers a cube map), and a view of another
+/// dimension then fails; there the array gets a spare layer. Other backends get `layers`.
+pub fn array_layers(gpu: &crate::GpuContext, width: u32, height: u32, layers: u32) -> u32 {
+    if gpu.info.backend != wgpu::Backend::Gl {
+        return layers;
+    }
+    let mut padded = layers.max(2);
+    if width == height && padded.is_multiple_of(6) {
+        padded += 1;
+    }
+    padded
+}

@@ -43,8 +43,9 @@ pub struct DebugViewPass {
     params: wgpu::Buffer,
 }
 
-/// Format the debug view writes (the output texture viewed without sRGB encoding).
-pub const DEBUG_TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Format the debug view writes: the output image's (the shader decodes sRGB first, so the
+/// stored bytes are the view's values).
+pub const DEBUG_TARGET_FORMAT: wgpu::TextureFormat = super::lighting::OUTPUT_FORMAT;
 
 impl DebugViewPass {
     /// Builds the pipelines from `host/debug_view.wgsl`.
@@ -57,20 +58,51 @@ impl DebugViewPass {
             blend: Some(wgpu::BlendState::ALPHA_BLENDING),
             write_mask: wgpu::ColorWrites::COLOR,
         };
-        let pipeline = |entry: &str| {
+        let pipeline = |entry: &str, layout: Option<&wgpu::PipelineLayout>| {
             crate::gpu::fullscreen_pipeline(
                 device,
                 &format!("debug view pipeline ({entry})"),
-                None,
+                layout,
                 &module,
                 entry,
                 target.clone(),
             )
         };
+        // Depth is bound as unfilterable float, which a derived layout would not choose.
+        let depth_group = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("debug view depth bind group layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let depth_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("debug view depth pipeline layout"),
+            bind_group_layouts: &[Some(&depth_group)],
+            immediate_size: 0,
+        });
         Ok(DebugViewPass {
-            float: pipeline("fs_float"),
-            depth: pipeline("fs_depth"),
-            uint: pipeline("fs_uint"),
+            float: pipeline("fs_float", None),
+            depth: pipeline("fs_depth", Some(&depth_layout)),
+            uint: pipeline("fs_uint", None),
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("debug view params"),
                 size: size_of::<ViewParams>() as u64,
@@ -80,7 +112,7 @@ impl DebugViewPass {
         })
     }
 
-    /// Records a pass that draws `source` into `target` (a non-sRGB view): full-screen when
+    /// Records a pass that draws `source` into `target` (the output image): full-screen when
     /// `overlay_opacity` is `None`, otherwise blended over what `target` holds.
     pub fn record(
         &self,

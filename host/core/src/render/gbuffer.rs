@@ -1,6 +1,12 @@
-//! The G-buffer: depth-stencil, world position, normal and albedo, and the pass that fills it.
+//! The G-buffer: depth-stencil, view depth, normal and albedo, and the pass that fills it.
+//!
+//! World positions are not stored: each pixel keeps its view-space depth (the distance along
+//! the camera's forward axis, as f32 bits in an `R32Uint` target, which every backend can render
+//! to) and the position is rebuilt from the ray through the pixel's centre, on the GPU by
+//! `load_surface` in `common/gbuffer.wgsl` and on the CPU by [`reconstruct_position`]. That is
+//! 4 bytes a pixel instead of 16, exact to f32 precision at any distance.
 
-use glam::UVec2;
+use glam::{Mat4, UVec2, Vec3};
 
 use super::frame::FrameBindings;
 use super::scene_buffers::{SceneBuffers, Vertex};
@@ -9,8 +15,8 @@ use crate::scene::Scene;
 
 /// Depth-stencil format shared with techniques that need stencil (planar, shadow volumes).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
-/// World position (w = 1 on geometry, 0 on background).
-pub const POSITION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// View-space depth as f32 bits (0 on background).
+pub const VIEW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// World normal (xyz) and shininess / 256 (w).
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Albedo (rgb) and specular strength (a).
@@ -24,8 +30,9 @@ pub struct GBuffer {
     pub depth_view: wgpu::TextureView,
     /// Depth aspect only, for sampling.
     pub depth_sample_view: wgpu::TextureView,
-    pub position: wgpu::Texture,
-    pub position_view: wgpu::TextureView,
+    /// View-space depth bits, from which world positions are rebuilt.
+    pub view_depth: wgpu::Texture,
+    pub view_depth_view: wgpu::TextureView,
     pub normal: wgpu::Texture,
     pub normal_view: wgpu::TextureView,
     pub albedo: wgpu::Texture,
@@ -36,20 +43,43 @@ pub struct GBuffer {
 
 /// Layout of bind group 1.
 pub fn gbuffer_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let texture = |binding| wgpu::BindGroupLayoutEntry {
+    let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            sample_type,
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         },
         count: None,
     };
+    let float = wgpu::TextureSampleType::Float { filterable: false };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("gbuffer bind group layout"),
-        entries: &[texture(0), texture(1), texture(2)],
+        entries: &[
+            texture(0, wgpu::TextureSampleType::Uint),
+            texture(1, float),
+            texture(2, float),
+        ],
     })
+}
+
+/// World position of the surface seen at `pixel` at view-space `depth` (the mirror of
+/// `load_surface` in `common/gbuffer.wgsl`): the camera position plus `depth` times the ray
+/// through the pixel's centre scaled to unit view-space depth.
+pub fn reconstruct_position(
+    view: Mat4,
+    proj: Mat4,
+    eye: Vec3,
+    size: UVec2,
+    pixel: UVec2,
+    depth: f32,
+) -> Vec3 {
+    let ndc_x = (pixel.x as f32 + 0.5) / size.x as f32 * 2.0 - 1.0;
+    let ndc_y = 1.0 - (pixel.y as f32 + 0.5) / size.y as f32 * 2.0;
+    let view_ray = Vec3::new(ndc_x / proj.x_axis.x, ndc_y / proj.y_axis.y, -1.0);
+    let rotation = glam::Mat3::from_mat4(view);
+    eye + rotation.transpose() * view_ray * depth
 }
 
 fn target(
@@ -71,7 +101,8 @@ impl GBuffer {
             aspect: wgpu::TextureAspect::DepthOnly,
             ..Default::default()
         });
-        let (position, position_view) = target(device, "gbuffer position", size, POSITION_FORMAT);
+        let (view_depth, view_depth_view) =
+            target(device, "gbuffer view depth", size, VIEW_DEPTH_FORMAT);
         let (normal, normal_view) = target(device, "gbuffer normal", size, NORMAL_FORMAT);
         let (albedo, albedo_view) = target(device, "gbuffer albedo", size, ALBEDO_FORMAT);
         let layout = gbuffer_layout(device);
@@ -81,7 +112,7 @@ impl GBuffer {
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&position_view),
+                    resource: wgpu::BindingResource::TextureView(&view_depth_view),
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
@@ -98,8 +129,8 @@ impl GBuffer {
             depth,
             depth_view,
             depth_sample_view,
-            position,
-            position_view,
+            view_depth,
+            view_depth_view,
             normal,
             normal_view,
             albedo,
@@ -163,7 +194,7 @@ impl GBufferPass {
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
                 targets: &[
-                    color(POSITION_FORMAT),
+                    color(VIEW_DEPTH_FORMAT),
                     color(NORMAL_FORMAT),
                     color(ALBEDO_FORMAT),
                 ],
@@ -195,7 +226,7 @@ impl GBufferPass {
             })
         };
         let attachments = [
-            clear(&gbuffer.position_view),
+            clear(&gbuffer.view_depth_view),
             clear(&gbuffer.normal_view),
             clear(&gbuffer.albedo_view),
         ];
@@ -220,5 +251,50 @@ impl GBufferPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &frame.bind_group, &[]);
         buffers.draw_objects(&mut pass, scene, false);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Camera;
+    use glam::Vec4Swizzles;
+
+    #[test]
+    fn reconstructed_positions_lie_on_the_pixel_ray_at_the_stored_depth() {
+        let camera = Camera {
+            position: Vec3::new(6.0, 4.8, 7.5),
+            target: Vec3::new(-0.5, 1.4, -0.5),
+            fov_y: 50f32.to_radians(),
+            near: 0.1,
+            far: 600.0,
+        };
+        let size = UVec2::new(320, 200);
+        let view = camera.view();
+        let proj = camera.projection(size.x as f32 / size.y as f32);
+        for (pixel, depth) in [
+            (UVec2::new(0, 0), 1.0),
+            (UVec2::new(160, 100), 12.5),
+            (UVec2::new(319, 199), 0.2),
+            (UVec2::new(37, 151), 480.0),
+        ] {
+            let p = reconstruct_position(view, proj, camera.position, size, pixel, depth);
+            let view_space = view * p.extend(1.0);
+            assert!(
+                (-view_space.z - depth).abs() <= 1e-5 * depth,
+                "{pixel} {depth}"
+            );
+            let clip = proj * view_space;
+            let ndc = clip.xy() / clip.w;
+            let screen = glam::Vec2::new(
+                (ndc.x + 1.0) * 0.5 * size.x as f32,
+                (1.0 - ndc.y) * 0.5 * size.y as f32,
+            );
+            let centre = pixel.as_vec2() + 0.5;
+            assert!(
+                screen.distance(centre) < 1e-3,
+                "{pixel}: {screen} vs {centre}"
+            );
+        }
     }
 }

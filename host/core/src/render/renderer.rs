@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use glam::{UVec2, Vec3, Vec4};
 
-use super::debug_view::{DEBUG_TARGET_FORMAT, DebugSource, DebugViewPass};
-use super::frame::FrameBindings;
+use super::debug_view::{DebugSource, DebugViewPass};
+use super::frame::{CameraMatrices, FrameBindings};
 use super::gbuffer::{GBuffer, GBufferPass};
 use super::lighting::{LightingPass, OUTPUT_FORMAT};
 use super::scene_buffers::SceneBuffers;
@@ -118,7 +118,6 @@ pub struct Renderer {
     indirect: IndirectTarget,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
-    output_debug_view: wgpu::TextureView,
     gbuffer_pass: GBufferPass,
     lighting: LightingPass,
     lighting_inputs: wgpu::BindGroup,
@@ -128,10 +127,7 @@ pub struct Renderer {
     technique: ActiveTechnique,
 }
 
-fn create_output(
-    gpu: &GpuContext,
-    size: UVec2,
-) -> (wgpu::Texture, wgpu::TextureView, wgpu::TextureView) {
+fn create_output(gpu: &GpuContext, size: UVec2) -> (wgpu::Texture, wgpu::TextureView) {
     let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("output image"),
         size: wgpu::Extent3d {
@@ -146,18 +142,13 @@ fn create_output(
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[DEBUG_TARGET_FORMAT],
+        view_formats: &[],
     });
     let view = texture.create_view(&wgpu::TextureViewDescriptor {
         label: Some("output image view"),
         ..Default::default()
     });
-    let debug_view = texture.create_view(&wgpu::TextureViewDescriptor {
-        label: Some("output image view (linear, debug)"),
-        format: Some(DEBUG_TARGET_FORMAT),
-        ..Default::default()
-    });
-    (texture, view, debug_view)
+    (texture, view)
 }
 
 fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
@@ -265,7 +256,7 @@ impl Renderer {
         let slots = SlotAssignment::one_per_light(scene.lights.len());
         let visibility = VisibilityTargets::new(&gpu, size, slots);
         let indirect = IndirectTarget::new(&gpu, size);
-        let (output, output_view, output_debug_view) = create_output(&gpu, size);
+        let (output, output_view) = create_output(&gpu, size);
         let gbuffer_pass = GBufferPass::new(&gpu, &shaders, &frame)?;
         let lighting = LightingPass::new(&gpu, &shaders, &frame, &gbuffer)?;
         let lighting_inputs = lighting.inputs(&gpu, &visibility, &indirect);
@@ -285,7 +276,6 @@ impl Renderer {
             indirect,
             output,
             output_view,
-            output_debug_view,
             gbuffer_pass,
             lighting,
             lighting_inputs,
@@ -371,8 +361,7 @@ impl Renderer {
             self.size = size;
             self.gbuffer = GBuffer::new(&self.gpu, size);
             self.indirect = IndirectTarget::new(&self.gpu, size);
-            (self.output, self.output_view, self.output_debug_view) =
-                create_output(&self.gpu, size);
+            (self.output, self.output_view) = create_output(&self.gpu, size);
             self.visibility =
                 VisibilityTargets::new(&self.gpu, size, self.visibility.slots.clone());
             self.lighting_inputs =
@@ -496,13 +485,8 @@ impl Renderer {
             ),
             other => {
                 let source = self.debug_source(other)?;
-                self.debug.record(
-                    &self.gpu,
-                    &mut recorder,
-                    &self.output_debug_view,
-                    &source,
-                    None,
-                );
+                self.debug
+                    .record(&self.gpu, &mut recorder, &self.output_view, &source, None);
             }
         }
         if let Some(overlay) = overlay {
@@ -510,7 +494,7 @@ impl Renderer {
             self.debug.record(
                 &self.gpu,
                 &mut recorder,
-                &self.output_debug_view,
+                &self.output_view,
                 &source,
                 Some(overlay.opacity),
             );
@@ -675,13 +659,35 @@ impl Renderer {
 
     /// World positions and normals per pixel.
     pub fn read_gbuffer(&self) -> GBufferData {
-        let positions = readback::f32s(&readback::read_texture(
+        let depths = readback::f32s(&readback::read_texture(
             &self.gpu,
-            &self.gbuffer.position,
+            &self.gbuffer.view_depth,
             0,
             wgpu::TextureAspect::All,
-            16,
+            4,
         ));
+        let matrices = CameraMatrices::new(&self.camera, self.size);
+        let width = self.size.x.max(1);
+        let positions = depths
+            .iter()
+            .enumerate()
+            .map(|(i, &depth)| {
+                if depth > 0.0 {
+                    let pixel = UVec2::new(i as u32 % width, i as u32 / width);
+                    super::gbuffer::reconstruct_position(
+                        matrices.view,
+                        matrices.proj,
+                        self.camera.position,
+                        self.size,
+                        pixel,
+                        depth,
+                    )
+                    .extend(1.0)
+                } else {
+                    Vec4::ZERO
+                }
+            })
+            .collect();
         let normals = readback::f16s(&readback::read_texture(
             &self.gpu,
             &self.gbuffer.normal,
@@ -698,7 +704,7 @@ impl Renderer {
         );
         GBufferData {
             size: self.size,
-            positions: positions.chunks_exact(4).map(Vec4::from_slice).collect(),
+            positions,
             normals: normals
                 .chunks_exact(4)
                 .map(|n| Vec3::new(n[0], n[1], n[2]))

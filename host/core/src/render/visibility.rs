@@ -127,7 +127,7 @@ impl VisibilityTargets {
             size: wgpu::Extent3d {
                 width: size.x,
                 height: size.y,
-                depth_or_array_layers: layers,
+                depth_or_array_layers: crate::gpu::array_layers(gpu, size.x, size.y, layers),
             },
             mip_level_count: 1,
             sample_count: 1,
@@ -142,6 +142,7 @@ impl VisibilityTargets {
         let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some("visibility slots (array)"),
             dimension: Some(wgpu::TextureViewDimension::D2Array),
+            array_layer_count: Some(layers),
             ..Default::default()
         });
         let layer_views = (0..layers)

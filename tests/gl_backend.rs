@@ -1,0 +1,183 @@
+//! The host and the techniques on wgpu's GL backend (a machine with only an OpenGL driver, and
+//! later WebGL2): the same frames as on Vulkan, and techniques that need more are reported as
+//! unavailable with the reason instead of failing.
+
+use std::sync::Arc;
+
+use glam::UVec2;
+use shadow_zoo::contact_sheet::{self, Layout};
+use zoo_host::judging::DEFAULT_SAMPLES;
+use zoo_host::params::ParamValues;
+use zoo_host::test_support::{gpu, scene_path};
+use zoo_host::{
+    Changes, GpuContext, LightKind, PassInfo, PassRecorder, RenderContext, Renderer, Scene,
+    ShadowTechnique, TechniqueError, View,
+};
+
+/// A test-only technique that needs view formats, which wgpu's GL backend lacks.
+struct NeedsViewFormats;
+
+impl ShadowTechnique for NeedsViewFormats {
+    fn passes(&self) -> Vec<PassInfo> {
+        Vec::new()
+    }
+    fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> Result<(), TechniqueError> {
+        Ok(())
+    }
+    fn record(
+        &mut self,
+        _: &RenderContext<'_>,
+        _: &mut PassRecorder<'_>,
+    ) -> Result<(), TechniqueError> {
+        Ok(())
+    }
+}
+
+zoo_host::register_technique! {
+    id: "test-needs-view-formats",
+    name: "Test: needs view formats",
+    description: "Declares a downlevel capability the GL backend lacks (test only)",
+    source: "test",
+    light_kinds: &[LightKind::Point],
+    required_downlevel: || zoo_host::wgpu::DownlevelFlags::VIEW_FORMATS,
+    create: |_, _| Ok(Box::new(NeedsViewFormats)),
+}
+
+/// A context on the GL backend, or `None` (with the reason printed) where there is none.
+fn gl() -> Option<Arc<GpuContext>> {
+    match GpuContext::new_headless_on(zoo_host::wgpu::Backends::GL) {
+        Ok(gpu) => {
+            eprintln!("GL tests run on {}", gpu.describe());
+            Some(Arc::new(gpu))
+        }
+        Err(e) => {
+            eprintln!("SKIPPED: no usable GL adapter on this machine ({e})");
+            None
+        }
+    }
+}
+
+/// Fraction of pixels that differ by more than `threshold` in any channel.
+fn differing(a: &image::RgbaImage, b: &image::RgbaImage, threshold: u8) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    a.pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > threshold))
+        .count() as f64
+        / a.pixels().len() as f64
+}
+
+/// One point light: six square shadow-map layers and one visibility layer, the sizes from
+/// which wgpu's GL backend would guess a cube map or a plain 2D texture.
+const ONE_POINT_LIGHT: &str = "(
+    camera: (position: (3, 4.5, 4), target: (0, 0.3, 0), fov_y_degrees: 50),
+    lights: [Point(position: (1.5, 5, 1), intensity: 40, range: 50)],
+    objects: [(mesh: Plane(size: 10), receiver: true),
+              (mesh: Sphere(radius: 0.7), transform: (translation: (0, 1.2, 0)))],
+)";
+
+#[test]
+fn every_technique_renders_on_gl_as_on_vulkan() {
+    let Some(gl) = gl() else { return };
+    let scenes = [
+        Scene::load(&scene_path("planar-room.ron")).unwrap(),
+        zoo_host::test_support::scene_from_ron("one-point-light.ron", ONE_POINT_LIGHT),
+    ];
+    for scene in scenes {
+        compare_backends(&gl, scene);
+    }
+}
+
+fn compare_backends(gl: &Arc<GpuContext>, scene: Scene) {
+    let size = UVec2::new(128, 96);
+    let mut on_gl = Renderer::new(gl.clone(), scene.clone(), size).unwrap();
+    let mut on_vulkan = Renderer::new(gpu(), scene, size).unwrap();
+    for registration in zoo_host::registry() {
+        if registration.id.starts_with("test-") {
+            continue;
+        }
+        assert_eq!(
+            registration.unavailable_reason(gl),
+            None,
+            "{} should run on GL",
+            registration.id
+        );
+        let values = zoo_host::params::defaults(&(registration.params)());
+        let frame = |renderer: &mut Renderer| {
+            renderer.set_technique(registration.id, &values).unwrap();
+            renderer.render(&View::Final).unwrap();
+            assert_eq!(renderer.technique().id, registration.id, "disabled");
+            renderer.read_output()
+        };
+        let (a, b) = (frame(&mut on_gl), frame(&mut on_vulkan));
+        let off = differing(&a, &b, 3);
+        eprintln!(
+            "{}: {off} of the pixels differ by more than 3/255",
+            registration.id
+        );
+        assert!(
+            off <= 0.001,
+            "{}: GL and Vulkan differ in {off}",
+            registration.id
+        );
+        assert!(gl.take_uncaptured_errors().is_empty());
+    }
+}
+
+#[test]
+fn the_default_render_on_gl_matches_vulkan() {
+    let Some(gl) = gl() else { return };
+    let tile = UVec2::new(96, 64);
+    let sheet = |gpu: Arc<GpuContext>| {
+        let (available, _) = contact_sheet::available_techniques(&gpu);
+        let techniques: Vec<_> = available
+            .into_iter()
+            .filter(|r| !r.id.starts_with("test-"))
+            .map(|r| (r, zoo_host::params::defaults(&(r.params)())))
+            .collect();
+        let scene = shadow_zoo::commands::load_scene(None).unwrap();
+        let mut renderer = Renderer::new(gpu, scene, tile).unwrap();
+        contact_sheet::build(&mut renderer, &techniques, DEFAULT_SAMPLES, |_| {}).unwrap()
+    };
+    let (a, b) = (sheet(gl), sheet(gpu()));
+    let ids = |s: &contact_sheet::Sheet| s.rows.iter().map(|r| r.id.clone()).collect::<Vec<_>>();
+    assert_eq!(ids(&a), ids(&b));
+    for (i, row) in a.rows.iter().enumerate() {
+        let off = differing(&a.images[i], &b.images[i], 3);
+        assert!(
+            off <= 0.001,
+            "tile {}: GL and Vulkan differ in {off}",
+            row.id
+        );
+        assert_eq!(
+            a.rows[i].summary.is_some(),
+            b.rows[i].summary.is_some(),
+            "{}",
+            row.id
+        );
+        if let (Some(x), Some(y)) = (a.rows[i].summary, b.rows[i].summary) {
+            assert!((x.mae - y.mae).abs() < 1e-3, "{}: {x:?} vs {y:?}", row.id);
+        }
+    }
+    let layout = Layout::new((tile.x, tile.y), a.images.len());
+    assert_eq!(contact_sheet::draw(&a).unwrap().dimensions(), layout.size());
+}
+
+#[test]
+fn techniques_that_need_more_than_gl_offers_are_unavailable_with_the_reason() {
+    let Some(gl) = gl() else { return };
+    let registration = zoo_host::find_technique("test-needs-view-formats").unwrap();
+    let reason = registration.unavailable_reason(&gl).unwrap();
+    assert!(
+        reason.contains("VIEW_FORMATS") && reason.contains("Gl backend"),
+        "{reason}"
+    );
+    let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
+    let mut renderer = Renderer::new(gl, scene, UVec2::new(32, 32)).unwrap();
+    let err = renderer
+        .set_technique("test-needs-view-formats", &ParamValues::new())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("VIEW_FORMATS"), "{err}");
+    assert_eq!(renderer.technique().id, "unshadowed");
+}
