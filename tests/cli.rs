@@ -305,7 +305,7 @@ fn no_usable_adapter_gives_one_clear_message() {
         assert!(!out.status.success(), "{all}");
         assert!(all.contains("error: no graphics adapter found"), "{all}");
         assert!(
-            all.contains("Shadow Zoo needs a Vulkan, Metal or DX12 adapter")
+            all.contains("Shadow Zoo needs a Vulkan, Metal, DX12 or OpenGL adapter")
                 && all.contains("sudo apt-get install -y mesa-vulkan-drivers"),
             "{all}"
         );

@@ -217,6 +217,31 @@ fn debug_views_render_and_unknown_views_are_errors() {
         let image = renderer.read_output();
         assert!(image.pixels().any(|p| p.0[0] > 20), "{view} is black");
     }
+    // Views show their values as stored bytes (the output is sRGB; the view shader decodes
+    // first): the albedo view holds the G-buffer's albedo exactly, mid values included.
+    renderer.render(&View::Albedo).unwrap();
+    let shown = renderer.read_output();
+    let g = renderer.read_gbuffer();
+    let mut checked = 0;
+    for (i, pixel) in shown.pixels().enumerate() {
+        if g.positions[i].w < 0.5 {
+            continue;
+        }
+        let albedo = g.materials[i].albedo * 255.0;
+        for c in 0..3 {
+            assert!(
+                (pixel.0[c] as f32 - albedo[c]).abs() <= 1.5,
+                "pixel {i} channel {c}: shown {} for albedo {}",
+                pixel.0[c],
+                albedo[c]
+            );
+        }
+        checked += usize::from((40.0..215.0).contains(&albedo.x));
+    }
+    assert!(
+        checked > 100,
+        "too few mid-grey albedo pixels checked: {checked}"
+    );
     // Unshadowed: visibility is 1 everywhere, shown white.
     renderer.render(&View::Visibility { light: 0 }).unwrap();
     assert!(renderer.read_output().pixels().all(|p| p.0[0] == 255));

@@ -16,13 +16,18 @@ struct Surface {
     valid: bool,
 }
 
-// World-space ray through the centre of `pixel`, scaled to unit view-space depth.
+// World-space ray through the centre of full-resolution `pixel`, scaled to unit view-space
+// depth (any perspective projection, off-centre ones included).
 fn pixel_ray(pixel: vec2<i32>) -> vec3<f32> {
     let ndc = vec2<f32>(
         (f32(pixel.x) + 0.5) / camera.size.x * 2.0 - 1.0,
         1.0 - (f32(pixel.y) + 0.5) / camera.size.y * 2.0,
     );
-    let view_ray = vec3<f32>(ndc.x / camera.proj[0][0], ndc.y / camera.proj[1][1], -1.0);
+    let view_ray = vec3<f32>(
+        (ndc.x + camera.proj[2][0]) / camera.proj[0][0],
+        (ndc.y + camera.proj[2][1]) / camera.proj[1][1],
+        -1.0,
+    );
     let rotation = mat3x3<f32>(camera.view[0].xyz, camera.view[1].xyz, camera.view[2].xyz);
     return transpose(rotation) * view_ray;
 }

@@ -144,6 +144,13 @@ fn render_sheet(args: &RenderArgs) -> anyhow::Result<()> {
         .save(&args.out)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     print!("{}", contact_sheet::table(&sheet));
+    if args.timings {
+        for row in &sheet.rows {
+            if let Some(timings) = &row.timings {
+                print!("{}: {}", row.id, format_timings(timings));
+            }
+        }
+    }
     println!(
         "false shadow / false lit: fractions of the pixels each light reaches, leaving out the \
          one-pixel band at reference shadow edges; mae: against the area-light reference; \

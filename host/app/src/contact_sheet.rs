@@ -51,10 +51,12 @@ pub struct Row {
     pub id: String,
     /// Human-readable name.
     pub name: String,
-    /// GPU time of the whole frame, and of the technique's own passes (ms); for the reference,
-    /// the CPU tracing time.
+    /// GPU time of the whole frame, and of the technique's own passes (ms); `None` for the
+    /// reference, whose tracing time is in `note`.
     pub frame_ms: Option<f64>,
     pub technique_ms: Option<f64>,
+    /// The technique's pass timings.
+    pub timings: Option<zoo_host::gpu::FrameTimings>,
     pub summary: Option<Summary>,
     /// Lights the technique does not support (rendered unshadowed, not scored).
     pub unsupported: Vec<usize>,
@@ -95,7 +97,12 @@ impl Row {
                 "false shadow {:.4}  false lit {:.4}  mae {:.4}",
                 s.false_shadow_core, s.false_lit_core, s.mae
             )),
-            None if self.id.starts_with("reference") => lines.push("exact (the judge)".to_string()),
+            None if self.id == "reference (hard)" => {
+                lines.push("the judge's exact visibility".to_string())
+            }
+            None if self.id.starts_with("reference") => {
+                lines.push("the judge's soft reference (mae baseline)".to_string())
+            }
             None => lines.push("not scored: no supported light".to_string()),
         }
         if !self.unsupported.is_empty() {
@@ -156,6 +163,7 @@ pub fn build(
         name,
         frame_ms: None,
         technique_ms: None,
+        timings: None,
         summary: None,
         unsupported: Vec::new(),
         failure: None,
@@ -184,6 +192,7 @@ pub fn build(
                     name: registration.name.to_string(),
                     frame_ms: Some(judged.timings.frame_total()),
                     technique_ms: Some(judged.gpu_ms),
+                    timings: Some(judged.timings.clone()),
                     summary: Summary::of(&judged),
                     unsupported: judged
                         .scores
@@ -202,6 +211,7 @@ pub fn build(
                     name: registration.name.to_string(),
                     frame_ms: None,
                     technique_ms: None,
+                    timings: None,
                     summary: None,
                     unsupported: Vec::new(),
                     failure: Some(e.to_string()),
@@ -329,7 +339,10 @@ pub fn draw(sheet: &Sheet) -> anyhow::Result<RgbImage> {
             let y_text = y0 + tile.1 + text / 4;
             for (k, label) in row.label_lines().iter().enumerate() {
                 let style = if k == 0 { &primary } else { &secondary };
-                let clipped = clip_to_width(label, tile.0, text);
+                let clipped = clip_to_width(label, tile.0, |t| {
+                    root.estimate_text_size(t, style)
+                        .map_or(u32::MAX, |(w, _)| w)
+                });
                 root.draw_text(
                     &clipped,
                     style,
@@ -343,15 +356,19 @@ pub fn draw(sheet: &Sheet) -> anyhow::Result<RgbImage> {
     RgbImage::from_raw(width, height, buffer).context("sheet buffer size")
 }
 
-/// Shortens `text` so that it fits `width` pixels at `text_px` (a conservative estimate).
-fn clip_to_width(text: &str, width: u32, text_px: u32) -> String {
-    let max_chars = (width as usize * 2) / text_px.max(1) as usize;
-    if text.chars().count() <= max_chars {
+/// Shortens `text` (ending it with an ellipsis) until `measure` says it fits `width` pixels.
+fn clip_to_width(text: &str, width: u32, measure: impl Fn(&str) -> u32) -> String {
+    if measure(text) <= width {
         return text.to_string();
     }
-    let mut out: String = text.chars().take(max_chars.saturating_sub(1)).collect();
-    out.push('…');
-    out
+    let chars: Vec<char> = text.chars().collect();
+    for keep in (0..chars.len()).rev() {
+        let candidate: String = chars[..keep].iter().chain(['…'].iter()).collect();
+        if measure(&candidate) <= width {
+            return candidate;
+        }
+    }
+    String::new()
 }
 
 /// The sheet's numbers as a text table.
@@ -410,9 +427,12 @@ mod tests {
 
     #[test]
     fn long_labels_are_clipped_to_the_tile() {
-        assert_eq!(clip_to_width("short", 200, 10), "short");
-        let clipped = clip_to_width(&"x".repeat(100), 100, 10);
-        assert_eq!(clipped.chars().count(), 20);
+        // A monospaced measure: 6 px a character.
+        let measure = |t: &str| 6 * t.chars().count() as u32;
+        assert_eq!(clip_to_width("short", 200, measure), "short");
+        let clipped = clip_to_width(&"x".repeat(100), 100, measure);
+        assert_eq!(clipped.chars().count(), 16);
         assert!(clipped.ends_with('…'));
+        assert_eq!(clip_to_width("wide", 3, measure), "");
     }
 }

@@ -116,13 +116,21 @@ impl TechniqueRegistration {
     }
 }
 
-/// Every registered technique, sorted by id. Duplicate ids are a programming error and panic at
-/// first use with both descriptions named.
+/// Every registered technique, sorted by id. Duplicate ids, and registrations without an id, a
+/// name or light kinds, are programming errors and panic at first use, naming the package or
+/// both descriptions.
 pub fn registry() -> Vec<&'static TechniqueRegistration> {
     let mut all: Vec<_> = inventory::iter::<TechniqueRegistration>
         .into_iter()
         .collect();
     all.sort_by_key(|r| r.id);
+    for r in &all {
+        assert!(
+            !r.id.is_empty() && !r.name.is_empty() && !r.light_kinds.is_empty(),
+            "a technique registered by {} lacks an id, a name or light kinds",
+            r.package
+        );
+    }
     for pair in all.windows(2) {
         assert!(
             pair[0].id != pair[1].id,
@@ -148,9 +156,10 @@ pub fn find_technique(id: &str) -> Result<&'static TechniqueRegistration, Techni
 }
 
 /// Registers a technique. Takes the fields of [`TechniqueRegistration`] except `package`,
-/// which is set to the calling crate's package name; fields left out take their
-/// [`TechniqueRegistration::DEFAULTS`] (no features or downlevel needs, WebGPU's downlevel
-/// limits, no parameters):
+/// which is set to the calling crate's package name. `id`, `name`, `description`, `source`,
+/// `light_kinds` and `create` are required (the registry rejects a registration without an
+/// id, name or light kinds); the others default to [`TechniqueRegistration::DEFAULTS`] (no
+/// features or downlevel needs, WebGPU's downlevel limits, no parameters):
 ///
 /// ```ignore
 /// zoo_host::register_technique! {

@@ -18,7 +18,7 @@ const CANONICAL_SIZE: f32 = 1024.0;
 /// found by one path and not another. The judge offsets origins by 2e-5 of the diagonal.
 const CANONICAL_TMIN: f32 = 2e-4;
 /// Padding of the triangles' boxes in the BVH (canonical units, 4e-6 of the diagonal): about
-/// 30 ulps of the largest canonical coordinate.
+/// 65 ulps of the largest canonical coordinate (512).
 const BOX_PADDING: f32 = 4e-3;
 
 /// The occluding geometry of a scene.
@@ -154,14 +154,17 @@ impl Occluders {
     }
 }
 
-/// Whether a triangle has no area at f32 precision (its edges are parallel within 1e-6 rad).
-/// Such a triangle cannot occlude anything, but the ray-triangle test divides by its
-/// vanishing normal and reports hits far outside it.
+/// Whether a triangle has no area at f32 precision: its height over its longest edge is below
+/// 1e-6 of that edge (whatever the vertex order). Such a triangle cannot occlude anything, but
+/// the ray-triangle test divides by its vanishing normal and reports hits far outside it.
 fn is_degenerate(t: &Triangle) -> bool {
-    let (e1, e2) = (t.v1 - t.v0, t.v2 - t.v0);
-    let n = e1.cross(e2).length();
-    // NaN (non-finite corners) counts as degenerate too.
-    n.partial_cmp(&(1e-6 * e1.length() * e2.length())) != Some(std::cmp::Ordering::Greater)
+    let twice_area = (t.v1 - t.v0).cross(t.v2 - t.v0).length();
+    let longest = [t.v1 - t.v0, t.v2 - t.v1, t.v0 - t.v2]
+        .map(|e| e.length_squared())
+        .into_iter()
+        .fold(0.0f32, f32::max);
+    // height / longest = twice_area / longest^2; NaN (non-finite corners) is degenerate too.
+    twice_area.partial_cmp(&(1e-6 * longest)) != Some(std::cmp::Ordering::Greater)
 }
 
 /// The reciprocal of a direction component for slab tests: exact except that it stays finite
@@ -371,6 +374,26 @@ mod tests {
         ]];
         let o = Occluders::from_triangles(&collinear, 10.0);
         assert!(o.is_empty());
+        // The same in every vertex order, and a sliver whose thin angle is at any corner.
+        let [a, b, c] = collinear[0];
+        for tri in [[b, c, a], [c, a, b], [a, c, b]] {
+            assert!(Occluders::from_triangles(&[tri], 10.0).is_empty());
+        }
+        let sliver = [
+            Vec3::ZERO,
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::new(5.0, 1e-6, 0.0),
+        ];
+        let [a, b, c] = sliver;
+        for tri in [[a, b, c], [b, c, a], [c, a, b]] {
+            assert!(Occluders::from_triangles(&[tri], 10.0).is_empty());
+        }
+        let thin_but_real = [
+            Vec3::ZERO,
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::new(5.0, 1e-3, 0.0),
+        ];
+        assert_eq!(Occluders::from_triangles(&[thin_but_real], 10.0).len(), 1);
         assert!(!o.occluded(
             Vec3::new(-2.0, 6.0, -3.0),
             Vec3::new(-1e-7, -1e-7, -1.0),

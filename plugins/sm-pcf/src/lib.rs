@@ -173,6 +173,8 @@ struct Pipelines {
 
 struct Maps {
     resolution: u32,
+    /// Layers in use (the texture may hold a spare one, see `zoo_host::gpu::array_layers`).
+    layers: u32,
     texture: wgpu::Texture,
     layer_views: Vec<wgpu::TextureView>,
     array_view: wgpu::TextureView,
@@ -430,9 +432,10 @@ impl ShadowMaps {
         }
         let layers_allocated =
             zoo_host::gpu::array_layers(ctx.gpu, resolution, resolution, layers_needed);
-        let reuse = self.maps.as_ref().is_some_and(|m| {
-            m.resolution == resolution && m.texture.depth_or_array_layers() == layers_allocated
-        });
+        let reuse = self
+            .maps
+            .as_ref()
+            .is_some_and(|m| m.resolution == resolution && m.layers == layers_needed);
         if !reuse {
             let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("sm-pcf shadow maps"),
@@ -468,6 +471,7 @@ impl ShadowMaps {
             });
             self.maps = Some(Maps {
                 resolution,
+                layers: layers_needed,
                 texture,
                 layer_views,
                 array_view,

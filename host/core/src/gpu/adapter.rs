@@ -5,26 +5,28 @@
 //! Vulkan, Metal and DX12 come before other backends, then discrete before integrated, virtual
 //! and CPU devices. When none qualifies, the error lists every adapter found with its reasons.
 
-use crate::render::gbuffer::{ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, VIEW_DEPTH_FORMAT};
-use crate::render::lighting::OUTPUT_FORMAT;
-use crate::render::visibility::{INDIRECT_FORMAT, VISIBILITY_FORMAT};
+use crate::render::gbuffer::{
+    ALBEDO_FORMAT, DEPTH_FORMAT, GBUFFER_USAGE, NORMAL_FORMAT, VIEW_DEPTH_FORMAT,
+};
+use crate::render::lighting::{OUTPUT_FORMAT, OUTPUT_USAGE};
+use crate::render::visibility::{INDIRECT_FORMAT, VISIBILITY_FORMAT, VISIBILITY_USAGE};
 
 /// Downlevel capabilities the host's own passes rely on (storage buffers of per-frame data
 /// read in vertex shaders). Techniques declare what they need beyond this.
 pub const HOST_DOWNLEVEL_FLAGS: wgpu::DownlevelFlags = wgpu::DownlevelFlags::VERTEX_STORAGE;
 
-/// Usages the host needs for each of its texture formats.
+/// Usages the host creates each of its texture formats with (the constants its textures are
+/// created from, so the check cannot drift from the code).
 pub fn host_formats() -> [(wgpu::TextureFormat, wgpu::TextureUsages); 7] {
-    use wgpu::TextureUsages as U;
-    let target = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
+    let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
     [
-        (VIEW_DEPTH_FORMAT, target),
-        (NORMAL_FORMAT, target),
-        (ALBEDO_FORMAT, target),
-        (DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING),
-        (VISIBILITY_FORMAT, target),
-        (INDIRECT_FORMAT, target),
-        (OUTPUT_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC),
+        (VIEW_DEPTH_FORMAT, GBUFFER_USAGE),
+        (NORMAL_FORMAT, GBUFFER_USAGE),
+        (ALBEDO_FORMAT, GBUFFER_USAGE),
+        (DEPTH_FORMAT, GBUFFER_USAGE),
+        (VISIBILITY_FORMAT, VISIBILITY_USAGE),
+        (INDIRECT_FORMAT, attachment),
+        (OUTPUT_FORMAT, OUTPUT_USAGE),
     ]
 }
 
@@ -118,8 +120,9 @@ fn describe_rejections(rejected: &[Rejected]) -> String {
 /// How to get a driver that runs Shadow Zoo on this platform.
 pub fn install_hint() -> String {
     let fix = if cfg!(target_os = "linux") {
-        "On Linux without a suitable GPU driver install Mesa's Vulkan software driver (lavapipe): \
-         `sudo apt-get install -y mesa-vulkan-drivers` (Fedora: `sudo dnf install mesa-vulkan-drivers`)"
+        "On Linux without a suitable GPU driver install Mesa's software drivers: \
+         `sudo apt-get install -y mesa-vulkan-drivers libegl-mesa0` (Fedora: \
+         `sudo dnf install mesa-vulkan-drivers mesa-libEGL`)"
     } else if cfg!(target_os = "windows") {
         "On Windows update the GPU driver (DX12 or Vulkan); without a GPU, WARP comes with Windows 10 and later"
     } else if cfg!(target_os = "macos") {
@@ -127,7 +130,7 @@ pub fn install_hint() -> String {
     } else {
         "Install a Vulkan driver"
     };
-    format!("Shadow Zoo needs a Vulkan, Metal or DX12 adapter. {fix}.")
+    format!("Shadow Zoo needs a Vulkan, Metal, DX12 or OpenGL adapter. {fix}.")
 }
 
 /// Chooses the best adapter among `adapters` that can run the host, honouring

@@ -43,8 +43,9 @@ pub struct DebugViewPass {
     params: wgpu::Buffer,
 }
 
-/// Format the debug view writes: the output image's (the shader decodes sRGB first, so the
-/// stored bytes are the view's values).
+/// Format the debug view writes: the output image's. The shader decodes sRGB first, so a
+/// full-screen view stores its values as bytes; an overlay blends with the final image in
+/// linear light (the blend of an sRGB target), as the image's own colours would.
 pub const DEBUG_TARGET_FORMAT: wgpu::TextureFormat = super::lighting::OUTPUT_FORMAT;
 
 impl DebugViewPass {

@@ -55,6 +55,10 @@ pub struct CameraMatrices {
     pub view: Mat4,
     pub proj: Mat4,
     pub view_proj: Mat4,
+    /// Camera position.
+    pub eye: Vec3,
+    /// Output size the projection was made for.
+    pub size: UVec2,
 }
 
 impl CameraMatrices {
@@ -66,6 +70,8 @@ impl CameraMatrices {
             view,
             proj,
             view_proj: proj * view,
+            eye: camera.position,
+            size,
         }
     }
 }

@@ -4,11 +4,12 @@
 //! the camera's forward axis, as f32 bits in an `R32Uint` target, which every backend can render
 //! to) and the position is rebuilt from the ray through the pixel's centre, on the GPU by
 //! `load_surface` in `common/gbuffer.wgsl` and on the CPU by [`reconstruct_position`]. That is
-//! 4 bytes a pixel instead of 16, exact to f32 precision at any distance.
+//! 4 bytes a pixel instead of 16, within a few ulps of the view depth at any distance. Passes
+//! that read the G-buffer do so at full resolution (one pixel of the output per texel).
 
-use glam::{Mat4, UVec2, Vec3};
+use glam::{UVec2, Vec3};
 
-use super::frame::FrameBindings;
+use super::frame::{CameraMatrices, FrameBindings};
 use super::scene_buffers::{SceneBuffers, Vertex};
 use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
 use crate::scene::Scene;
@@ -19,6 +20,10 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusSt
 pub const VIEW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// World normal (xyz) and shininess / 256 (w).
 pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// How every G-buffer texture is used: drawn, sampled, copied for readback.
+pub const GBUFFER_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+    .union(wgpu::TextureUsages::TEXTURE_BINDING)
+    .union(wgpu::TextureUsages::COPY_SRC);
 /// Albedo (rgb) and specular strength (a).
 pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
@@ -64,22 +69,22 @@ pub fn gbuffer_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-/// World position of the surface seen at `pixel` at view-space `depth` (the mirror of
-/// `load_surface` in `common/gbuffer.wgsl`): the camera position plus `depth` times the ray
-/// through the pixel's centre scaled to unit view-space depth.
-pub fn reconstruct_position(
-    view: Mat4,
-    proj: Mat4,
-    eye: Vec3,
-    size: UVec2,
-    pixel: UVec2,
-    depth: f32,
-) -> Vec3 {
+/// World position of the surface seen at full-resolution `pixel` at view-space `depth` (the
+/// mirror of `load_surface` in `common/gbuffer.wgsl`): the camera position plus `depth` times
+/// the ray through the pixel's centre scaled to unit view-space depth. Any perspective
+/// projection works, off-centre (jittered) ones included.
+pub fn reconstruct_position(matrices: &CameraMatrices, pixel: UVec2, depth: f32) -> Vec3 {
+    let (size, proj) = (matrices.size.max(UVec2::ONE), matrices.proj);
     let ndc_x = (pixel.x as f32 + 0.5) / size.x as f32 * 2.0 - 1.0;
     let ndc_y = 1.0 - (pixel.y as f32 + 0.5) / size.y as f32 * 2.0;
-    let view_ray = Vec3::new(ndc_x / proj.x_axis.x, ndc_y / proj.y_axis.y, -1.0);
-    let rotation = glam::Mat3::from_mat4(view);
-    eye + rotation.transpose() * view_ray * depth
+    // Clip x = p00 x + p20 z with z = -1 on the unit-depth ray, and w = 1.
+    let view_ray = Vec3::new(
+        (ndc_x + proj.z_axis.x) / proj.x_axis.x,
+        (ndc_y + proj.z_axis.y) / proj.y_axis.y,
+        -1.0,
+    );
+    let rotation = glam::Mat3::from_mat4(matrices.view);
+    matrices.eye + rotation.transpose() * view_ray * depth
 }
 
 fn target(
@@ -88,7 +93,8 @@ fn target(
     size: UVec2,
     format: wgpu::TextureFormat,
 ) -> (wgpu::Texture, wgpu::TextureView) {
-    crate::gpu::render_target(device, label, size, format, wgpu::TextureUsages::COPY_SRC)
+    // `render_target` adds the attachment and binding usages.
+    crate::gpu::render_target(device, label, size, format, GBUFFER_USAGE)
 }
 
 impl GBuffer {
@@ -270,15 +276,25 @@ mod tests {
             far: 600.0,
         };
         let size = UVec2::new(320, 200);
-        let view = camera.view();
-        let proj = camera.projection(size.x as f32 / size.y as f32);
+        let centred = CameraMatrices::new(&camera, size);
+        // A jittered (off-centre) projection, as temporal anti-aliasing would use.
+        let mut jittered = centred;
+        jittered.proj.z_axis.x += 0.37 * 2.0 / size.x as f32;
+        jittered.proj.z_axis.y -= 0.21 * 2.0 / size.y as f32;
+        for matrices in [centred, jittered] {
+            check_rays(&matrices);
+        }
+    }
+
+    fn check_rays(matrices: &CameraMatrices) {
+        let (view, proj, size) = (matrices.view, matrices.proj, matrices.size);
         for (pixel, depth) in [
             (UVec2::new(0, 0), 1.0),
             (UVec2::new(160, 100), 12.5),
             (UVec2::new(319, 199), 0.2),
             (UVec2::new(37, 151), 480.0),
         ] {
-            let p = reconstruct_position(view, proj, camera.position, size, pixel, depth);
+            let p = reconstruct_position(matrices, pixel, depth);
             let view_space = view * p.extend(1.0);
             assert!(
                 (-view_space.z - depth).abs() <= 1e-5 * depth,

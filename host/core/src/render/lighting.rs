@@ -7,6 +7,11 @@ use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
 
 /// Format of the final image.
 pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// How the output image is used: the lighting and debug passes draw it, the difference pass
+/// and the viewer sample it, readback copies it.
+pub const OUTPUT_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+    .union(wgpu::TextureUsages::TEXTURE_BINDING)
+    .union(wgpu::TextureUsages::COPY_SRC);
 
 /// Pipeline and layout of the lighting pass.
 pub struct LightingPass {

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::{UVec2, Vec3, Vec4};
 
 use super::debug_view::{DebugSource, DebugViewPass};
-use super::frame::{CameraMatrices, FrameBindings};
+use super::frame::FrameBindings;
 use super::gbuffer::{GBuffer, GBufferPass};
 use super::lighting::{LightingPass, OUTPUT_FORMAT};
 use super::scene_buffers::SceneBuffers;
@@ -139,9 +139,7 @@ fn create_output(gpu: &GpuContext, size: UVec2) -> (wgpu::Texture, wgpu::Texture
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format: OUTPUT_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
+        usage: super::lighting::OUTPUT_USAGE,
         view_formats: &[],
     });
     let view = texture.create_view(&wgpu::TextureViewDescriptor {
@@ -666,7 +664,8 @@ impl Renderer {
             wgpu::TextureAspect::All,
             4,
         ));
-        let matrices = CameraMatrices::new(&self.camera, self.size);
+        // The camera the G-buffer was rendered with (the last one uploaded).
+        let matrices = &self.frame.matrices;
         let width = self.size.x.max(1);
         let positions = depths
             .iter()
@@ -674,15 +673,7 @@ impl Renderer {
             .map(|(i, &depth)| {
                 if depth > 0.0 {
                     let pixel = UVec2::new(i as u32 % width, i as u32 / width);
-                    super::gbuffer::reconstruct_position(
-                        matrices.view,
-                        matrices.proj,
-                        self.camera.position,
-                        self.size,
-                        pixel,
-                        depth,
-                    )
-                    .extend(1.0)
+                    super::gbuffer::reconstruct_position(matrices, pixel, depth).extend(1.0)
                 } else {
                     Vec4::ZERO
                 }

@@ -12,6 +12,12 @@ use crate::scene::{Light, LightKind};
 
 /// Texture format of the visibility array.
 pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// How the visibility array is used: written as attachments or storage, read by lighting,
+/// copied for readback.
+pub const VISIBILITY_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+    .union(wgpu::TextureUsages::TEXTURE_BINDING)
+    .union(wgpu::TextureUsages::STORAGE_BINDING)
+    .union(wgpu::TextureUsages::COPY_SRC);
 
 /// Which slot each light writes.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -133,10 +139,7 @@ impl VisibilityTargets {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: VISIBILITY_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
+            usage: VISIBILITY_USAGE,
             view_formats: &[],
         });
         let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
