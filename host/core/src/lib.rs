@@ -12,6 +12,7 @@ extern crate self as zoo_host;
 pub mod builtin;
 pub mod gpu;
 pub mod judging;
+pub mod kit;
 pub mod params;
 pub mod render;
 pub mod technique;
@@ -24,15 +25,26 @@ pub use render::{Renderer, View};
 pub use scene::{Camera, Light, LightKind, MAX_LIGHTS, Scene};
 pub use technique::{
     Changes, DebugImage, PassInfo, RenderContext, ResourceInfo, ShadowTechnique, TechniqueError,
-    TechniqueRegistration, ViewMapping, find_technique, registry,
+    TechniqueRegistration, TechniqueResult, ViewMapping, find_technique, registry,
 };
+
+/// What a technique's crate usually needs: `use zoo_host::prelude::*;`.
+pub mod prelude {
+    pub use crate::kit::{self, FullscreenLightPass, LightSlot, UniformSlots};
+    pub use crate::params::TechniqueParams;
+    pub use crate::{
+        Changes, GpuContext, LightKind, ParamValues, PassInfo, PassRecorder, RenderContext,
+        ShadowTechnique, TechniqueError, TechniqueResult,
+    };
+    pub use crate::{bytemuck, glam, wgpu};
+}
 
 // Re-exported so plugins and the macros need no direct dependency on them.
 /// The reference judge (the GPU-free `zoo-judge` crate).
 pub use zoo_judge as judge;
 /// Scenes, lights, meshes and adjacency (the GPU-free `zoo-scene` crate).
 pub use zoo_scene as scene;
-pub use {glam, image, inventory, log, serde, wgpu};
+pub use {bytemuck, glam, image, inventory, log, serde, wgpu};
 
 /// Compiles the README's code examples ("Writing a technique") as doctests.
 #[cfg(doctest)]

@@ -212,6 +212,16 @@ pub enum TechniqueError {
     Other(String),
 }
 
+impl TechniqueError {
+    /// `record` was called before `prepare` made the technique's GPU objects.
+    pub fn not_prepared() -> TechniqueError {
+        TechniqueError::Other("recorded before it was prepared".into())
+    }
+}
+
+/// The result of a technique's methods and factory (`()` unless given).
+pub type TechniqueResult<T = ()> = Result<T, TechniqueError>;
+
 /// A declared pass.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PassInfo {

@@ -120,13 +120,20 @@ impl ShaderLibrary {
 
     /// Resolves the imports of `name`.
     pub fn compose(&self, name: &str) -> Result<ComposedShader, ShaderError> {
+        let text = self.source(name)?;
+        self.compose_source(name, &text)
+    }
+
+    /// Resolves the imports of WGSL `text` that is not a file of the library (a technique's
+    /// inline shader); errors in it are reported as `name:line:column`.
+    pub fn compose_source(&self, name: &str, text: &str) -> Result<ComposedShader, ShaderError> {
         let mut out = ComposedShader {
             name: name.to_string(),
             source: String::new(),
             line_map: Vec::new(),
         };
-        let mut seen = HashSet::new();
-        self.append(name, &mut out, &mut seen, &mut Vec::new())?;
+        let mut seen = HashSet::from([name.to_string()]);
+        self.append_text(name, text, &mut out, &mut seen, &mut Vec::new())?;
         Ok(out)
     }
 
@@ -141,6 +148,17 @@ impl ShaderLibrary {
             return Ok(());
         }
         let text = self.source(name)?;
+        self.append_text(name, &text, out, seen, stack)
+    }
+
+    fn append_text(
+        &self,
+        name: &str,
+        text: &str,
+        out: &mut ComposedShader,
+        seen: &mut HashSet<String>,
+        stack: &mut Vec<String>,
+    ) -> Result<(), ShaderError> {
         let file: Arc<str> = Arc::from(name);
         stack.push(name.to_string());
         for (i, line) in text.lines().enumerate() {
@@ -173,7 +191,10 @@ impl ShaderLibrary {
 
     /// Composes and validates `name` with naga, reporting errors at their original location.
     pub fn validate(&self, name: &str) -> Result<(ComposedShader, naga::Module), ShaderError> {
-        let composed = self.compose(name)?;
+        Self::validated(self.compose(name)?)
+    }
+
+    fn validated(composed: ComposedShader) -> Result<(ComposedShader, naga::Module), ShaderError> {
         let module = naga::front::wgsl::parse_str(&composed.source).map_err(|e| {
             let location = e.location(&composed.source);
             compile_error(&composed, location, e.message().to_string())
@@ -203,7 +224,26 @@ impl ShaderLibrary {
         device: &wgpu::Device,
         name: &str,
     ) -> Result<wgpu::ShaderModule, ShaderError> {
-        let (composed, _) = self.validate(name)?;
+        Self::module_from(device, name, self.compose(name)?)
+    }
+
+    /// Creates a labelled shader module from WGSL `text` with `#import`s of the library (see
+    /// [`Self::compose_source`]); `name` labels it and its errors.
+    pub fn create_module_from_source(
+        &self,
+        device: &wgpu::Device,
+        name: &str,
+        text: &str,
+    ) -> Result<wgpu::ShaderModule, ShaderError> {
+        Self::module_from(device, name, self.compose_source(name, text)?)
+    }
+
+    fn module_from(
+        device: &wgpu::Device,
+        name: &str,
+        composed: ComposedShader,
+    ) -> Result<wgpu::ShaderModule, ShaderError> {
+        let (composed, _) = Self::validated(composed)?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),

@@ -331,6 +331,11 @@ impl Renderer {
         &self.visibility.slots
     }
 
+    /// The visibility storage (slot views and their channel selectors).
+    pub fn visibility(&self) -> &VisibilityTargets {
+        &self.visibility
+    }
+
     /// Switches to technique `id` with `values` (missing keys take defaults). On error the
     /// current technique stays active. The old technique's resources are dropped.
     pub fn set_technique(&mut self, id: &str, values: &ParamValues) -> Result<(), TechniqueError> {

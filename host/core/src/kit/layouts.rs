@@ -1,0 +1,96 @@
+//! Terse bind group layout entries and pipeline layouts with the host's groups first.
+
+use crate::technique::RenderContext;
+
+/// A uniform buffer at `binding` (no dynamic offset).
+pub fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    buffer(binding, visibility, wgpu::BufferBindingType::Uniform)
+}
+
+/// A storage buffer at `binding`.
+pub fn storage(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    buffer(
+        binding,
+        visibility,
+        wgpu::BufferBindingType::Storage { read_only },
+    )
+}
+
+fn buffer(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A sampled texture at `binding`.
+pub fn texture(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A pipeline layout of the frame (group 0) and G-buffer (group 1) layouts followed by a
+/// technique's own `groups` (2, 3, ...).
+pub fn pipeline_layout(
+    ctx: &RenderContext<'_>,
+    label: &str,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let mut layouts = vec![Some(&ctx.frame.layout), Some(&ctx.gbuffer.layout)];
+    layouts.extend(groups.iter().map(|g| Some(*g)));
+    ctx.gpu
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        })
+}
+
+/// A full-screen pipeline (`common/fullscreen.wgsl`'s vertex stage, fragment `entry` of
+/// `module`) that writes visibility slots (see [`super::slot`]), with the host's groups and
+/// then `groups`.
+pub fn slot_fullscreen_pipeline(
+    ctx: &RenderContext<'_>,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::RenderPipeline {
+    let layout = pipeline_layout(ctx, &format!("{label} layout"), groups);
+    crate::gpu::fullscreen_pipeline(
+        &ctx.gpu.device,
+        label,
+        Some(&layout),
+        module,
+        entry,
+        super::slot_target(),
+    )
+}

@@ -1,0 +1,23 @@
+//! The technique kit: helpers that leave a technique's code to state its idea.
+//!
+//! - [`slot`]: write a light's visibility slot with one pipeline (the blend constant selects
+//!   the channel) and open a pass on it with the frame and G-buffer groups bound.
+//! - [`uniforms`]: per-light (or per-draw) uniforms in one buffer, at the device's dynamic
+//!   offset alignment.
+//! - [`layouts`]: terse bind group layout entries and pipeline layouts that put the frame
+//!   (group 0) and G-buffer (group 1) layouts first.
+//! - [`light_pass`]: a full-screen fragment shader run once per light into its slot, with
+//!   per-light uniforms.
+//!
+//! Shader modules from inline WGSL with `#import`s come from
+//! [`ShaderLibrary::create_module_from_source`](crate::ShaderLibrary::create_module_from_source).
+
+pub mod layouts;
+pub mod light_pass;
+pub mod slot;
+pub mod uniforms;
+
+pub use layouts::{pipeline_layout, slot_fullscreen_pipeline, storage, texture, uniform};
+pub use light_pass::FullscreenLightPass;
+pub use slot::{LightSlot, slot_target};
+pub use uniforms::UniformSlots;

@@ -1,0 +1,134 @@
+//! Uniforms for many draws in one buffer, addressed by dynamic offsets.
+
+use std::marker::PhantomData;
+
+use bytemuck::Pod;
+
+use crate::GpuContext;
+
+/// `count` values of `T`, each at a multiple of the device's
+/// `min_uniform_buffer_offset_alignment`, with a bind group that exposes one value at a time
+/// (binding 0, dynamic offset). Write the values for a frame, then bind with
+/// [`Self::offset`] per draw.
+pub struct UniformSlots<T: Pod> {
+    label: String,
+    stride: u64,
+    capacity: usize,
+    buffer: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    bind_group: wgpu::BindGroup,
+    _value: PhantomData<T>,
+}
+
+impl<T: Pod> UniformSlots<T> {
+    /// Room for `capacity` values, visible to `visibility` stages.
+    pub fn new(
+        gpu: &GpuContext,
+        label: &str,
+        capacity: usize,
+        visibility: wgpu::ShaderStages,
+    ) -> UniformSlots<T> {
+        let device = &gpu.device;
+        let alignment = u64::from(device.limits().min_uniform_buffer_offset_alignment);
+        let stride = (size_of::<T>() as u64).max(1).div_ceil(alignment) * alignment;
+        let capacity = capacity.max(1);
+        let buffer = Self::create_buffer(device, label, stride, capacity);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(&format!("{label} layout")),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(size_of::<T>() as u64),
+                },
+                count: None,
+            }],
+        });
+        let bind_group = Self::bind(device, label, &layout, &buffer);
+        UniformSlots {
+            label: label.to_string(),
+            stride,
+            capacity,
+            buffer,
+            layout,
+            bind_group,
+            _value: PhantomData,
+        }
+    }
+
+    fn create_buffer(
+        device: &wgpu::Device,
+        label: &str,
+        stride: u64,
+        capacity: usize,
+    ) -> wgpu::Buffer {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: stride * capacity as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    fn bind(
+        device: &wgpu::Device,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        buffer: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(&format!("{label} bind group")),
+            layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size_of::<T>() as u64),
+                }),
+            }],
+        })
+    }
+
+    /// Writes `values` from slot 0 on, growing the buffer (and replacing the bind group, whose
+    /// layout stays the same) when they do not fit.
+    pub fn write(&mut self, gpu: &GpuContext, values: &[T]) {
+        if values.len() > self.capacity {
+            self.capacity = values.len().next_power_of_two();
+            self.buffer = Self::create_buffer(&gpu.device, &self.label, self.stride, self.capacity);
+            self.bind_group = Self::bind(&gpu.device, &self.label, &self.layout, &self.buffer);
+        }
+        let mut bytes = vec![0u8; self.stride as usize * values.len()];
+        for (chunk, value) in bytes.chunks_exact_mut(self.stride as usize).zip(values) {
+            chunk[..size_of::<T>()].copy_from_slice(bytemuck::bytes_of(value));
+        }
+        gpu.queue.write_buffer(&self.buffer, 0, &bytes);
+    }
+
+    /// The dynamic offset of slot `index`.
+    pub fn offset(&self, index: usize) -> u32 {
+        (self.stride * index as u64) as u32
+    }
+
+    /// Distance in bytes between slots (a multiple of the device's offset alignment).
+    pub fn stride(&self) -> u64 {
+        self.stride
+    }
+
+    /// The layout of [`Self::bind_group`].
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// The bind group (binding 0: one `T`, dynamic offset).
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_group
+    }
+
+    /// The buffer, for the memory table.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+}

@@ -1,0 +1,71 @@
+//! The technique kit's helpers: uniforms at the device's alignment, inline shaders with
+//! imports, and slot writes that leave the other lights' channels untouched.
+
+use zoo_host::ShaderLibrary;
+use zoo_host::gpu::ShaderError;
+use zoo_host::kit::{LightSlot, UniformSlots};
+use zoo_host::test_support::gpu;
+
+#[test]
+fn uniform_slots_follow_the_device_alignment_and_grow() {
+    let gpu = gpu();
+    let alignment = u64::from(gpu.device.limits().min_uniform_buffer_offset_alignment);
+    let stages = zoo_host::wgpu::ShaderStages::FRAGMENT;
+    let mut slots = UniformSlots::<[f32; 5]>::new(&gpu, "kit test", 2, stages);
+    assert_eq!(slots.stride() % alignment, 0);
+    assert!(slots.stride() >= 20);
+    assert_eq!(slots.offset(3) as u64, 3 * slots.stride());
+    // More values than room: the buffer grows and keeps the stride.
+    slots.write(&gpu, &[[1.0; 5]; 9]);
+    assert!(slots.buffer().size() >= 9 * slots.stride());
+    assert!(gpu.take_uncaptured_errors().is_empty());
+}
+
+#[test]
+fn inline_shaders_resolve_imports_and_report_their_own_lines() {
+    let library = ShaderLibrary::embedded();
+    let text =
+        "#import \"common/frame.wgsl\"\n\nfn eye() -> vec3<f32> { return camera.position; }\n";
+    let composed = library
+        .compose_source("my-technique (inline)", text)
+        .unwrap();
+    assert!(composed.source.contains("struct Camera"));
+    assert!(composed.source.contains("fn eye()"));
+    let device = &gpu().device;
+    library
+        .create_module_from_source(device, "my-technique (inline)", text)
+        .unwrap();
+    let broken = "#import \"common/frame.wgsl\"\n\nfn eye() -> vec3<f32> { return nope; }\n";
+    match library.create_module_from_source(device, "my-technique (inline)", broken) {
+        Err(ShaderError::Compile { file, line, .. }) => {
+            assert_eq!((file.as_str(), line), ("my-technique (inline)", 3));
+        }
+        other => panic!("expected a compile error at line 3, got {other:?}"),
+    }
+}
+
+#[test]
+fn light_slots_select_one_channel_each() {
+    use zoo_host::Renderer;
+    use zoo_host::glam::UVec2;
+    let scene =
+        zoo_host::Scene::load(&zoo_host::test_support::scene_path("planar-room.ron")).unwrap();
+    let renderer = Renderer::new(gpu(), scene, UVec2::new(16, 16)).unwrap();
+    let (layer_of, channels): (Vec<u32>, Vec<[f64; 4]>) = (0..3)
+        .map(|light| {
+            let LightSlot {
+                blend_constant: c, ..
+            } = renderer.visibility().light_slot(light);
+            (renderer.slots().slot(light).0, [c.r, c.g, c.b, c.a])
+        })
+        .unzip();
+    assert_eq!(layer_of, [0, 0, 0]);
+    assert_eq!(
+        channels,
+        [
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0]
+        ]
+    );
+}
