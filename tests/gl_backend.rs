@@ -8,31 +8,10 @@ use glam::UVec2;
 use shadow_zoo::contact_sheet::{self, Layout};
 use zoo_host::judging::DEFAULT_SAMPLES;
 use zoo_host::params::ParamValues;
-use zoo_host::test_support::{gpu, scene_path};
-use zoo_host::{
-    Changes, GpuContext, LightKind, PassInfo, PassRecorder, RenderContext, Renderer, Scene,
-    ShadowTechnique, TechniqueError, View,
-};
+use zoo_host::test_support::{Inert, gpu, scene_path};
+use zoo_host::{GpuContext, LightKind, Renderer, Scene, View};
 
-/// A test-only technique that needs view formats, which wgpu's GL backend lacks.
-struct NeedsViewFormats;
-
-impl ShadowTechnique for NeedsViewFormats {
-    fn passes(&self) -> Vec<PassInfo> {
-        Vec::new()
-    }
-    fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> Result<(), TechniqueError> {
-        Ok(())
-    }
-    fn record(
-        &mut self,
-        _: &RenderContext<'_>,
-        _: &mut PassRecorder<'_>,
-    ) -> Result<(), TechniqueError> {
-        Ok(())
-    }
-}
-
+// A test-only technique that needs view formats, which wgpu's GL backend lacks.
 zoo_host::register_technique! {
     id: "test-needs-view-formats",
     name: "Test: needs view formats",
@@ -40,7 +19,7 @@ zoo_host::register_technique! {
     source: "test",
     light_kinds: &[LightKind::Point],
     required_downlevel: || zoo_host::wgpu::DownlevelFlags::VIEW_FORMATS,
-    create: |_, _| Ok(Box::new(NeedsViewFormats)),
+    create: |_, _| Ok(Box::new(Inert)),
 }
 
 /// A context on the GL backend, or `None` (with the reason printed) where there is none.

@@ -1,50 +1,17 @@
 //! The reference judge on rendered frames, and the plugin-test helper built on it.
 
 use glam::UVec2;
-use zoo_host::params::{ParamSpec, ParamValues};
-use zoo_host::test_support::{Metric, judge};
-use zoo_host::{
-    Changes, GpuContext, LightKind, PassInfo, PassRecorder, RenderContext, ShadowTechnique,
-    TechniqueError,
-};
+use zoo_host::LightKind;
+use zoo_host::test_support::{Inert, Metric, judge};
 
-/// A test-only technique that supports point lights only (and shadows nothing).
-struct PointOnly;
-
-impl ShadowTechnique for PointOnly {
-    fn passes(&self) -> Vec<PassInfo> {
-        Vec::new()
-    }
-    fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> Result<(), TechniqueError> {
-        Ok(())
-    }
-    fn record(
-        &mut self,
-        _: &RenderContext<'_>,
-        _: &mut PassRecorder<'_>,
-    ) -> Result<(), TechniqueError> {
-        Ok(())
-    }
-}
-
-fn create_point_only(
-    _: &GpuContext,
-    _: &ParamValues,
-) -> Result<Box<dyn ShadowTechnique>, TechniqueError> {
-    Ok(Box::new(PointOnly))
-}
-
+// A test-only technique that supports point lights only (and shadows nothing).
 zoo_host::register_technique! {
     id: "test-point-only",
     name: "Test: point lights only",
     description: "Supports point lights only (test only)",
     source: "test",
     light_kinds: &[LightKind::Point],
-    required_features: zoo_host::wgpu::Features::empty,
-    optional_features: zoo_host::wgpu::Features::empty,
-    required_limits: zoo_host::wgpu::Limits::downlevel_defaults,
-    params: Vec::<ParamSpec>::new,
-    create: create_point_only,
+    create: |_, _| Ok(Box::new(Inert)),
 }
 
 #[test]

@@ -19,6 +19,30 @@ pub fn gpu() -> Arc<GpuContext> {
     .clone()
 }
 
+/// A technique that records nothing (every light stays lit), for tests that register
+/// techniques with particular light kinds or needs: `create: |_, _| Ok(Box::new(Inert))`.
+pub struct Inert;
+
+impl crate::ShadowTechnique for Inert {
+    fn passes(&self) -> Vec<crate::PassInfo> {
+        Vec::new()
+    }
+    fn prepare(
+        &mut self,
+        _: &crate::RenderContext<'_>,
+        _: crate::Changes,
+    ) -> crate::TechniqueResult {
+        Ok(())
+    }
+    fn record(
+        &mut self,
+        _: &crate::RenderContext<'_>,
+        _: &mut crate::PassRecorder<'_>,
+    ) -> crate::TechniqueResult {
+        Ok(())
+    }
+}
+
 /// The workspace root (where `scenes/` and `shaders/` are).
 pub fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
