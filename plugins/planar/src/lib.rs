@@ -13,9 +13,9 @@ pub mod matrix;
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::params::TechniqueParams;
+use zoo_host::render::Vertex;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::render::visibility::VISIBILITY_FORMAT;
-use zoo_host::render::{Vertex, channel_writes};
 use zoo_host::scene::{LightKind, Scene};
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
@@ -68,8 +68,8 @@ struct LightPass {
 
 struct Gpu {
     mark: wgpu::RenderPipeline,
-    /// One shadow pipeline per visibility channel.
-    shadow: Vec<wgpu::RenderPipeline>,
+    /// Writes shadows into the light's slot (`kit::slot_target`).
+    shadow: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -117,7 +117,8 @@ impl Planar {
         let pipeline = |label: &str,
                         vertex: &str,
                         fragment: &str,
-                        writes: [wgpu::ColorWrites; 2],
+                        visibility: wgpu::ColorTargetState,
+                        plane_ids: wgpu::ColorWrites,
                         depth_compare,
                         stencil: wgpu::StencilFaceState,
                         bias: wgpu::DepthBiasState| {
@@ -152,15 +153,11 @@ impl Planar {
                     entry_point: Some(fragment),
                     compilation_options: Default::default(),
                     targets: &[
-                        Some(wgpu::ColorTargetState {
-                            format: VISIBILITY_FORMAT,
-                            blend: None,
-                            write_mask: writes[0],
-                        }),
+                        Some(visibility),
                         Some(wgpu::ColorTargetState {
                             format: PLANE_IDS_FORMAT,
                             blend: None,
-                            write_mask: writes[1],
+                            write_mask: plane_ids,
                         }),
                     ],
                 }),
@@ -172,7 +169,12 @@ impl Planar {
             "planar mark plane pipeline",
             "vs_mark",
             "fs_mark",
-            [wgpu::ColorWrites::empty(), wgpu::ColorWrites::RED],
+            wgpu::ColorTargetState {
+                format: VISIBILITY_FORMAT,
+                blend: None,
+                write_mask: wgpu::ColorWrites::empty(),
+            },
+            wgpu::ColorWrites::RED,
             wgpu::CompareFunction::LessEqual,
             stencil_face(
                 wgpu::CompareFunction::Always,
@@ -188,20 +190,17 @@ impl Planar {
                 clamp: 0.0,
             },
         );
-        let shadow = (0..4)
-            .map(|channel| {
-                pipeline(
-                    &format!("planar shadow pipeline (channel {channel})"),
-                    "vs_shadow",
-                    "fs_shadow",
-                    [channel_writes(channel), wgpu::ColorWrites::empty()],
-                    wgpu::CompareFunction::Always,
-                    // Zero after the first write: each pixel is shadowed once per plane.
-                    stencil_face(wgpu::CompareFunction::Equal, wgpu::StencilOperation::Zero),
-                    Default::default(),
-                )
-            })
-            .collect();
+        let shadow = pipeline(
+            "planar shadow pipeline",
+            "vs_shadow",
+            "fs_shadow",
+            zoo_host::kit::slot_target(),
+            wgpu::ColorWrites::empty(),
+            wgpu::CompareFunction::Always,
+            // Zero after the first write: each pixel is shadowed once per plane.
+            stencil_face(wgpu::CompareFunction::Equal, wgpu::StencilOperation::Zero),
+            Default::default(),
+        );
         Ok(Gpu {
             mark,
             shadow,
@@ -350,28 +349,15 @@ impl ShadowTechnique for Planar {
         };
         let scene = ctx.scene;
         for (k, light_pass) in self.lights.iter().enumerate() {
-            let (view, _) = ctx.visibility.target(light_pass.light);
-            let (_, channel) = ctx.visibility.slots.slot(light_pass.light);
+            let plane_ids = zoo_host::gpu::color_attachment(
+                plane_ids,
+                zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT),
+            );
+            let stencil =
+                zoo_host::gpu::stencil_attachment(&ctx.gbuffer.depth_view, wgpu::LoadOp::Clear(0));
             let name = pass_name(light_pass.light);
-            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&name),
-                color_attachments: &[
-                    zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Load),
-                    zoo_host::gpu::color_attachment(
-                        plane_ids,
-                        zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT),
-                    ),
-                ],
-                depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
-                    &ctx.gbuffer.depth_view,
-                    wgpu::LoadOp::Clear(0),
-                ),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
+            let mut pass =
+                ctx.light_pass_with(recorder, &name, light_pass.light, &[plane_ids], stencil);
             pass.set_vertex_buffer(0, ctx.scene_buffers.vertices.slice(..));
             pass.set_index_buffer(
                 ctx.scene_buffers.indices.slice(..),
@@ -383,7 +369,7 @@ impl ShadowTechnique for Planar {
                 pass.set_stencil_reference(plane.receiver as u32 + 1);
                 pass.set_pipeline(&gpu.mark);
                 draw_object(&mut pass, scene, receiver.object);
-                pass.set_pipeline(&gpu.shadow[channel as usize]);
+                pass.set_pipeline(&gpu.shadow);
                 for (object, o) in scene.objects.iter().enumerate() {
                     if o.casts_shadows && object != receiver.object {
                         draw_object(&mut pass, scene, object);

@@ -14,8 +14,7 @@ pub mod light_space;
 use bytemuck::{Pod, Zeroable};
 use zoo_host::glam::{UVec2, Vec3};
 use zoo_host::params::TechniqueParams;
-use zoo_host::render::visibility::VISIBILITY_FORMAT;
-use zoo_host::render::{Vertex, channel_writes};
+use zoo_host::render::Vertex;
 use zoo_host::scene::{Light, LightKind, Scene};
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
@@ -166,7 +165,7 @@ pub fn light_scissor(light: &Light, view_proj: zoo_host::glam::Mat4, size: UVec2
 struct Pipelines {
     depth: wgpu::RenderPipeline,
     depth_layout: wgpu::BindGroupLayout,
-    /// Indexed by `channel * 2 + diagnostics`.
+    /// Without and with diagnostics output; each writes the light's slot (`kit::slot_target`).
     lookup: Vec<wgpu::RenderPipeline>,
     lookup_layout: wgpu::BindGroupLayout,
 }
@@ -367,11 +366,15 @@ impl ShadowMaps {
                 ],
                 immediate_size: 0,
             });
-        let lookup = (0..8)
-            .map(|k| {
-                let (channel, diagnostics) = (k / 2, k % 2 == 1);
+        let lookup = [false, true]
+            .into_iter()
+            .map(|diagnostics| {
                 device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(&format!("sm-pcf lookup pipeline (channel {channel})")),
+                    label: Some(if diagnostics {
+                        "sm-pcf lookup pipeline (diagnostics)"
+                    } else {
+                        "sm-pcf lookup pipeline"
+                    }),
                     layout: Some(&lookup_pipeline_layout),
                     vertex: wgpu::VertexState {
                         module: &lookup_module,
@@ -387,11 +390,7 @@ impl ShadowMaps {
                         entry_point: Some("fs_lookup"),
                         compilation_options: Default::default(),
                         targets: &[
-                            Some(wgpu::ColorTargetState {
-                                format: VISIBILITY_FORMAT,
-                                blend: None,
-                                write_mask: channel_writes(channel),
-                            }),
+                            Some(zoo_host::kit::slot_target()),
                             Some(wgpu::ColorTargetState {
                                 format: DIAGNOSTICS_FORMAT,
                                 blend: None,
@@ -848,27 +847,15 @@ impl ShadowTechnique for ShadowMaps {
             }
         }
         for (k, light_maps) in self.lights.iter().enumerate() {
-            let (view, _) = ctx.visibility.target(light_maps.light);
-            let (_, channel) = ctx.visibility.slots.slot(light_maps.light);
             let debug = light_maps.light as u32 == self.params.debug_light;
             let name = lookup_pass_name(light_maps.light);
-            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&name),
-                color_attachments: &[
-                    zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Load),
-                    zoo_host::gpu::color_attachment(
-                        diagnostics,
-                        zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT),
-                    ),
-                ],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&pipelines.lookup[channel as usize * 2 + usize::from(debug)]);
-            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
+            let diagnostics = zoo_host::gpu::color_attachment(
+                diagnostics,
+                zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT),
+            );
+            let mut pass =
+                ctx.light_pass_with(recorder, &name, light_maps.light, &[diagnostics], None);
+            pass.set_pipeline(&pipelines.lookup[usize::from(debug)]);
             pass.set_bind_group(2, &buffers.lookup_bind_group, &[(k as u64 * SLOT) as u32]);
             let [x, y, width, height] = light_maps.scissor;
             if width > 0 && height > 0 {

@@ -14,7 +14,6 @@ pub mod silhouette;
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::params::TechniqueParams;
-use zoo_host::render::channel_writes;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::render::visibility::VISIBILITY_FORMAT;
 use zoo_host::scene::{EdgeKind, LightKind, Scene};
@@ -83,7 +82,7 @@ struct Pipelines {
     edges: wgpu::ComputePipeline,
     compute_layout: wgpu::BindGroupLayout,
     volume: wgpu::RenderPipeline,
-    resolve: Vec<wgpu::RenderPipeline>,
+    resolve: wgpu::RenderPipeline,
     overlay: wgpu::RenderPipeline,
     count_equal: wgpu::RenderPipeline,
     count_any: wgpu::RenderPipeline,
@@ -351,17 +350,13 @@ impl ShadowVolumes {
                 cache: None,
             })
         };
-        let resolve = (0..4)
-            .map(|channel| {
-                fullscreen(
-                    &format!("sv-zfail resolve pipeline (channel {channel})"),
-                    &frame_layout,
-                    "fs_shadowed",
-                    wgpu::CompareFunction::NotEqual,
-                    &[target(VISIBILITY_FORMAT, channel_writes(channel), None)],
-                )
-            })
-            .collect();
+        let resolve = fullscreen(
+            "sv-zfail resolve pipeline",
+            &frame_layout,
+            "fs_shadowed",
+            wgpu::CompareFunction::NotEqual,
+            &[Some(zoo_host::kit::slot_target())],
+        );
         let debug_targets = |count_writes, overlay_writes, blend| {
             [
                 target(COUNTS_FORMAT, count_writes, None),
@@ -715,26 +710,17 @@ impl ShadowTechnique for ShadowVolumes {
                 pass.set_pipeline(&p.edges);
                 pass.dispatch_workgroups(edge_x, edge_y, 1);
             }
-            let (view, _) = ctx.visibility.target(light);
-            let (_, channel) = ctx.visibility.slots.slot(light);
             {
                 let name = volume_pass_name(light);
-                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(&name),
-                    color_attachments: &[zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Load)],
-                    depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
-                        &ctx.gbuffer.depth_view,
-                        wgpu::LoadOp::Clear(0),
-                    ),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+                let stencil = zoo_host::gpu::stencil_attachment(
+                    &ctx.gbuffer.depth_view,
+                    wgpu::LoadOp::Clear(0),
+                );
+                let mut pass = ctx.light_pass(recorder, &name, light, stencil);
                 pass.set_pipeline(&p.volume);
                 pass.set_vertex_buffer(0, b.volume.slice(..));
                 pass.draw_indirect(&b.args, 0);
-                pass.set_pipeline(&p.resolve[channel as usize]);
+                pass.set_pipeline(&p.resolve);
                 pass.set_stencil_reference(0);
                 pass.draw(0..3, 0..1);
             }

@@ -66,8 +66,22 @@ impl RenderContext<'_> {
         light: usize,
         depth_stencil: Option<wgpu::RenderPassDepthStencilAttachment<'_>>,
     ) -> RecordedRenderPass<'r> {
+        self.light_pass_with(recorder, label, light, &[], depth_stencil)
+    }
+
+    /// As [`Self::light_pass`], with more colour attachments after the slot (locations 1, 2,
+    /// ...; pipelines that do not blend them are not affected by the blend constant).
+    pub fn light_pass_with<'r>(
+        &self,
+        recorder: &'r mut PassRecorder<'_>,
+        label: &str,
+        light: usize,
+        more_colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
+        depth_stencil: Option<wgpu::RenderPassDepthStencilAttachment<'_>>,
+    ) -> RecordedRenderPass<'r> {
         let slot = self.visibility.light_slot(light);
-        let attachments = [crate::gpu::color_attachment(slot.view, wgpu::LoadOp::Load)];
+        let mut attachments = vec![crate::gpu::color_attachment(slot.view, wgpu::LoadOp::Load)];
+        attachments.extend_from_slice(more_colors);
         let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &attachments,

@@ -104,16 +104,6 @@ fn influences_overlap(a: &Light, b: &Light) -> bool {
     }
 }
 
-/// The colour write mask that writes only `channel`.
-pub fn channel_writes(channel: u32) -> wgpu::ColorWrites {
-    match channel {
-        0 => wgpu::ColorWrites::RED,
-        1 => wgpu::ColorWrites::GREEN,
-        2 => wgpu::ColorWrites::BLUE,
-        _ => wgpu::ColorWrites::ALPHA,
-    }
-}
-
 /// The visibility array texture and its views.
 pub struct VisibilityTargets {
     pub texture: wgpu::Texture,
@@ -165,12 +155,6 @@ impl VisibilityTargets {
             layer_views,
             slots,
         }
-    }
-
-    /// The attachment view and channel write mask for light `light`.
-    pub fn target(&self, light: usize) -> (&wgpu::TextureView, wgpu::ColorWrites) {
-        let (layer, channel) = self.slots.slot(light);
-        (&self.layer_views[layer as usize], channel_writes(channel))
     }
 }
 
