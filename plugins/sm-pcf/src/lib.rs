@@ -942,6 +942,7 @@ zoo_host::register_technique! {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_integer_constant};
 
     #[test]
     fn resolution_is_clamped_to_device_and_memory() {
@@ -998,9 +999,61 @@ mod tests {
 
     #[test]
     fn filter_codes_match_the_shader() {
-        assert_eq!(Filter::None.code(), 0);
-        assert_eq!(Filter::Hardware2x2.code(), 1);
-        assert_eq!(Filter::Pcf9x9.code(), 5);
-        assert_eq!(Filter::Pcss.code(), 7);
+        let source = shader("sm-pcf/lookup.wgsl");
+        for (filter, constant) in [
+            (Filter::None, "FILTER_NONE"),
+            (Filter::Hardware2x2, "FILTER_HARDWARE_2X2"),
+            (Filter::Pcf3x3, "FILTER_PCF_3X3"),
+            (Filter::Pcf5x5, "FILTER_PCF_5X5"),
+            (Filter::Pcf7x7, "FILTER_PCF_7X7"),
+            (Filter::Pcf9x9, "FILTER_PCF_9X9"),
+            (Filter::Poisson, "FILTER_POISSON"),
+            (Filter::Pcss, "FILTER_PCSS"),
+        ] {
+            assert_eq!(
+                Ok(i64::from(filter.code())),
+                wgsl_integer_constant(&source, constant),
+                "{filter:?}"
+            );
+        }
+    }
+
+    fn shader(name: &str) -> String {
+        zoo_host::ShaderLibrary::embedded()
+            .compose(name)
+            .unwrap()
+            .source
+    }
+
+    #[test]
+    fn gpu_structs_mirror_the_shaders() {
+        let lookup = shader("sm-pcf/lookup.wgsl");
+        let (size, fields) = zoo_host::mirror_fields!(ShadowLight {
+            first_layer,
+            layer_count,
+            filter_mode,
+            light,
+            texel_scale,
+            perspective,
+            near,
+            far,
+            normal_offset,
+            kernel_texels,
+            light_size,
+            map_size,
+            position,
+            search_texels,
+            direction,
+            _pad
+        });
+        check_mirror(&lookup, "ShadowLight", size, &fields, SizeRule::Equal).unwrap();
+        let (size, fields) = zoo_host::mirror_fields!(Slot { view_proj, _pad });
+        check_mirror(&lookup, "Slot", size, &fields, SizeRule::Equal).unwrap();
+        // Uniforms at 256-byte dynamic offsets: the Rust struct fills the slot.
+        let (size, fields) = zoo_host::mirror_fields!(Current { index, debug });
+        check_mirror(&lookup, "Current", size, &fields, SizeRule::AtLeast).unwrap();
+        let depth = shader("sm-pcf/depth.wgsl");
+        let (size, fields) = zoo_host::mirror_fields!(Slot { view_proj });
+        check_mirror(&depth, "LayerCamera", size, &fields, SizeRule::AtLeast).unwrap();
     }
 }

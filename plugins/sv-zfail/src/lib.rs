@@ -835,3 +835,30 @@ zoo_host::register_technique! {
     params: SvParams::schema,
     create: create,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_struct};
+
+    #[test]
+    fn gpu_structs_mirror_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose("sv-zfail/volumes.wgsl")
+            .unwrap()
+            .source;
+        // Uniforms at 256-byte dynamic offsets: the Rust struct fills the slot.
+        let (size, fields) = zoo_host::mirror_fields!(Params {
+            light,
+            mode,
+            triangle_count,
+            edge_count,
+            capacity
+        });
+        check_mirror(&source, "Params", size, &fields, SizeRule::AtLeast).unwrap();
+        assert_eq!(
+            wgsl_struct(&source, "DrawArgs").unwrap().size as u64,
+            ARGS_BYTES
+        );
+    }
+}

@@ -2,6 +2,7 @@
 
 pub mod adapter;
 mod context;
+pub mod layout;
 pub mod readback;
 mod recorder;
 mod shaders;

@@ -177,3 +177,28 @@ impl DebugViewPass {
         pass.draw(0..3, 0..1);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout::{SizeRule, check_mirror};
+
+    #[test]
+    fn view_params_mirror_the_shader() {
+        let source = ShaderLibrary::embedded()
+            .compose("host/debug_view.wgsl")
+            .unwrap()
+            .source;
+        let (size, fields) = crate::mirror_fields!(ViewParams {
+            mode,
+            channel,
+            min_value,
+            max_value,
+            near,
+            far,
+            opacity,
+            _pad
+        });
+        check_mirror(&source, "ViewParams", size, &fields, SizeRule::Equal).unwrap();
+    }
+}

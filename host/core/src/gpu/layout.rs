@@ -1,0 +1,212 @@
+//! Checks that a Rust struct uploaded to the GPU has the layout of the WGSL struct it mirrors
+//! (member offsets and size, read from the shader with naga), so the two cannot drift apart.
+//!
+//! ```ignore
+//! let wgsl = ShaderLibrary::embedded().compose("common/frame.wgsl")?.source;
+//! let (size, fields) = zoo_host::mirror_fields!(GpuLight { position, kind, direction });
+//! check_mirror(&wgsl, "Light", size, &fields, SizeRule::Equal)?;
+//! ```
+
+/// The members (name, byte offset) and size of a WGSL struct.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WgslStruct {
+    pub size: u32,
+    pub members: Vec<(String, u32)>,
+}
+
+/// Reads struct `name` from WGSL `source` (imports already resolved).
+pub fn wgsl_struct(source: &str, name: &str) -> Result<WgslStruct, String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    let mut layouter = naga::proc::Layouter::default();
+    layouter
+        .update(module.to_ctx())
+        .map_err(|e| format!("layout of the module: {e}"))?;
+    module
+        .types
+        .iter()
+        .find(|(_, ty)| ty.name.as_deref() == Some(name))
+        .and_then(|(handle, ty)| match &ty.inner {
+            naga::TypeInner::Struct { members, .. } => Some(WgslStruct {
+                size: layouter[handle].size,
+                members: members
+                    .iter()
+                    .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                    .collect(),
+            }),
+            _ => None,
+        })
+        .ok_or_else(|| format!("no struct `{name}` in the shader"))
+}
+
+/// The value of module-scope constant `name` (a `u32` or `i32` literal) in WGSL `source`, so
+/// numbers shared with Rust (enum codes, sizes) can be checked instead of kept by hand.
+pub fn wgsl_integer_constant(source: &str, name: &str) -> Result<i64, String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    let (_, constant) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .ok_or_else(|| format!("no constant `{name}` in the shader"))?;
+    match module.global_expressions[constant.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => Ok(i64::from(v)),
+        naga::Expression::Literal(naga::Literal::I32(v)) => Ok(i64::from(v)),
+        ref other => Err(format!("`{name}` is not an integer literal: {other:?}")),
+    }
+}
+
+/// How the Rust size may relate to the WGSL size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SizeRule {
+    /// The same size (arrays of the struct, storage buffers).
+    Equal,
+    /// The Rust struct is padded to a larger slot (uniforms at dynamic offsets).
+    AtLeast,
+}
+
+/// Compares the Rust layout (`size`, and `fields` as (WGSL member name, Rust offset)) with
+/// WGSL struct `name` in `source`: every member must be at the same offset, members starting
+/// with `_` (padding) may be left out, and the sizes must follow `rule`.
+pub fn check_mirror(
+    source: &str,
+    name: &str,
+    size: usize,
+    fields: &[(&str, usize)],
+    rule: SizeRule,
+) -> Result<(), String> {
+    let wgsl = wgsl_struct(source, name)?;
+    let mut problems = Vec::new();
+    for (member, offset) in &wgsl.members {
+        match fields.iter().find(|(f, _)| f == member) {
+            Some((_, rust)) if *rust != *offset as usize => problems.push(format!(
+                "`{member}` is at {offset} in WGSL and {rust} in Rust"
+            )),
+            None if !member.starts_with('_') => {
+                problems.push(format!("`{member}` has no Rust field"))
+            }
+            _ => {}
+        }
+    }
+    for (field, _) in fields {
+        if !wgsl.members.iter().any(|(m, _)| m == field) {
+            problems.push(format!("Rust field `{field}` is not in WGSL"));
+        }
+    }
+    let size_ok = match rule {
+        SizeRule::Equal => size == wgsl.size as usize,
+        SizeRule::AtLeast => size >= wgsl.size as usize,
+    };
+    if !size_ok {
+        problems.push(format!(
+            "size {size} in Rust, {} in WGSL ({rule:?})",
+            wgsl.size
+        ));
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("`{name}`: {}", problems.join("; ")))
+    }
+}
+
+/// `(size_of::<T>(), [(member, offset_of!(T, field))...])` for [`check_mirror`]:
+/// `mirror_fields!(Pass { light: 0, darkness: 1 })` maps WGSL members to Rust fields (a
+/// member alone means a field of the same name).
+#[macro_export]
+macro_rules! mirror_fields {
+    ($ty:ty { $($member:ident $(: $field:tt)?),* $(,)? }) => {
+        (
+            ::std::mem::size_of::<$ty>(),
+            vec![$((
+                stringify!($member),
+                $crate::mirror_fields!(@offset $ty, $member $(, $field)?),
+            )),*],
+        )
+    };
+    (@offset $ty:ty, $member:ident) => { ::std::mem::offset_of!($ty, $member) };
+    (@offset $ty:ty, $member:ident, $field:tt) => { ::std::mem::offset_of!($ty, $field) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ShaderLibrary;
+    use crate::render::frame::{CameraUniform, GpuLight, GpuObject};
+
+    fn frame() -> String {
+        ShaderLibrary::embedded()
+            .compose("common/frame.wgsl")
+            .unwrap()
+            .source
+    }
+
+    #[test]
+    fn frame_structs_mirror_their_wgsl() {
+        let source = frame();
+        let (size, fields) = crate::mirror_fields!(CameraUniform {
+            view,
+            proj,
+            view_proj,
+            inv_view_proj,
+            position,
+            near,
+            size,
+            far,
+            light_count,
+            ambient,
+            _pad
+        });
+        check_mirror(&source, "Camera", size, &fields, SizeRule::Equal).unwrap();
+        let (size, fields) = crate::mirror_fields!(GpuLight {
+            position,
+            kind,
+            direction,
+            range,
+            radiance,
+            radius,
+            cos_outer,
+            cos_inner,
+            slot_layer,
+            slot_channel
+        });
+        check_mirror(&source, "Light", size, &fields, SizeRule::Equal).unwrap();
+        let (size, fields) = crate::mirror_fields!(GpuObject {
+            model,
+            color,
+            material
+        });
+        check_mirror(&source, "Object", size, &fields, SizeRule::Equal).unwrap();
+    }
+
+    #[test]
+    fn integer_constants_are_read_from_the_shader() {
+        let source = "const A: u32 = 7u;\nconst B: i32 = -3;\nconst C: f32 = 1.0;";
+        assert_eq!(wgsl_integer_constant(source, "A"), Ok(7));
+        assert_eq!(wgsl_integer_constant(source, "B"), Ok(-3));
+        assert!(wgsl_integer_constant(source, "C").is_err());
+        assert!(
+            wgsl_integer_constant(source, "D")
+                .unwrap_err()
+                .contains("no constant")
+        );
+    }
+
+    #[repr(C)]
+    struct Drifted {
+        a: u32,
+        b: [f32; 3],
+    }
+
+    #[test]
+    fn drift_is_reported_with_the_member_and_both_offsets() {
+        let source = "struct S { a: u32, b: vec3<f32> }";
+        let (size, fields) = crate::mirror_fields!(Drifted { a, b });
+        let err = check_mirror(source, "S", size, &fields, SizeRule::Equal).unwrap_err();
+        // vec3<f32> is 16-byte aligned in WGSL, 4 in Rust.
+        assert!(err.contains("`b` is at 16 in WGSL and 4 in Rust"), "{err}");
+        assert!(err.contains("size 16 in Rust, 32 in WGSL"), "{err}");
+        let err = check_mirror(source, "S", size, &fields[..1], SizeRule::AtLeast).unwrap_err();
+        assert!(err.contains("`b` has no Rust field"), "{err}");
+        let err = check_mirror(source, "T", size, &fields, SizeRule::Equal).unwrap_err();
+        assert!(err.contains("no struct `T`"), "{err}");
+    }
+}
