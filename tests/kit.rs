@@ -69,3 +69,43 @@ fn light_slots_select_one_channel_each() {
         ]
     );
 }
+
+#[test]
+fn readback_ring_delivers_the_newest_results_without_waiting() {
+    use zoo_host::gpu::readback::ReadbackRing;
+    use zoo_host::wgpu::util::DeviceExt;
+    let gpu = gpu();
+    let device = &gpu.device;
+    let mut ring = ReadbackRing::new(device, "kit test", 8, 2);
+    let frame = |ring: &mut ReadbackRing, value: u32| -> bool {
+        let Some(target) = ring.target().cloned() else {
+            return false;
+        };
+        let source = device.create_buffer_init(&zoo_host::wgpu::util::BufferInitDescriptor {
+            label: Some("kit test source"),
+            contents: zoo_host::bytemuck::cast_slice(&[value, value + 1]),
+            usage: zoo_host::wgpu::BufferUsages::COPY_SRC,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&source, 0, &target, 0, 8);
+        gpu.queue.submit([encoder.finish()]);
+        true
+    };
+    assert!(ring.latest(device).is_none(), "nothing was written yet");
+    assert!(frame(&mut ring, 10));
+    assert!(frame(&mut ring, 20));
+    // Both buffers are in flight until read: a third frame is skipped, not waited for.
+    assert!(!frame(&mut ring, 30));
+    gpu.wait_idle();
+    let _ = ring.latest(device);
+    gpu.wait_idle();
+    let (frame_index, bytes) = ring.latest(device).expect("results arrived");
+    assert_eq!(frame_index, 2);
+    let words: Vec<u32> = bytes
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    assert_eq!(words, [20, 21]);
+    // The buffers are free again.
+    assert!(frame(&mut ring, 40));
+}

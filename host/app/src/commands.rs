@@ -220,7 +220,7 @@ fn render_one(args: &RenderArgs, id: &str) -> anyhow::Result<()> {
     );
     if args.timings {
         print!("{}", format_timings(&timings));
-        for (name, value) in renderer.technique_instance().counters() {
+        for (name, value) in renderer.wait_for_counters() {
             println!("  counter {name}: {value}");
         }
     }

@@ -13,6 +13,7 @@
 pub mod silhouette;
 
 use bytemuck::{Pod, Zeroable};
+use zoo_host::gpu::readback::ReadbackRing;
 use zoo_host::params::TechniqueParams;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::render::visibility::VISIBILITY_FORMAT;
@@ -94,7 +95,8 @@ struct Buffers {
     weights: wgpu::Buffer,
     volume: wgpu::Buffer,
     args: wgpu::Buffer,
-    stats: wgpu::Buffer,
+    /// Draw arguments and silhouette counters per light, read back a frame or two late.
+    stats: std::sync::Mutex<ReadbackRing>,
     compute_bind_group: wgpu::BindGroup,
     levels_bind_group: wgpu::BindGroup,
 }
@@ -496,11 +498,12 @@ impl ShadowVolumes {
             bytemuck::cast_slice(&params),
             wgpu::BufferUsages::UNIFORM,
         );
-        let stats = empty(
+        let stats = std::sync::Mutex::new(ReadbackRing::new(
+            &ctx.gpu.device,
             "sv-zfail workload counters",
-            (ctx.lights.len() as u64 * ARGS_BYTES).next_multiple_of(4),
-            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        );
+            ctx.lights.len() as u64 * ARGS_BYTES,
+            3,
+        ));
         let level_data: Vec<u32> = std::iter::once(11)
             .chain(COUNT_LEVELS.iter().enumerate().map(|(i, _)| i as u32 + 1))
             .flat_map(|value| std::iter::once(value).chain(std::iter::repeat_n(0, 63)))
@@ -572,29 +575,28 @@ impl ShadowVolumes {
         }
     }
 
-    /// Silhouette edges and volume triangles per light from the last frame.
+    /// Silhouette edges and volume triangles per light from the newest frame whose counters
+    /// have arrived (empty until one has; never waits for the GPU).
     pub fn workload(&self) -> Vec<(u32, u32)> {
         let Some(buffers) = &self.buffers else {
             return Vec::new();
         };
-        let slice = buffers.stats.slice(..);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = sender.send(r);
-        });
-        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
-        let mut out = Vec::new();
-        if let Ok(Ok(())) = receiver.recv()
-            && let Ok(view) = slice.get_mapped_range()
-        {
-            let words: &[u32] = bytemuck::cast_slice(&view);
-            for light in 0..self.lights {
+        let Ok(mut ring) = buffers.stats.lock() else {
+            return Vec::new();
+        };
+        let Some((_, bytes)) = ring.latest(&self.device) else {
+            return Vec::new();
+        };
+        let words: Vec<u32> = bytes
+            .chunks_exact(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        (0..self.lights)
+            .map(|light| {
                 let base = light * (ARGS_BYTES as usize / 4);
-                out.push((words[base + 4], words[base] / 3));
-            }
-        }
-        buffers.stats.unmap();
-        out
+                (words[base + 4], words[base] / 3)
+            })
+            .collect()
     }
 }
 
@@ -694,6 +696,11 @@ impl ShadowTechnique for ShadowVolumes {
         };
         let (tri_x, tri_y) = dispatch_size(self.triangles);
         let (edge_x, edge_y) = dispatch_size(self.edges);
+        let stats = b
+            .stats
+            .lock()
+            .ok()
+            .and_then(|mut ring| ring.target().cloned());
         for light in 0..self.lights {
             let offset = (light as u64 * SLOT) as u32;
             // Reset the vertex count (keeping instance_count = 1) and the silhouette counter.
@@ -724,13 +731,15 @@ impl ShadowTechnique for ShadowVolumes {
                 pass.set_stencil_reference(0);
                 pass.draw(0..3, 0..1);
             }
-            recorder.encoder().copy_buffer_to_buffer(
-                &b.args,
-                0,
-                &b.stats,
-                light as u64 * ARGS_BYTES,
-                ARGS_BYTES,
-            );
+            if let Some(stats) = &stats {
+                recorder.encoder().copy_buffer_to_buffer(
+                    &b.args,
+                    0,
+                    stats,
+                    light as u64 * ARGS_BYTES,
+                    ARGS_BYTES,
+                );
+            }
             let showing_debug = matches!(ctx.debug_view, Some("stencil counts" | "volumes"));
             if showing_debug && light as u32 == self.params.debug_light {
                 let name = debug_pass_name(light);

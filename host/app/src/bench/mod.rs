@@ -340,7 +340,7 @@ pub fn run_configuration(
         frame_gpu: Summary::of(&frame_gpu),
         technique_gpu: Summary::of(&technique_gpu),
         frame_cpu: Summary::of(&frame_cpu),
-        counters: renderer.technique_instance().counters(),
+        counters: renderer.wait_for_counters(),
         flicker,
         timing_source,
         triangles,

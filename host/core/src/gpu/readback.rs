@@ -126,3 +126,117 @@ mod tests {
         assert_eq!(half_to_f32(0x7c00), f32::INFINITY);
     }
 }
+
+/// Small GPU results (counters, statistics) read back without stalling a frame: each frame
+/// copies into a free staging buffer of the ring; reading maps the buffers whose frames have
+/// been submitted, polls without waiting and returns the newest data that has arrived, so
+/// results come a frame or two late. Call [`Self::target`] while recording and
+/// [`Self::latest`] between frames (never between recording and submission).
+pub struct ReadbackRing {
+    slots: Vec<RingSlot>,
+    latest: Option<(u64, Vec<u8>)>,
+    frame: u64,
+}
+
+struct RingSlot {
+    buffer: wgpu::Buffer,
+    state: std::sync::Arc<std::sync::Mutex<SlotState>>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum SlotState {
+    Free,
+    /// Copied into during frame `n`; not yet mapped.
+    Written(u64),
+    Mapping(u64),
+    Mapped(u64),
+    Failed,
+}
+
+impl ReadbackRing {
+    /// `slots` staging buffers of `size` bytes.
+    pub fn new(device: &wgpu::Device, label: &str, size: u64, slots: usize) -> ReadbackRing {
+        ReadbackRing {
+            slots: (0..slots.max(2))
+                .map(|i| RingSlot {
+                    buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(&format!("{label} readback {i}")),
+                        size: size.max(4).next_multiple_of(4),
+                        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                        mapped_at_creation: false,
+                    }),
+                    state: std::sync::Arc::new(std::sync::Mutex::new(SlotState::Free)),
+                })
+                .collect(),
+            latest: None,
+            frame: 0,
+        }
+    }
+
+    /// A free buffer to copy this frame's results into, or `None` when every buffer is still
+    /// in flight (this frame's results are then skipped).
+    pub fn target(&mut self) -> Option<&wgpu::Buffer> {
+        self.frame += 1;
+        let frame = self.frame;
+        let slot = self.slots.iter().find(|s| {
+            let mut state = s.state.lock().expect("ring state");
+            if *state == SlotState::Free {
+                *state = SlotState::Written(frame);
+                true
+            } else {
+                false
+            }
+        })?;
+        Some(&slot.buffer)
+    }
+
+    /// The newest results that have arrived (and the frame they come from, counted by
+    /// [`Self::target`] calls), without waiting for the GPU.
+    pub fn latest(&mut self, device: &wgpu::Device) -> Option<(u64, &[u8])> {
+        for slot in &self.slots {
+            let written = {
+                let mut state = slot.state.lock().expect("ring state");
+                match *state {
+                    SlotState::Written(frame) => {
+                        *state = SlotState::Mapping(frame);
+                        Some(frame)
+                    }
+                    _ => None,
+                }
+            };
+            if let Some(frame) = written {
+                let shared = slot.state.clone();
+                slot.buffer
+                    .slice(..)
+                    .map_async(wgpu::MapMode::Read, move |result| {
+                        if let Ok(mut state) = shared.lock() {
+                            *state = match result {
+                                Ok(()) => SlotState::Mapped(frame),
+                                Err(_) => SlotState::Failed,
+                            };
+                        }
+                    });
+            }
+        }
+        let _ = device.poll(wgpu::PollType::Poll);
+        for slot in &self.slots {
+            let mut state = slot.state.lock().expect("ring state");
+            match *state {
+                SlotState::Mapped(frame) => {
+                    if self.latest.as_ref().is_none_or(|(f, _)| *f < frame)
+                        && let Ok(view) = slot.buffer.slice(..).get_mapped_range()
+                    {
+                        self.latest = Some((frame, view.to_vec()));
+                    }
+                    slot.buffer.unmap();
+                    *state = SlotState::Free;
+                }
+                SlotState::Failed => *state = SlotState::Free,
+                _ => {}
+            }
+        }
+        self.latest
+            .as_ref()
+            .map(|(frame, data)| (*frame, data.as_slice()))
+    }
+}

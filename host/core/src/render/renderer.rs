@@ -321,6 +321,22 @@ impl Renderer {
         self.technique.instance.as_ref()
     }
 
+    /// The technique's counters for the last frame rendered, waiting for the GPU until they
+    /// have arrived (counters are read back without stalling frames, so
+    /// `technique_instance().counters()` lags a frame or two). For tools and tests, not for
+    /// interactive frames.
+    pub fn wait_for_counters(&self) -> Vec<(String, f64)> {
+        let mut counters = Vec::new();
+        for _ in 0..4 {
+            self.gpu.wait_idle();
+            counters = self.technique.instance.counters();
+            if !counters.is_empty() {
+                break;
+            }
+        }
+        counters
+    }
+
     /// The active technique's parameter values.
     pub fn technique_params(&self) -> &ParamValues {
         &self.technique.params
