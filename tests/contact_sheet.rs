@@ -15,7 +15,7 @@ const README_TILE: UVec2 = UVec2::new(320, 240);
 const README_IMAGE: &str = "host/app/docs/contact-sheet.png";
 
 fn sheet(size: UVec2) -> Sheet {
-    let scene = shadow_zoo::commands::load_scene(None).unwrap();
+    let scene = shadow_zoo::setup::load_scene(None).unwrap();
     let gpu = gpu();
     let (available, _) = contact_sheet::available_techniques(&gpu);
     let techniques: Vec<_> = available
@@ -28,7 +28,7 @@ fn sheet(size: UVec2) -> Sheet {
 
 /// Pixels within one pixel of a hard shadow boundary of any light of the default scene.
 fn edge_band(size: UVec2) -> Vec<bool> {
-    let scene = shadow_zoo::commands::load_scene(None).unwrap();
+    let scene = shadow_zoo::setup::load_scene(None).unwrap();
     let mut renderer = Renderer::new(gpu(), scene, size).unwrap();
     let reference = zoo_host::judging::SceneReference::compute(&mut renderer, 1, |_| {}).unwrap();
     let (w, h) = (size.x as i64, size.y as i64);

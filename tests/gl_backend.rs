@@ -114,7 +114,7 @@ fn the_default_render_on_gl_matches_vulkan() {
             .filter(|r| !r.id.starts_with("test-"))
             .map(|r| (r, zoo_host::params::defaults(&(r.params)())))
             .collect();
-        let scene = shadow_zoo::commands::load_scene(None).unwrap();
+        let scene = shadow_zoo::setup::load_scene(None).unwrap();
         let mut renderer = Renderer::new(gpu, scene, tile).unwrap();
         contact_sheet::build(&mut renderer, &techniques, DEFAULT_SAMPLES, |_| {}).unwrap()
     };

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 use glam::UVec2;
+use serde::Deserialize;
 
 /// Shadow Zoo: real-time shadow techniques side by side, judged against ray-traced visibility.
 #[derive(Debug, Parser)]
@@ -53,7 +54,7 @@ pub struct BenchArgs {
     pub warmup: u32,
     /// What moves along the scene's paths.
     #[arg(long, value_enum, default_value = "camera")]
-    pub path: crate::bench::PathMode,
+    pub path: PathMode,
     /// Sweep a quantity: `size=256x256,512x512`, `scene.tessellation=0.5,1,2` or
     /// `TECHNIQUE.PARAM=v1,v2` (repeatable; configurations are the cartesian product).
     #[arg(long = "sweep", value_name = "KEY=v1,v2,...", value_parser = parse_assignment)]
@@ -123,6 +124,20 @@ pub struct RenderArgs {
     /// Print per-pass GPU times.
     #[arg(long)]
     pub timings: bool,
+}
+
+/// What moves during a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, clap::ValueEnum)]
+pub enum PathMode {
+    /// Nothing moves.
+    Static,
+    /// The camera follows the scene's camera path.
+    #[default]
+    Camera,
+    /// The lights follow their paths.
+    Light,
+    /// Both.
+    Both,
 }
 
 /// Parses `WIDTHxHEIGHT`.

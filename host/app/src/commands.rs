@@ -1,7 +1,6 @@
 //! The commands behind the CLI.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use anyhow::{Context, bail};
 use zoo_host::gpu::{FrameTimings, PassOwner};
@@ -9,6 +8,7 @@ use zoo_host::{GpuContext, Renderer, Scene, View, params};
 
 use crate::cli::{Cli, Command, RenderArgs};
 use crate::contact_sheet;
+use crate::setup::{headless_gpu, load_scene};
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -57,25 +57,6 @@ fn list() {
             println!("(availability not checked: {e})");
         }
     }
-}
-
-/// Loads `path`, or the built-in default scene when `None`.
-pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
-    Ok(match path {
-        Some(path) => Scene::load(path)?,
-        None => Scene::from_ron(
-            crate::DEFAULT_SCENE,
-            Path::new(crate::DEFAULT_SCENE_NAME),
-            Path::new("scenes"),
-        )?,
-    })
-}
-
-/// Creates the headless GPU context and prints what it runs on.
-pub fn headless_gpu() -> anyhow::Result<Arc<GpuContext>> {
-    let gpu = GpuContext::new_headless()?;
-    println!("adapter: {}", gpu.describe());
-    Ok(Arc::new(gpu))
 }
 
 fn render(args: &RenderArgs) -> anyhow::Result<()> {

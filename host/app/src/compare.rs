@@ -12,7 +12,7 @@ use zoo_host::params::{self, ParamValues};
 use zoo_host::{Renderer, Scene, TechniqueRegistration};
 
 use crate::cli::CompareArgs;
-use crate::commands::headless_gpu;
+use crate::setup::headless_gpu;
 
 /// The exact header of `results.csv`.
 pub const CSV_HEADER: &str = "scene,technique,light,light_kind,pixels,false_shadow,false_lit,\

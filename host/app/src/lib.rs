@@ -9,6 +9,7 @@ pub mod commands;
 pub mod compare;
 pub mod contact_sheet;
 pub mod font;
+pub mod setup;
 pub mod viewer;
 
 mod linked {

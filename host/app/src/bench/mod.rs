@@ -15,7 +15,6 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use serde::Deserialize;
 use zoo_host::gpu::{PassOwner, TimingSource};
 use zoo_host::judge::{Occluders, reference_visibility};
 use zoo_host::judging::surface_points;
@@ -23,23 +22,10 @@ use zoo_host::params::{self, ParamValues};
 use zoo_host::scene::{SceneDescription, paths};
 use zoo_host::{GpuContext, Renderer, Scene, TechniqueRegistration, View};
 
+pub use crate::cli::PathMode;
 use crate::cli::{BenchArgs, parse_size};
 use flicker::{Flicker, FrameVisibility};
 use stats::Summary;
-
-/// What moves during a run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, clap::ValueEnum)]
-pub enum PathMode {
-    /// Nothing moves.
-    Static,
-    /// The camera follows the scene's camera path.
-    #[default]
-    Camera,
-    /// The lights follow their paths.
-    Light,
-    /// Both.
-    Both,
-}
 
 /// A swept quantity.
 #[derive(Debug, Clone, PartialEq)]
@@ -418,7 +404,7 @@ pub fn run_plans(
         .into_iter()
         .flatten()
         .collect();
-    let gpu = crate::commands::headless_gpu()?;
+    let gpu = crate::setup::headless_gpu()?;
     let total: u64 = configs
         .iter()
         .map(|(i, _)| (plans[*i].frames + plans[*i].warmup) as u64)

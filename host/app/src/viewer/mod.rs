@@ -187,7 +187,7 @@ pub fn run() -> anyhow::Result<()> {
                 render_state.device.clone(),
                 render_state.queue.clone(),
             ));
-            let scene = crate::commands::load_scene(None)?;
+            let scene = crate::setup::load_scene(None)?;
             let mut state =
                 ViewerState::with_shaders(gpu, scene, UVec2::new(960, 640), shader_library())?;
             state.restore_settings(&settings_path());

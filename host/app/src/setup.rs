@@ -1,0 +1,25 @@
+//! What every command starts from: the scene to open and the headless GPU.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use zoo_host::{GpuContext, Scene};
+
+/// Loads `path`, or the built-in default scene when `None`.
+pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
+    Ok(match path {
+        Some(path) => Scene::load(path)?,
+        None => Scene::from_ron(
+            crate::DEFAULT_SCENE,
+            Path::new(crate::DEFAULT_SCENE_NAME),
+            Path::new("scenes"),
+        )?,
+    })
+}
+
+/// Creates the headless GPU context and prints what it runs on.
+pub fn headless_gpu() -> anyhow::Result<Arc<GpuContext>> {
+    let gpu = GpuContext::new_headless()?;
+    println!("adapter: {}", gpu.describe());
+    Ok(Arc::new(gpu))
+}
