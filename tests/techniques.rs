@@ -322,3 +322,65 @@ fn every_standard_scene_loads_and_renders() {
         assert!(image.pixels().any(|p| p.0[0] > 60), "{name} renders dark");
     }
 }
+
+/// A parameter change reaches the live technique when it can take it (no rebuild), and the
+/// frame is exactly the one a new instance with those values renders; others rebuild.
+#[test]
+fn parameter_changes_apply_in_place_or_rebuild() {
+    let scene = load("planar-room.ron");
+    let size = UVec2::new(96, 80);
+    let fresh = |id: &str, assignments: &[(&str, &str)]| {
+        let mut renderer = Renderer::new(gpu(), scene.clone(), size).unwrap();
+        renderer
+            .set_technique(id, &values_for(id, assignments))
+            .unwrap();
+        renderer.render(&View::Final).unwrap();
+        renderer.read_output()
+    };
+    for (id, in_place, rebuilt) in [
+        ("sm-pcf", ("filter", "Pcss"), ("map_size", "1024")),
+        ("planar", ("opacity", "0.4"), ("depth_offset", "32")),
+        ("sv-zfail", ("debug_light", "1"), ("counting", "ZPass")),
+    ] {
+        let mut renderer = Renderer::new(gpu(), scene.clone(), size).unwrap();
+        renderer.set_technique(id, &ParamValues::new()).unwrap();
+        renderer.render(&View::Final).unwrap();
+        let before = renderer.read_output();
+        let applied = renderer.set_params(&values_for(id, &[in_place])).unwrap();
+        assert!(applied, "{id}: {in_place:?} should apply in place");
+        renderer.render(&View::Final).unwrap();
+        let after = renderer.read_output();
+        assert_eq!(
+            after,
+            fresh(id, &[in_place]),
+            "{id}: {in_place:?} in place differs from a new instance"
+        );
+        // Visible parameters do change the frame (the debug light only changes debug views).
+        assert_eq!(after != before, id != "sv-zfail", "{id}: {in_place:?}");
+        let applied = renderer
+            .set_params(&values_for(id, &[in_place, rebuilt]))
+            .unwrap();
+        assert!(!applied, "{id}: {rebuilt:?} should rebuild");
+        renderer.render(&View::Final).unwrap();
+        assert_eq!(
+            renderer.read_output(),
+            fresh(id, &[in_place, rebuilt]),
+            "{id}"
+        );
+        assert_eq!(
+            renderer.technique_params(),
+            &values_for(id, &[in_place, rebuilt])
+        );
+    }
+}
+
+fn values_for(id: &str, assignments: &[(&str, &str)]) -> ParamValues {
+    let schema = (zoo_host::find_technique(id).unwrap().params)();
+    let mut values = zoo_host::params::defaults(&schema);
+    let assignments: Vec<(String, String)> = assignments
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    zoo_host::params::apply_assignments(&schema, &mut values, &assignments).unwrap();
+    values
+}

@@ -24,8 +24,8 @@ pub use params::{ParamSpec, ParamValue, ParamValues, TechniqueParams};
 pub use render::{Renderer, View};
 pub use scene::{Camera, Light, LightKind, MAX_LIGHTS, Scene};
 pub use technique::{
-    Changes, DebugImage, PassInfo, RenderContext, ResourceInfo, ShadowTechnique, TechniqueError,
-    TechniqueRegistration, TechniqueResult, ViewMapping, find_technique, registry,
+    Changes, DebugImage, ParamUpdate, PassInfo, RenderContext, ResourceInfo, ShadowTechnique,
+    TechniqueError, TechniqueRegistration, TechniqueResult, ViewMapping, find_technique, registry,
 };
 
 /// What a technique's crate usually needs: `use zoo_host::prelude::*;`.
@@ -33,8 +33,8 @@ pub mod prelude {
     pub use crate::kit::{self, FullscreenLightPass, LightSlot, UniformSlots};
     pub use crate::params::TechniqueParams;
     pub use crate::{
-        Changes, GpuContext, LightKind, ParamValues, PassInfo, PassRecorder, RenderContext,
-        ShadowTechnique, TechniqueError, TechniqueResult,
+        Changes, GpuContext, LightKind, ParamUpdate, ParamValues, PassInfo, PassRecorder,
+        RenderContext, ShadowTechnique, TechniqueError, TechniqueResult,
     };
     pub use crate::{bytemuck, glam, wgpu};
 }

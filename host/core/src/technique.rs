@@ -348,6 +348,8 @@ pub struct Changes {
     pub resolution: bool,
     /// The camera.
     pub camera: bool,
+    /// Parameters applied in place by [`ShadowTechnique::update_params`].
+    pub params: bool,
 }
 
 impl Changes {
@@ -357,7 +359,18 @@ impl Changes {
         lights: true,
         resolution: true,
         camera: true,
+        params: true,
     };
+}
+
+/// What [`ShadowTechnique::update_params`] did with new parameter values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParamUpdate {
+    /// Taken over by the live instance; the next `prepare` sees `changes.params`.
+    Applied,
+    /// They change resources or pipelines the instance cannot adjust: the host creates a new
+    /// instance with them.
+    Rebuild,
 }
 
 /// Everything a technique may read while preparing and recording a frame.
@@ -418,7 +431,14 @@ pub trait ShadowTechnique: Send {
         None
     }
 
-    /// Workload counters from the last frame (silhouette edges, VPLs, ...).
+    /// Takes new, validated parameter values without being rebuilt when it can (a filter
+    /// radius, a debug choice), or asks for a new instance. The default always rebuilds.
+    fn update_params(&mut self, _values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+        Ok(ParamUpdate::Rebuild)
+    }
+
+    /// Workload counters from the newest frame whose counters have arrived (silhouette
+    /// edges, VPLs, ...); read back without stalling, so they may lag a frame or two.
     fn counters(&self) -> Vec<(String, f64)> {
         Vec::new()
     }

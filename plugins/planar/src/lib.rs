@@ -19,8 +19,8 @@ use zoo_host::render::visibility::VISIBILITY_FORMAT;
 use zoo_host::scene::{LightKind, Scene};
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
-    Changes, GpuContext, ParamValues, PassInfo, PassRecorder, RenderContext, ShadowTechnique,
-    TechniqueError, wgpu,
+    Changes, GpuContext, ParamUpdate, ParamValues, PassInfo, PassRecorder, RenderContext,
+    ShadowTechnique, TechniqueError, wgpu,
 };
 
 use crate::matrix::shadow_matrix;
@@ -320,7 +320,7 @@ impl ShadowTechnique for Planar {
         if self.gpu.is_none() {
             self.gpu = Some(self.create_pipelines(ctx)?);
         }
-        if changes.scene || changes.lights || self.uniforms.is_none() {
+        if changes.scene || changes.lights || changes.params || self.uniforms.is_none() {
             self.plan(ctx)?;
         }
         if changes.resolution || self.plane_ids.is_none() {
@@ -378,6 +378,17 @@ impl ShadowTechnique for Planar {
             }
         }
         Ok(())
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
+        let next = PlanarParams::from_values(values)?;
+        // The depth offset is part of the marking pipeline; receivers and opacity are in the
+        // projection uniforms `plan` rewrites.
+        if next.depth_offset != self.params.depth_offset {
+            return Ok(ParamUpdate::Rebuild);
+        }
+        self.params = next;
+        Ok(ParamUpdate::Applied)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

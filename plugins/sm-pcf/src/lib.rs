@@ -18,8 +18,8 @@ use zoo_host::render::Vertex;
 use zoo_host::scene::{Light, LightKind, Scene};
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
-    Changes, GpuContext, ParamValues, PassInfo, PassRecorder, RenderContext, ShadowTechnique,
-    TechniqueError, wgpu,
+    Changes, GpuContext, ParamUpdate, ParamValues, PassInfo, PassRecorder, RenderContext,
+    ShadowTechnique, TechniqueError, wgpu,
 };
 
 use crate::light_space::{
@@ -864,6 +864,25 @@ impl ShadowTechnique for ShadowMaps {
             }
         }
         Ok(())
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
+        let next = SmParams::from_values(values)?;
+        // Map size, depth biases and culling live in the maps and the depth pipeline; the
+        // rest reaches the shader through the per-light buffers `fit` rewrites.
+        let built = |p: &SmParams| {
+            (
+                p.map_size,
+                p.constant_bias,
+                p.slope_bias.to_bits(),
+                p.cull_front,
+            )
+        };
+        if built(&next) != built(&self.params) {
+            return Ok(ParamUpdate::Rebuild);
+        }
+        self.params = next;
+        Ok(ParamUpdate::Applied)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

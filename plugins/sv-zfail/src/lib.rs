@@ -20,8 +20,8 @@ use zoo_host::render::visibility::VISIBILITY_FORMAT;
 use zoo_host::scene::{EdgeKind, LightKind, Scene};
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
-    Changes, GpuContext, ParamValues, PassInfo, PassRecorder, RenderContext, ShadowTechnique,
-    TechniqueError, wgpu,
+    Changes, GpuContext, ParamUpdate, ParamValues, PassInfo, PassRecorder, RenderContext,
+    ShadowTechnique, TechniqueError, wgpu,
 };
 
 zoo_host::param_choice! {
@@ -775,6 +775,20 @@ impl ShadowTechnique for ShadowVolumes {
             }
         }
         Ok(())
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
+        let next = SvParams::from_values(values)?;
+        // Only the debug light is read at record time; the rest shapes pipelines and buffers.
+        let same_build = SvParams {
+            debug_light: self.params.debug_light,
+            ..next.clone()
+        } == self.params;
+        if !same_build {
+            return Ok(ParamUpdate::Rebuild);
+        }
+        self.params = next;
+        Ok(ParamUpdate::Applied)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

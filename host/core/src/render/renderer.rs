@@ -19,8 +19,8 @@ use crate::gpu::{
 use crate::params::{self, ParamValues};
 use crate::scene::{Camera, Light, Scene};
 use crate::technique::{
-    self, Changes, RenderContext, ShadowTechnique, TechniqueError, TechniqueRegistration,
-    ViewMapping,
+    self, Changes, ParamUpdate, RenderContext, ShadowTechnique, TechniqueError,
+    TechniqueRegistration, ViewMapping,
 };
 
 /// What the output image shows.
@@ -360,6 +360,34 @@ impl Renderer {
         self.technique = next;
         self.update_slots();
         Ok(())
+    }
+
+    /// Changes the current technique's parameters: applied to the live instance when it can
+    /// take them ([`ShadowTechnique::update_params`]), else a new instance is created. Returns
+    /// whether they were applied in place. On error the technique and its values stay.
+    pub fn set_params(&mut self, values: &ParamValues) -> Result<bool, TechniqueError> {
+        let registration = self.technique.registration;
+        let schema = (registration.params)();
+        let mut params = params::defaults(&schema);
+        for (key, value) in values {
+            params::find_spec(&schema, key)?.check(value)?;
+            params.insert(key.clone(), value.clone());
+        }
+        let instance = &mut self.technique.instance;
+        let update = guarded(&self.gpu, registration.id, || {
+            instance.update_params(&params)
+        })?;
+        match update {
+            ParamUpdate::Applied => {
+                self.technique.params = params;
+                self.technique.pending.params = true;
+                Ok(true)
+            }
+            ParamUpdate::Rebuild => {
+                self.set_technique(registration.id, &params)?;
+                Ok(false)
+            }
+        }
     }
 
     /// Counts vertex, fragment and compute invocations per pass (where the device has
