@@ -9,21 +9,20 @@
 //! lit. Bias: constant and slope-scaled pipeline depth bias, normal offset in texels, and
 //! optional front-face culling in the depth pass.
 
-pub mod light_space;
-
 use bytemuck::{Pod, Zeroable};
-use zoo_host::glam::{UVec2, Vec3};
+use zoo_host::glam::UVec2;
 use zoo_host::params::TechniqueParams;
-use zoo_host::render::Vertex;
-use zoo_host::scene::{Light, LightKind, Scene};
+use zoo_host::scene::LightKind;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
     Changes, GpuContext, ParamUpdate, ParamValues, PassInfo, PassRecorder, RenderContext,
     ShadowTechnique, TechniqueError, wgpu,
 };
 
-use crate::light_space::{
-    Aabb, LightFrustum, Projection, cube_frustums, directional_frustum, spot_frustum,
+use zoo_shadow_maps::light_space::{Aabb, Projection};
+use zoo_shadow_maps::{
+    DepthPass, DepthState, LightMaps, MapArray, PlanInputs, effective_resolution, layers_needed,
+    light_size, object_bounds,
 };
 
 zoo_host::param_choice! {
@@ -67,14 +66,6 @@ impl Filter {
     }
 }
 
-/// `Slot` in `sm-pcf/lookup.wgsl` and `LayerCamera` in `depth.wgsl`: 256 bytes.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-#[repr(C)]
-struct Slot {
-    view_proj: [[f32; 4]; 4],
-    _pad: [[f32; 4]; 12],
-}
-
 /// `ShadowLight` in `sm-pcf/lookup.wgsl`.
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 #[repr(C)]
@@ -107,83 +98,17 @@ struct Current {
 }
 
 const SLOT: u64 = 256;
-const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const DIAGNOSTICS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// Texels of guard band around each cube face (covers bilinear taps across face edges).
-const CUBE_GUARD: u32 = 2;
-/// Shadow maps are kept under this many bytes; the resolution drops to fit.
-const MEMORY_BUDGET: u64 = 1 << 30;
-
-/// One light's layers.
-#[derive(Debug, Clone)]
-struct LightMaps {
-    light: usize,
-    first_layer: u32,
-    frustums: Vec<LightFrustum>,
-    /// Screen rectangle (x, y, width, height) its lookup pass can touch.
-    scissor: [u32; 4],
-}
-
-/// The screen rectangle covering `light`'s range sphere (the whole screen for directional
-/// lights or when the sphere reaches behind the camera); width 0 when it is off screen.
-pub fn light_scissor(light: &Light, view_proj: zoo_host::glam::Mat4, size: UVec2) -> [u32; 4] {
-    let full = [0, 0, size.x, size.y];
-    if light.kind == LightKind::Directional {
-        return full;
-    }
-    let (mut lo, mut hi) = (
-        zoo_host::glam::Vec2::splat(f32::INFINITY),
-        zoo_host::glam::Vec2::splat(f32::NEG_INFINITY),
-    );
-    for i in 0..8 {
-        let corner = light.position
-            + light.range
-                * Vec3::new(
-                    if i & 1 == 0 { -1.0 } else { 1.0 },
-                    if i & 2 == 0 { -1.0 } else { 1.0 },
-                    if i & 4 == 0 { -1.0 } else { 1.0 },
-                );
-        let clip = view_proj * corner.extend(1.0);
-        if clip.w <= 1e-4 {
-            return full;
-        }
-        let ndc = clip.truncate().truncate() / clip.w;
-        let pixel = zoo_host::glam::Vec2::new(
-            (ndc.x * 0.5 + 0.5) * size.x as f32,
-            (0.5 - ndc.y * 0.5) * size.y as f32,
-        );
-        lo = lo.min(pixel);
-        hi = hi.max(pixel);
-    }
-    let x0 = lo.x.floor().clamp(0.0, size.x as f32) as u32;
-    let y0 = lo.y.floor().clamp(0.0, size.y as f32) as u32;
-    let x1 = hi.x.ceil().clamp(0.0, size.x as f32) as u32;
-    let y1 = hi.y.ceil().clamp(0.0, size.y as f32) as u32;
-    [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)]
-}
-
 struct Pipelines {
-    depth: wgpu::RenderPipeline,
-    depth_layout: wgpu::BindGroupLayout,
+    depth: DepthPass,
     /// Without and with diagnostics output; each writes the light's slot (`kit::slot_target`).
     lookup: Vec<wgpu::RenderPipeline>,
     lookup_layout: wgpu::BindGroupLayout,
 }
 
-struct Maps {
-    resolution: u32,
-    /// Layers in use (the texture may hold a spare one, see `zoo_host::gpu::array_layers`).
-    layers: u32,
-    texture: wgpu::Texture,
-    layer_views: Vec<wgpu::TextureView>,
-    array_view: wgpu::TextureView,
-}
-
 struct Buffers {
-    slots: wgpu::Buffer,
     lights: wgpu::Buffer,
     current: wgpu::Buffer,
-    depth_bind_group: wgpu::BindGroup,
     lookup_bind_group: wgpu::BindGroup,
 }
 
@@ -191,7 +116,7 @@ struct Buffers {
 pub struct ShadowMaps {
     params: SmParams,
     pipelines: Option<Pipelines>,
-    maps: Option<Maps>,
+    maps: Option<MapArray>,
     buffers: Option<Buffers>,
     diagnostics: Option<(wgpu::Texture, wgpu::TextureView)>,
     samplers: Option<(wgpu::Sampler, wgpu::Sampler)>,
@@ -201,98 +126,19 @@ pub struct ShadowMaps {
     caster_bounds: Vec<Aabb>,
 }
 
-/// World-space bounds of the objects (only shadow casters when `casters_only`).
-fn object_bounds(scene: &Scene, casters_only: bool) -> Vec<Aabb> {
-    scene
-        .objects
-        .iter()
-        .filter(|o| o.casts_shadows || !casters_only)
-        .filter_map(|o| {
-            let points: Vec<Vec3> = scene.mesh.indices[o.indices.clone()]
-                .iter()
-                .map(|&i| scene.mesh.positions[i as usize])
-                .collect();
-            zoo_host::scene::mesh::bounds(&points)
-        })
-        .collect()
-}
-
-/// The resolution to use: the requested one clamped to the device and the memory budget.
-pub fn effective_resolution(requested: u32, device_max: u32, layers: u32) -> (u32, Option<String>) {
-    let mut resolution = requested.min(device_max);
-    let mut note = (resolution < requested).then(|| {
-        format!("sm-pcf: map_size {requested} exceeds the device limit; using {resolution}")
-    });
-    while resolution > 256 && layers as u64 * (resolution as u64).pow(2) * 4 > MEMORY_BUDGET {
-        resolution /= 2;
-        note = Some(format!(
-            "sm-pcf: {layers} map layers at {requested} texels exceed {} MiB; using {resolution}",
-            MEMORY_BUDGET >> 20
-        ));
-    }
-    (resolution, note)
-}
-
-fn light_size(light: &Light) -> f32 {
-    match light.kind {
-        LightKind::Directional => light.radius.tan(),
-        _ => light.radius,
-    }
-}
-
 impl ShadowMaps {
     fn create_pipelines(&self, ctx: &RenderContext<'_>) -> Result<Pipelines, TechniqueError> {
         let device = &ctx.gpu.device;
-        let depth_module = ctx.shaders.create_module(device, "sm-pcf/depth.wgsl")?;
+        let depth = DepthPass::new(
+            ctx,
+            "sm-pcf depth",
+            DepthState {
+                constant_bias: self.params.constant_bias as i32,
+                slope_bias: self.params.slope_bias,
+                cull_front: self.params.cull_front,
+            },
+        )?;
         let lookup_module = ctx.shaders.create_module(device, "sm-pcf/lookup.wgsl")?;
-        let depth_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sm-pcf depth layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(64),
-                },
-                count: None,
-            }],
-        });
-        let depth_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("sm-pcf depth pipeline layout"),
-                bind_group_layouts: &[Some(&depth_layout)],
-                immediate_size: 0,
-            });
-        let depth = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("sm-pcf depth pipeline"),
-            layout: Some(&depth_pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &depth_module,
-                entry_point: Some("vs_depth"),
-                compilation_options: Default::default(),
-                buffers: &[Some(Vertex::LAYOUT)],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: self.params.cull_front.then_some(wgpu::Face::Front),
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: MAP_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: wgpu::DepthBiasState {
-                    constant: self.params.constant_bias as i32,
-                    slope_scale: self.params.slope_bias,
-                    clamp: 0.0,
-                },
-            }),
-            multisample: Default::default(),
-            fragment: None,
-            multiview_mask: None,
-            cache: None,
-        });
 
         let texture_entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -409,7 +255,6 @@ impl ShadowMaps {
             .collect();
         Ok(Pipelines {
             depth,
-            depth_layout,
             lookup,
             lookup_layout,
         })
@@ -417,64 +262,23 @@ impl ShadowMaps {
 
     /// Plans layers for every light and (re)creates the map array when its size changes.
     fn plan_maps(&mut self, ctx: &RenderContext<'_>) {
-        let layers_needed: u32 = ctx
-            .lights
-            .iter()
-            .map(|l| if l.kind == LightKind::Point { 6 } else { 1 })
-            .sum::<u32>()
-            .max(1);
+        let layers = layers_needed(ctx.lights);
         let device_max = ctx.gpu.device.limits().max_texture_dimension_2d;
-        let (resolution, note) =
-            effective_resolution(self.params.map_size, device_max, layers_needed);
+        let (resolution, note) = effective_resolution(self.params.map_size, device_max, layers);
         if let Some(note) = note {
-            zoo_host::log::warn!("{note}");
+            zoo_host::log::warn!("sm-pcf: {note}");
         }
-        let layers_allocated =
-            zoo_host::gpu::array_layers(ctx.gpu, resolution, resolution, layers_needed);
         let reuse = self
             .maps
             .as_ref()
-            .is_some_and(|m| m.resolution == resolution && m.layers == layers_needed);
+            .is_some_and(|m| m.resolution == resolution && m.layers == layers);
         if !reuse {
-            let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("sm-pcf shadow maps"),
-                size: wgpu::Extent3d {
-                    width: resolution,
-                    height: resolution,
-                    depth_or_array_layers: layers_allocated,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: MAP_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            let layer_views = (0..layers_needed)
-                .map(|layer| {
-                    texture.create_view(&wgpu::TextureViewDescriptor {
-                        label: Some(&format!("sm-pcf shadow map layer {layer}")),
-                        dimension: Some(wgpu::TextureViewDimension::D2),
-                        base_array_layer: layer,
-                        array_layer_count: Some(1),
-                        ..Default::default()
-                    })
-                })
-                .collect();
-            let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some("sm-pcf shadow maps (array)"),
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                array_layer_count: Some(layers_needed),
-                ..Default::default()
-            });
-            self.maps = Some(Maps {
+            self.maps = Some(MapArray::new(
+                ctx.gpu,
+                "sm-pcf shadow maps",
                 resolution,
-                layers: layers_needed,
-                texture,
-                layer_views,
-                array_view,
-            });
+                layers,
+            ));
             self.buffers = None;
         }
     }
@@ -482,45 +286,20 @@ impl ShadowMaps {
     /// Fits every light's frustums to the current lights and camera and uploads them.
     fn fit(&mut self, ctx: &RenderContext<'_>) {
         let resolution = self.maps.as_ref().expect("maps planned").resolution;
-        let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
-        let mut next_layer = 0;
-        self.lights = ctx
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(i, light)| {
-                let frustums = match light.kind {
-                    LightKind::Spot => vec![spot_frustum(light)],
-                    LightKind::Point => cube_frustums(light, resolution, CUBE_GUARD).to_vec(),
-                    LightKind::Directional => vec![directional_frustum(
-                        light.direction,
-                        ctx.camera,
-                        aspect,
-                        &self.object_bounds,
-                        &self.caster_bounds,
-                        self.params.stable_fit.then_some(resolution),
-                    )],
-                };
-                let maps = LightMaps {
-                    light: i,
-                    first_layer: next_layer,
-                    frustums,
-                    scissor: light_scissor(light, ctx.frame.matrices.view_proj, ctx.size),
-                };
-                next_layer += maps.frustums.len() as u32;
-                maps
-            })
-            .collect();
-
-        let slots: Vec<Slot> = self
-            .lights
-            .iter()
-            .flat_map(|l| &l.frustums)
-            .map(|f| Slot {
-                view_proj: f.view_proj.to_cols_array_2d(),
-                _pad: [[0.0; 4]; 12],
-            })
-            .collect();
+        self.lights = zoo_shadow_maps::plan(&PlanInputs {
+            lights: ctx.lights,
+            camera: ctx.camera,
+            view_proj: ctx.frame.matrices.view_proj,
+            size: ctx.size,
+            objects: &self.object_bounds,
+            casters: &self.caster_bounds,
+            resolution,
+            stable: self.params.stable_fit,
+        });
+        let pipelines = self.pipelines.as_mut().expect("pipelines exist");
+        if pipelines.depth.write_cameras(ctx.gpu, &self.lights) {
+            self.buffers = None;
+        }
         let shadow_lights: Vec<ShadowLight> = self
             .lights
             .iter()
@@ -566,19 +345,17 @@ impl ShadowMaps {
 
         let queue = &ctx.gpu.queue;
         let fits = |buffer: &wgpu::Buffer, bytes: usize| buffer.size() >= bytes.max(16) as u64;
-        let slot_bytes = size_of_val(slots.as_slice());
         let light_bytes = size_of_val(shadow_lights.as_slice());
         let current_bytes = size_of_val(currents.as_slice());
-        if !self.buffers.as_ref().is_some_and(|b| {
-            fits(&b.slots, slot_bytes)
-                && fits(&b.lights, light_bytes)
-                && fits(&b.current, current_bytes)
-        }) {
-            self.buffers = Some(self.create_buffers(ctx, slot_bytes, light_bytes, current_bytes));
+        if !self
+            .buffers
+            .as_ref()
+            .is_some_and(|b| fits(&b.lights, light_bytes) && fits(&b.current, current_bytes))
+        {
+            self.buffers = Some(self.create_buffers(ctx, light_bytes, current_bytes));
         }
         let buffers = self.buffers.as_ref().expect("created above");
-        if !slots.is_empty() {
-            queue.write_buffer(&buffers.slots, 0, bytemuck::cast_slice(&slots));
+        if !shadow_lights.is_empty() {
             queue.write_buffer(&buffers.lights, 0, bytemuck::cast_slice(&shadow_lights));
             queue.write_buffer(&buffers.current, 0, bytemuck::cast_slice(&currents));
         }
@@ -587,7 +364,6 @@ impl ShadowMaps {
     fn create_buffers(
         &self,
         ctx: &RenderContext<'_>,
-        slot_bytes: usize,
         light_bytes: usize,
         current_bytes: usize,
     ) -> Buffers {
@@ -603,11 +379,7 @@ impl ShadowMaps {
                 mapped_at_creation: false,
             })
         };
-        let slots = buffer(
-            "sm-pcf layer cameras",
-            slot_bytes,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE,
-        );
+        let cameras = pipelines.depth.cameras().expect("cameras written");
         let lights = buffer(
             "sm-pcf shadow lights",
             light_bytes,
@@ -618,18 +390,6 @@ impl ShadowMaps {
             current_bytes,
             wgpu::BufferUsages::UNIFORM,
         );
-        let depth_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sm-pcf depth bind group"),
-            layout: &pipelines.depth_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &slots,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(64),
-                }),
-            }],
-        });
         let lookup_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sm-pcf lookup bind group"),
             layout: &pipelines.lookup_layout,
@@ -648,7 +408,7 @@ impl ShadowMaps {
                 },
                 wgpu::BindGroupEntry {
                     binding: 3,
-                    resource: slots.as_entire_binding(),
+                    resource: cameras.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 4,
@@ -673,10 +433,8 @@ impl ShadowMaps {
             ],
         });
         Buffers {
-            slots,
             lights,
             current,
-            depth_bind_group,
             lookup_bind_group,
         }
     }
@@ -760,12 +518,14 @@ impl ShadowTechnique for ShadowMaps {
                 });
             }
         }
-        if let Some(b) = &self.buffers {
+        if let Some(cameras) = self.pipelines.as_ref().and_then(|p| p.depth.cameras()) {
             out.push(ResourceInfo::buffer(
                 "layer cameras",
-                &b.slots,
+                cameras,
                 "mat4 in 256-byte slots",
             ));
+        }
+        if let Some(b) = &self.buffers {
             out.push(ResourceInfo::buffer(
                 "shadow lights",
                 &b.lights,
@@ -817,35 +577,9 @@ impl ShadowTechnique for ShadowMaps {
                 "sm-pcf: record before prepare".into(),
             ));
         };
-        for light_maps in &self.lights {
-            let cube = light_maps.frustums.len() == 6;
-            for face in 0..light_maps.frustums.len() {
-                let layer = light_maps.first_layer + face as u32;
-                let name = depth_pass_name(light_maps.light, cube.then_some(face));
-                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(&name),
-                    color_attachments: &[],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &maps.layer_views[layer as usize],
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&pipelines.depth);
-                pass.set_bind_group(
-                    0,
-                    &buffers.depth_bind_group,
-                    &[(layer as u64 * SLOT) as u32],
-                );
-                ctx.scene_buffers.draw_objects(&mut pass, ctx.scene, true);
-            }
-        }
+        pipelines
+            .depth
+            .record(ctx, recorder, maps, &self.lights, depth_pass_name)?;
         for (k, light_maps) in self.lights.iter().enumerate() {
             let debug = light_maps.light as u32 == self.params.debug_light;
             let name = lookup_pass_name(light_maps.light);
@@ -961,60 +695,7 @@ zoo_host::register_technique! {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_integer_constant};
-
-    #[test]
-    fn resolution_is_clamped_to_device_and_memory() {
-        assert_eq!(effective_resolution(2048, 16384, 3), (2048, None));
-        let (r, note) = effective_resolution(8192, 4096, 1);
-        assert_eq!(r, 4096);
-        assert!(note.unwrap().contains("device limit"));
-        // 224 layers at 2048 would need 3.5 GiB.
-        let (r, note) = effective_resolution(2048, 16384, 224);
-        assert!(224 * (r as u64).pow(2) * 4 <= MEMORY_BUDGET);
-        assert!(note.unwrap().contains("exceed"));
-    }
-
-    #[test]
-    fn scissor_covers_the_light_sphere_on_screen() {
-        let camera = zoo_host::scene::Camera {
-            position: Vec3::new(0.0, 5.0, 10.0),
-            target: Vec3::ZERO,
-            fov_y: 1.0,
-            near: 0.1,
-            far: 100.0,
-        };
-        let size = UVec2::new(200, 100);
-        let view_proj = camera.projection(2.0) * camera.view();
-        let mut light = Light {
-            kind: LightKind::Point,
-            position: Vec3::ZERO,
-            direction: Vec3::NEG_Y,
-            radiance: Vec3::ONE,
-            range: 1.0,
-            spot_angle: 0.0,
-            spot_softness: 0.0,
-            radius: 0.0,
-        };
-        let [x, y, w, h] = light_scissor(&light, view_proj, size);
-        assert!(w > 0 && h > 0 && w < 200 && h < 100, "{x} {y} {w} {h}");
-        // Every point of the sphere projects inside the rectangle.
-        for k in 0..200 {
-            let t = k as f32;
-            let p = Vec3::new((t * 1.7).sin(), (t * 0.9).cos(), (t * 2.3).sin()).normalize() * 0.99;
-            let ndc = view_proj.project_point3(p);
-            let px = (ndc.x * 0.5 + 0.5) * 200.0;
-            let py = (0.5 - ndc.y * 0.5) * 100.0;
-            assert!(
-                px >= x as f32 && px <= (x + w) as f32 && py >= y as f32 && py <= (y + h) as f32
-            );
-        }
-        // A sphere reaching behind the camera, or a directional light, covers the screen.
-        light.range = 20.0;
-        assert_eq!(light_scissor(&light, view_proj, size), [0, 0, 200, 100]);
-        light.kind = LightKind::Directional;
-        assert_eq!(light_scissor(&light, view_proj, size), [0, 0, 200, 100]);
-    }
+    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_integer_constant, wgsl_struct};
 
     #[test]
     fn filter_codes_match_the_shader() {
@@ -1066,13 +747,12 @@ mod tests {
             _pad
         });
         check_mirror(&lookup, "ShadowLight", size, &fields, SizeRule::Equal).unwrap();
-        let (size, fields) = zoo_host::mirror_fields!(Slot { view_proj, _pad });
-        check_mirror(&lookup, "Slot", size, &fields, SizeRule::Equal).unwrap();
+        // The layer cameras come from the shadow-map library's depth pass, 256 bytes apart.
+        let slot = wgsl_struct(&lookup, "Slot").unwrap();
+        assert_eq!(slot.size as u64, zoo_shadow_maps::CAMERA_STRIDE);
+        assert_eq!(slot.members[0], ("view_proj".to_string(), 0));
         // Uniforms at 256-byte dynamic offsets: the Rust struct fills the slot.
         let (size, fields) = zoo_host::mirror_fields!(Current { index, debug });
         check_mirror(&lookup, "Current", size, &fields, SizeRule::AtLeast).unwrap();
-        let depth = shader("sm-pcf/depth.wgsl");
-        let (size, fields) = zoo_host::mirror_fields!(Slot { view_proj });
-        check_mirror(&depth, "LayerCamera", size, &fields, SizeRule::AtLeast).unwrap();
     }
 }

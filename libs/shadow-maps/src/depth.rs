@@ -1,0 +1,207 @@
+//! The depth pass: every caster rendered into each layer of a [`MapArray`] from that layer's
+//! camera (`shaders/shadow-maps/depth.wgsl`).
+
+use zoo_host::gpu::PassRecorder;
+use zoo_host::render::Vertex;
+use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
+
+use crate::maps::{MAP_FORMAT, MapArray};
+use crate::planning::LightMaps;
+
+/// Bytes between layer cameras: a uniform dynamic-offset slot, and `LayerCamera` as an array
+/// element for lookups that project into any layer.
+pub const CAMERA_STRIDE: u64 = 256;
+
+/// Rasterisation state of the depth pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DepthState {
+    /// Constant depth bias, in units of the depth format's resolution.
+    pub constant_bias: i32,
+    /// Slope-scaled depth bias.
+    pub slope_bias: f32,
+    /// Store back faces (cull front faces).
+    pub cull_front: bool,
+}
+
+/// The depth pipeline and the layer cameras.
+pub struct DepthPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    cameras: Option<(wgpu::Buffer, wgpu::BindGroup)>,
+}
+
+impl DepthPass {
+    /// Builds the pipeline (`label` names it and its layouts).
+    pub fn new(
+        ctx: &RenderContext<'_>,
+        label: &str,
+        state: DepthState,
+    ) -> Result<DepthPass, TechniqueError> {
+        let device = &ctx.gpu.device;
+        let module = ctx
+            .shaders
+            .create_module(device, "shadow-maps/depth.wgsl")?;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(&format!("{label} layer camera layout")),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(64),
+                },
+                count: None,
+            }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(&format!("{label} pipeline layout")),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(&format!("{label} pipeline")),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_depth"),
+                compilation_options: Default::default(),
+                buffers: &[Some(Vertex::LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: state.cull_front.then_some(wgpu::Face::Front),
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: MAP_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                stencil: Default::default(),
+                bias: wgpu::DepthBiasState {
+                    constant: state.constant_bias,
+                    slope_scale: state.slope_bias,
+                    clamp: 0.0,
+                },
+            }),
+            multisample: Default::default(),
+            fragment: None,
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(DepthPass {
+            pipeline,
+            layout,
+            cameras: None,
+        })
+    }
+
+    /// Uploads the layer cameras of `lights` (growing the buffer when needed). Returns whether
+    /// the buffer was replaced, so bind groups that read [`Self::cameras`] must be rebuilt.
+    pub fn write_cameras(&mut self, gpu: &GpuContext, lights: &[LightMaps]) -> bool {
+        let mut bytes = Vec::new();
+        for frustum in lights.iter().flat_map(|l| &l.frustums) {
+            let mut slot = [0u8; CAMERA_STRIDE as usize];
+            slot[..64].copy_from_slice(bytemuck::bytes_of(&frustum.view_proj.to_cols_array()));
+            bytes.extend_from_slice(&slot);
+        }
+        let needed = (bytes.len() as u64).max(CAMERA_STRIDE);
+        let replaced = self
+            .cameras
+            .as_ref()
+            .is_none_or(|(buffer, _)| buffer.size() < needed);
+        if replaced {
+            let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadow-map layer cameras"),
+                size: needed.next_power_of_two().max(CAMERA_STRIDE),
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shadow-map layer camera bind group"),
+                layout: &self.layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &buffer,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(64),
+                    }),
+                }],
+            });
+            self.cameras = Some((buffer, bind_group));
+        }
+        if !bytes.is_empty() {
+            let (buffer, _) = self.cameras.as_ref().expect("created above");
+            gpu.queue.write_buffer(buffer, 0, &bytes);
+        }
+        replaced
+    }
+
+    /// The layer cameras (`array<LayerCamera>` with a 256-byte stride, for lookups), once
+    /// written.
+    pub fn cameras(&self) -> Option<&wgpu::Buffer> {
+        self.cameras.as_ref().map(|(buffer, _)| buffer)
+    }
+
+    /// Records one depth pass per layer of `lights` into `maps`, named by
+    /// `name(light, face)` (`face` is `Some` for cube faces).
+    pub fn record(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        maps: &MapArray,
+        lights: &[LightMaps],
+        name: impl Fn(usize, Option<usize>) -> String,
+    ) -> Result<(), TechniqueError> {
+        let (_, bind_group) = self
+            .cameras
+            .as_ref()
+            .ok_or_else(TechniqueError::not_prepared)?;
+        for light_maps in lights {
+            let cube = light_maps.frustums.len() == 6;
+            for face in 0..light_maps.frustums.len() {
+                let layer = light_maps.first_layer + face as u32;
+                let label = name(light_maps.light, cube.then_some(face));
+                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(&label),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &maps.layer_views[layer as usize],
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, bind_group, &[(layer as u64 * CAMERA_STRIDE) as u32]);
+                ctx.scene_buffers.draw_objects(&mut pass, ctx.scene, true);
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::wgsl_struct;
+
+    #[test]
+    fn layer_cameras_mirror_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose("shadow-maps/depth.wgsl")
+            .unwrap()
+            .source;
+        let camera = wgsl_struct(&source, "LayerCamera").unwrap();
+        assert_eq!(camera.members, [("view_proj".to_string(), 0)]);
+        assert_eq!(camera.size, 64);
+        assert_eq!(CAMERA_STRIDE % 256, 0, "a dynamic-offset slot");
+    }
+}

@@ -1,0 +1,102 @@
+//! The depth array that holds every light's shadow-map layers.
+
+use zoo_host::GpuContext;
+use zoo_host::wgpu;
+
+/// Depth format of the maps.
+pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Texels of guard band around each cube face (covers bilinear taps across face edges).
+pub const CUBE_GUARD: u32 = 2;
+/// Shadow maps are kept under this many bytes; the resolution drops to fit.
+pub const MEMORY_BUDGET: u64 = 1 << 30;
+
+/// The resolution to use: `requested` clamped to the device and to [`MEMORY_BUDGET`] for
+/// `layers` layers, with a note saying why when it was lowered.
+pub fn effective_resolution(requested: u32, device_max: u32, layers: u32) -> (u32, Option<String>) {
+    let mut resolution = requested.min(device_max);
+    let mut note = (resolution < requested)
+        .then(|| format!("map_size {requested} exceeds the device limit; using {resolution}"));
+    while resolution > 256 && layers as u64 * (resolution as u64).pow(2) * 4 > MEMORY_BUDGET {
+        resolution /= 2;
+        note = Some(format!(
+            "{layers} map layers at {requested} texels exceed {} MiB; using {resolution}",
+            MEMORY_BUDGET >> 20
+        ));
+    }
+    (resolution, note)
+}
+
+/// `layers` square depth maps of `resolution` texels in one array texture.
+pub struct MapArray {
+    pub resolution: u32,
+    /// Layers in use (the texture may hold a spare one on GL, see
+    /// `zoo_host::gpu::array_layers`).
+    pub layers: u32,
+    pub texture: wgpu::Texture,
+    /// One 2D view per layer, for depth attachments and debug views.
+    pub layer_views: Vec<wgpu::TextureView>,
+    /// All layers in use, for lookups.
+    pub array_view: wgpu::TextureView,
+}
+
+impl MapArray {
+    /// Creates the array (`label` names the texture and its views).
+    pub fn new(gpu: &GpuContext, label: &str, resolution: u32, layers: u32) -> MapArray {
+        let allocated = zoo_host::gpu::array_layers(gpu, resolution, resolution, layers);
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: resolution,
+                height: resolution,
+                depth_or_array_layers: allocated,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: MAP_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let layer_views = (0..layers)
+            .map(|layer| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some(&format!("{label} layer {layer}")),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some(&format!("{label} (array)")),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            array_layer_count: Some(layers),
+            ..Default::default()
+        });
+        MapArray {
+            resolution,
+            layers,
+            texture,
+            layer_views,
+            array_view,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolution_is_clamped_to_device_and_memory() {
+        assert_eq!(effective_resolution(2048, 16384, 3), (2048, None));
+        let (r, note) = effective_resolution(8192, 4096, 1);
+        assert_eq!(r, 4096);
+        assert!(note.unwrap().contains("device limit"));
+        // 224 layers at 2048 would need 3.5 GiB.
+        let (r, note) = effective_resolution(2048, 16384, 224);
+        assert!(224 * (r as u64).pow(2) * 4 <= MEMORY_BUDGET);
+        assert!(note.unwrap().contains("exceed"));
+    }
+}

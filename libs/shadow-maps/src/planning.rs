@@ -1,0 +1,185 @@
+//! Which layers each light gets, their cameras, and the screen area each light can touch.
+
+use zoo_host::glam::{Mat4, UVec2, Vec2, Vec3};
+use zoo_host::scene::{Camera, Light, LightKind, Scene};
+
+use crate::light_space::{Aabb, LightFrustum, cube_frustums, directional_frustum, spot_frustum};
+use crate::maps::CUBE_GUARD;
+
+/// One light's layers of the map array.
+#[derive(Debug, Clone)]
+pub struct LightMaps {
+    /// Index of the scene light.
+    pub light: usize,
+    pub first_layer: u32,
+    /// One frustum per layer: 1 (spot, directional) or 6 (point: cube faces).
+    pub frustums: Vec<LightFrustum>,
+    /// Screen rectangle (x, y, width, height) its lookups can touch.
+    pub scissor: [u32; 4],
+}
+
+/// Layers the lights need: six for a point light, one otherwise (at least one in all).
+pub fn layers_needed(lights: &[Light]) -> u32 {
+    lights
+        .iter()
+        .map(|l| if l.kind == LightKind::Point { 6 } else { 1 })
+        .sum::<u32>()
+        .max(1)
+}
+
+/// What [`plan`] fits the maps to.
+pub struct PlanInputs<'a> {
+    pub lights: &'a [Light],
+    pub camera: &'a Camera,
+    /// The camera's view-projection and output size, for the scissors.
+    pub view_proj: Mat4,
+    pub size: UVec2,
+    /// World bounds of every object and of each caster ([`object_bounds`]).
+    pub objects: &'a [Aabb],
+    pub casters: &'a [Aabb],
+    /// Map resolution; with `stable`, directional maps keep a stable fit (extent on a ladder,
+    /// centre snapped to whole texels) so edges do not shimmer as the camera moves.
+    pub resolution: u32,
+    pub stable: bool,
+}
+
+/// Consecutive layers for every light with their frusta: a perspective frustum on a spot
+/// cone, six guarded cube faces for a point light, and for a directional light an
+/// orthographic box fitted to the receivers the camera sees, reaching back to every caster.
+pub fn plan(inputs: &PlanInputs<'_>) -> Vec<LightMaps> {
+    let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
+    let mut next_layer = 0;
+    inputs
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, light)| {
+            let frustums = match light.kind {
+                LightKind::Spot => vec![spot_frustum(light)],
+                LightKind::Point => cube_frustums(light, inputs.resolution, CUBE_GUARD).to_vec(),
+                LightKind::Directional => vec![directional_frustum(
+                    light.direction,
+                    inputs.camera,
+                    aspect,
+                    inputs.objects,
+                    inputs.casters,
+                    inputs.stable.then_some(inputs.resolution),
+                )],
+            };
+            let maps = LightMaps {
+                light: i,
+                first_layer: next_layer,
+                frustums,
+                scissor: light_scissor(light, inputs.view_proj, inputs.size),
+            };
+            next_layer += maps.frustums.len() as u32;
+            maps
+        })
+        .collect()
+}
+
+/// The screen rectangle covering `light`'s range sphere (the whole screen for directional
+/// lights or when the sphere reaches behind the camera); width 0 when it is off screen.
+pub fn light_scissor(light: &Light, view_proj: Mat4, size: UVec2) -> [u32; 4] {
+    let full = [0, 0, size.x, size.y];
+    if light.kind == LightKind::Directional {
+        return full;
+    }
+    let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+    for i in 0..8 {
+        let corner = light.position
+            + light.range
+                * Vec3::new(
+                    if i & 1 == 0 { -1.0 } else { 1.0 },
+                    if i & 2 == 0 { -1.0 } else { 1.0 },
+                    if i & 4 == 0 { -1.0 } else { 1.0 },
+                );
+        let clip = view_proj * corner.extend(1.0);
+        if clip.w <= 1e-4 {
+            return full;
+        }
+        let ndc = clip.truncate().truncate() / clip.w;
+        let pixel = Vec2::new(
+            (ndc.x * 0.5 + 0.5) * size.x as f32,
+            (0.5 - ndc.y * 0.5) * size.y as f32,
+        );
+        lo = lo.min(pixel);
+        hi = hi.max(pixel);
+    }
+    let x0 = lo.x.floor().clamp(0.0, size.x as f32) as u32;
+    let y0 = lo.y.floor().clamp(0.0, size.y as f32) as u32;
+    let x1 = hi.x.ceil().clamp(0.0, size.x as f32) as u32;
+    let y1 = hi.y.ceil().clamp(0.0, size.y as f32) as u32;
+    [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)]
+}
+
+/// World-space bounds of the objects (only shadow casters when `casters_only`).
+pub fn object_bounds(scene: &Scene, casters_only: bool) -> Vec<Aabb> {
+    scene
+        .objects
+        .iter()
+        .filter(|o| o.casts_shadows || !casters_only)
+        .filter_map(|o| {
+            let points: Vec<Vec3> = scene.mesh.indices[o.indices.clone()]
+                .iter()
+                .map(|&i| scene.mesh.positions[i as usize])
+                .collect();
+            zoo_host::scene::mesh::bounds(&points)
+        })
+        .collect()
+}
+
+/// The light's size for penumbra estimates: its radius (point, spot) or the tangent of its
+/// angular radius (directional).
+pub fn light_size(light: &Light) -> f32 {
+    match light.kind {
+        LightKind::Directional => light.radius.tan(),
+        _ => light.radius,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scissor_covers_the_light_sphere_on_screen() {
+        let camera = zoo_host::scene::Camera {
+            position: Vec3::new(0.0, 5.0, 10.0),
+            target: Vec3::ZERO,
+            fov_y: 1.0,
+            near: 0.1,
+            far: 100.0,
+        };
+        let size = UVec2::new(200, 100);
+        let view_proj = camera.projection(2.0) * camera.view();
+        let mut light = Light {
+            kind: LightKind::Point,
+            position: Vec3::ZERO,
+            direction: Vec3::NEG_Y,
+            radiance: Vec3::ONE,
+            range: 1.0,
+            spot_angle: 0.0,
+            spot_softness: 0.0,
+            radius: 0.0,
+        };
+        let [x, y, w, h] = light_scissor(&light, view_proj, size);
+        assert!(w > 0 && h > 0 && w < 200 && h < 100, "{x} {y} {w} {h}");
+        // Every point of the sphere projects inside the rectangle.
+        for k in 0..200 {
+            let t = k as f32;
+            let p = Vec3::new((t * 1.7).sin(), (t * 0.9).cos(), (t * 2.3).sin()).normalize() * 0.99;
+            let ndc = view_proj.project_point3(p);
+            let px = (ndc.x * 0.5 + 0.5) * 200.0;
+            let py = (0.5 - ndc.y * 0.5) * 100.0;
+            assert!(
+                px >= x as f32 && px <= (x + w) as f32 && py >= y as f32 && py <= (y + h) as f32
+            );
+        }
+        // A sphere reaching behind the camera, or a directional light, covers the screen.
+        light.range = 20.0;
+        assert_eq!(light_scissor(&light, view_proj, size), [0, 0, 200, 100]);
+        light.kind = LightKind::Directional;
+        assert_eq!(light_scissor(&light, view_proj, size), [0, 0, 200, 100]);
+    }
+}
