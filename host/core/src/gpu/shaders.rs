@@ -118,6 +118,17 @@ impl ShaderLibrary {
             .ok_or_else(|| ShaderError::NotFound(name.to_string()))
     }
 
+    /// Whether `name` is a shared module (no entry point: `common/` files, library filters
+    /// that call functions their importer supplies). Such files are validated through the
+    /// shaders that import them, not on their own.
+    pub fn is_shared_module(&self, name: &str) -> bool {
+        self.source(name).is_ok_and(|text| {
+            !["@vertex", "@fragment", "@compute"]
+                .iter()
+                .any(|stage| text.contains(stage))
+        })
+    }
+
     /// Resolves the imports of `name`.
     pub fn compose(&self, name: &str) -> Result<ComposedShader, ShaderError> {
         let text = self.source(name)?;
@@ -301,9 +312,12 @@ mod tests {
         let library = ShaderLibrary::embedded();
         let names: Vec<_> = ShaderLibrary::names().collect();
         assert!(names.contains(&"host/lighting.wgsl"), "{names:?}");
+        assert!(library.is_shared_module("common/gbuffer.wgsl"));
+        assert!(library.is_shared_module("shadow-maps/filters.wgsl"));
+        assert!(!library.is_shared_module("sm-pcf/lookup.wgsl"));
         for name in names {
             // Shared modules are checked through the shaders that import them.
-            if name.starts_with("common/") {
+            if library.is_shared_module(name) {
                 continue;
             }
             if let Err(e) = library.validate(name) {

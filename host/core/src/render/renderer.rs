@@ -564,7 +564,7 @@ impl Renderer {
     pub fn reload_shaders(&mut self) -> Result<(), RenderError> {
         for name in self.shaders.file_names() {
             // Shared modules are checked through the shaders that import them.
-            if !name.starts_with("common/") {
+            if !self.shaders.is_shared_module(&name) {
                 self.shaders.validate(&name)?;
             }
         }

@@ -1,0 +1,154 @@
+// Shadow-map filters that fix no bindings. The importing shader supplies the map access:
+//
+//   fn shadow_tap(p: vec3<f32>, linear: bool) -> f32
+//       one depth comparison at world point p (1 = lit; bilinear when `linear`; points
+//       outside the map are lit),
+//   fn shadow_depths(p: vec3<f32>) -> vec3<f32>
+//       (1 when p projects inside the map else 0, p's depth along the map's axis, the stored
+//       depth there in the same units),
+//
+// and calls the filters with a tangent frame (`tangent_frame`) perpendicular to the light's
+// rays at p, so taps are placed in world space and each is projected by itself (seamless
+// across cube faces).
+
+// Poisson disc, 16 points in the unit disk, minimum spacing 0.423.
+const POISSON_16: array<vec2<f32>, 16> = array<vec2<f32>, 16>(
+    vec2<f32>(0.0118, -0.1794),
+    vec2<f32>(-0.8401, -0.1568),
+    vec2<f32>(-0.0068, 0.3801),
+    vec2<f32>(0.4789, 0.3546),
+    vec2<f32>(0.8432, -0.1561),
+    vec2<f32>(0.6935, -0.7197),
+    vec2<f32>(0.1784, -0.9475),
+    vec2<f32>(-0.6969, -0.5744),
+    vec2<f32>(0.2624, 0.7274),
+    vec2<f32>(-0.6019, 0.7281),
+    vec2<f32>(-0.6308, 0.2454),
+    vec2<f32>(0.2945, -0.4959),
+    vec2<f32>(-0.2507, -0.8731),
+    vec2<f32>(-0.1435, 0.9813),
+    vec2<f32>(0.8964, 0.4394),
+    vec2<f32>(-0.4136, -0.1654),
+);
+
+// Poisson disc, 32 points in the unit disk, minimum spacing 0.282.
+const POISSON_32: array<vec2<f32>, 32> = array<vec2<f32>, 32>(
+    vec2<f32>(-0.6682, -0.6513),
+    vec2<f32>(0.4346, 0.9006),
+    vec2<f32>(-0.2654, -0.2610),
+    vec2<f32>(-0.1212, 0.9853),
+    vec2<f32>(-0.5647, 0.0362),
+    vec2<f32>(0.8074, -0.2949),
+    vec2<f32>(-0.2463, -0.9410),
+    vec2<f32>(0.1881, 0.3581),
+    vec2<f32>(-0.6987, -0.2835),
+    vec2<f32>(-0.3201, 0.6051),
+    vec2<f32>(-0.7995, 0.5465),
+    vec2<f32>(0.4193, -0.5893),
+    vec2<f32>(-0.0013, -0.7142),
+    vec2<f32>(0.0254, -0.2954),
+    vec2<f32>(-0.9079, 0.1392),
+    vec2<f32>(0.5672, 0.5483),
+    vec2<f32>(-0.0402, 0.1679),
+    vec2<f32>(0.5645, 0.1509),
+    vec2<f32>(0.8734, 0.4058),
+    vec2<f32>(0.2160, 0.0168),
+    vec2<f32>(-0.3108, -0.5523),
+    vec2<f32>(0.7254, -0.6554),
+    vec2<f32>(0.0343, 0.7370),
+    vec2<f32>(0.9795, 0.1444),
+    vec2<f32>(0.2523, -0.8969),
+    vec2<f32>(-0.5561, 0.3951),
+    vec2<f32>(0.3312, -0.3040),
+    vec2<f32>(-0.5921, 0.7865),
+    vec2<f32>(-0.9631, -0.1598),
+    vec2<f32>(-0.3184, 0.2193),
+    vec2<f32>(0.5695, -0.1380),
+    vec2<f32>(-0.0765, 0.4555),
+);
+
+// Two unit vectors perpendicular to the ray direction `w` and to each other.
+fn tangent_frame(w: vec3<f32>) -> mat2x3<f32> {
+    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(w.x) > 0.9);
+    let u = normalize(cross(w, helper));
+    return mat2x3<f32>(u, cross(w, u));
+}
+
+fn interleaved_gradient_noise(pixel: vec2<f32>) -> f32 {
+    return fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
+}
+
+// A per-pixel rotation of the Poisson discs (interleaved gradient noise).
+fn rotation(pixel: vec2<f32>) -> mat2x2<f32> {
+    let angle = 6.2831853 * interleaved_gradient_noise(pixel);
+    let c = cos(angle);
+    let s = sin(angle);
+    return mat2x2<f32>(c, s, -s, c);
+}
+
+// n x n bilinear comparison taps one texel apart.
+fn grid_pcf(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, n: i32) -> f32 {
+    var sum = 0.0;
+    let h = n / 2;
+    for (var j = -h; j <= h; j++) {
+        for (var i = -h; i <= h; i++) {
+            sum += shadow_tap(p + (frame[0] * f32(i) + frame[1] * f32(j)) * texel, true);
+        }
+    }
+    return sum / f32(n * n);
+}
+
+// 32 bilinear taps on a rotated Poisson disc of world radius `radius`.
+fn poisson_pcf(p: vec3<f32>, frame: mat2x3<f32>, radius: f32, r: mat2x2<f32>) -> f32 {
+    var sum = 0.0;
+    for (var k = 0u; k < 32u; k++) {
+        let o = r * POISSON_32[k] * radius;
+        sum += shadow_tap(p + frame[0] * o.x + frame[1] * o.y, true);
+    }
+    return sum / 32.0;
+}
+
+// What PCSS needs to know about the light and the map.
+struct PcssLight {
+    // Radius (point, spot) or tangent of the angular radius (directional).
+    size: f32,
+    // The map's near plane, and whether it is a perspective map.
+    near: f32,
+    perspective: bool,
+    // Largest search and penumbra radius, in texels.
+    max_texels: f32,
+}
+
+// Percentage-closer soft shadows: average blocker depth from a 16-tap search, then a Poisson
+// kernel sized by the penumbra the light's size gives at that blocker depth.
+fn pcss(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: PcssLight) -> f32 {
+    let center = shadow_depths(p);
+    if center.x == 0.0 {
+        return 1.0;
+    }
+    let receiver = center.y;
+    var search = light.size * (receiver - light.near);
+    if light.perspective {
+        search /= max(light.near, 1e-4);
+    }
+    search = clamp(search, texel, light.max_texels * texel);
+    var blockers = 0.0;
+    var blocker_sum = 0.0;
+    for (var k = 0u; k < 16u; k++) {
+        let o = r * POISSON_16[k] * search;
+        let d = shadow_depths(p + frame[0] * o.x + frame[1] * o.y);
+        if d.x > 0.0 && d.z < d.y {
+            blockers += 1.0;
+            blocker_sum += d.z;
+        }
+    }
+    if blockers == 0.0 {
+        return 1.0;
+    }
+    let blocker = blocker_sum / blockers;
+    var penumbra = light.size * (receiver - blocker);
+    if light.perspective {
+        penumbra /= max(blocker, 1e-4);
+    }
+    return poisson_pcf(p, frame, clamp(penumbra, texel, light.max_texels * texel), r);
+}
