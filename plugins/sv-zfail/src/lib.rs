@@ -10,29 +10,21 @@
 //! the depth test fails, with wrap); a full-screen pass then writes visibility 0 where the count
 //! is not zero.
 
-pub mod silhouette;
-
-use bytemuck::{Pod, Zeroable};
 use zoo_host::gpu::readback::ReadbackRing;
 use zoo_host::params::TechniqueParams;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::render::visibility::VISIBILITY_FORMAT;
-use zoo_host::scene::{EdgeKind, LightKind, Scene};
+use zoo_host::scene::LightKind;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
     Changes, GpuContext, ParamUpdate, ParamValues, PassInfo, PassRecorder, RenderContext,
     ShadowTechnique, TechniqueError, wgpu,
 };
 
-zoo_host::param_choice! {
-    /// How volume crossings are counted.
-    pub enum Counting { ZFail, ZPass }
-}
-
-zoo_host::param_choice! {
-    /// How volumes are built.
-    pub enum Volumes { Silhouette, PerTriangle }
-}
+use zoo_shadow_volumes::{
+    ARGS_BYTES, VOLUME_VERTEX_LAYOUT, VolumeGenerator, volume_depth_stencil, volume_primitive,
+};
+pub use zoo_shadow_volumes::{Counting, Volumes, silhouette};
 
 zoo_host::technique_params! {
     /// Parameters of stencil shadow volumes.
@@ -54,8 +46,6 @@ zoo_host::technique_params! {
     }
 }
 
-const FLAG_CASTS: u32 = 1;
-const FLAG_CLOSED: u32 = 2;
 const SLOT: u64 = 256;
 const COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
 const OVERLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -63,25 +53,8 @@ const OVERLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// 254 (-1 and -2 wrapped); any other non-zero count is id 11.
 const COUNT_LEVELS: [u32; 10] = [1, 2, 3, 4, 5, 6, 7, 8, 255, 254];
 
-/// `Params` in `sv-zfail/volumes.wgsl`, in a 256-byte slot.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-#[repr(C)]
-struct Params {
-    light: u32,
-    mode: u32,
-    triangle_count: u32,
-    edge_count: u32,
-    capacity: u32,
-    _pad: [u32; 59],
-}
-
-/// Draw arguments followed by the silhouette counter (`DrawArgs` in the shader).
-const ARGS_BYTES: u64 = 20;
-
 struct Pipelines {
-    triangles: wgpu::ComputePipeline,
-    edges: wgpu::ComputePipeline,
-    compute_layout: wgpu::BindGroupLayout,
+    generator: VolumeGenerator,
     volume: wgpu::RenderPipeline,
     resolve: wgpu::RenderPipeline,
     overlay: wgpu::RenderPipeline,
@@ -91,13 +64,8 @@ struct Pipelines {
 }
 
 struct Buffers {
-    triangle_flags: wgpu::Buffer,
-    weights: wgpu::Buffer,
-    volume: wgpu::Buffer,
-    args: wgpu::Buffer,
     /// Draw arguments and silhouette counters per light, read back a frame or two late.
     stats: std::sync::Mutex<ReadbackRing>,
-    compute_bind_group: wgpu::BindGroup,
     levels_bind_group: wgpu::BindGroup,
 }
 
@@ -114,95 +82,13 @@ pub struct ShadowVolumes {
     buffers: Option<Buffers>,
     debug: Option<DebugTargets>,
     lights: usize,
-    triangles: u32,
-    edges: u32,
-}
-
-/// Per-triangle flags: casts shadows, and belongs to a closed (all edges manifold) object.
-pub fn triangle_flags(scene: &Scene) -> Vec<u32> {
-    let mut flags = vec![0; scene.triangle_count()];
-    for (i, object) in scene.objects.iter().enumerate() {
-        let edges = &scene.adjacency.edges[scene.adjacency.object_edges[i].start as usize
-            ..scene.adjacency.object_edges[i].end as usize];
-        let closed = edges.iter().all(|e| e.kind() == EdgeKind::Manifold);
-        let value = u32::from(object.casts_shadows) * FLAG_CASTS + u32::from(closed) * FLAG_CLOSED;
-        flags[object.indices.start / 3..object.indices.end / 3].fill(value);
-    }
-    flags
-}
-
-/// Vertex capacity of the volume buffer for `scene` (caps, plus sides for the chosen mode).
-pub fn volume_capacity(scene: &Scene, volumes: Volumes) -> u64 {
-    let triangles = scene.triangle_count() as u64;
-    let sides = match volumes {
-        Volumes::Silhouette => 6 * scene.adjacency.edge_faces.len() as u64,
-        Volumes::PerTriangle => 18 * triangles,
-    };
-    (6 * triangles + sides).max(3)
-}
-
-fn dispatch_size(items: u32) -> (u32, u32) {
-    let groups = items.div_ceil(64).max(1);
-    let x = groups.min(65535);
-    (x, groups.div_ceil(x))
 }
 
 impl ShadowVolumes {
     fn create_pipelines(&self, ctx: &RenderContext<'_>) -> Result<Pipelines, TechniqueError> {
         let device = &ctx.gpu.device;
-        let volumes_module = ctx.shaders.create_module(device, "sv-zfail/volumes.wgsl")?;
         let stencil_module = ctx.shaders.create_module(device, "sv-zfail/stencil.wgsl")?;
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sv-zfail volume generation layout"),
-            entries: &[
-                storage(0, true),
-                storage(1, true),
-                storage(2, true),
-                storage(3, true),
-                storage(4, true),
-                storage(5, false),
-                storage(6, false),
-                storage(7, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 8,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(32),
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let compute_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("sv-zfail volume generation pipeline layout"),
-                bind_group_layouts: &[Some(&ctx.frame.layout), Some(&compute_layout)],
-                immediate_size: 0,
-            });
-        let compute = |label: &str, entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: Some(&compute_pipeline_layout),
-                module: &volumes_module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let triangles = compute("sv-zfail caps pipeline", "triangles");
-        let edges = compute("sv-zfail sides pipeline", "edges_main");
+        let generator = VolumeGenerator::new(ctx, "sv-zfail")?;
 
         let count_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sv-zfail count level layout"),
@@ -236,39 +122,6 @@ impl ShadowVolumes {
             depth_fail_op,
             pass_op,
         };
-        let (front, back) = match self.params.counting {
-            // z-fail: count crossings behind the visible surface.
-            Counting::ZFail => (
-                face(
-                    wgpu::CompareFunction::Always,
-                    keep,
-                    wgpu::StencilOperation::DecrementWrap,
-                ),
-                face(
-                    wgpu::CompareFunction::Always,
-                    keep,
-                    wgpu::StencilOperation::IncrementWrap,
-                ),
-            ),
-            // z-pass: count crossings in front of it.
-            Counting::ZPass => (
-                face(
-                    wgpu::CompareFunction::Always,
-                    wgpu::StencilOperation::IncrementWrap,
-                    keep,
-                ),
-                face(
-                    wgpu::CompareFunction::Always,
-                    wgpu::StencilOperation::DecrementWrap,
-                    keep,
-                ),
-            ),
-        };
-        let volume_vertex = wgpu::VertexBufferLayout {
-            array_stride: 16,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &wgpu::vertex_attr_array![0 => Float32x4],
-        };
         let depth_state = |compare, front, back, bias| wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
             depth_write_enabled: Some(false),
@@ -288,11 +141,7 @@ impl ShadowVolumes {
                 write_mask,
             })
         };
-        let volume_primitive = wgpu::PrimitiveState {
-            cull_mode: None,
-            unclipped_depth: true,
-            ..Default::default()
-        };
+        let volume_primitive = volume_primitive();
         let bias = wgpu::DepthBiasState {
             constant: self.params.depth_bias as i32,
             slope_scale: self.params.slope_bias,
@@ -305,10 +154,10 @@ impl ShadowVolumes {
                 module: &stencil_module,
                 entry_point: Some("vs_volume"),
                 compilation_options: Default::default(),
-                buffers: &[Some(volume_vertex.clone())],
+                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
             },
             primitive: volume_primitive,
-            depth_stencil: Some(depth_state(wgpu::CompareFunction::Less, front, back, bias)),
+            depth_stencil: Some(volume_depth_stencil(self.params.counting, bias)),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &stencil_module,
@@ -395,7 +244,7 @@ impl ShadowVolumes {
                 module: &stencil_module,
                 entry_point: Some("vs_volume"),
                 compilation_options: Default::default(),
-                buffers: &[Some(volume_vertex)],
+                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
             },
             primitive: volume_primitive,
             depth_stencil: Some(depth_state(
@@ -419,9 +268,7 @@ impl ShadowVolumes {
             cache: None,
         });
         Ok(Pipelines {
-            triangles,
-            edges,
-            compute_layout,
+            generator,
             volume,
             resolve,
             overlay,
@@ -434,72 +281,8 @@ impl ShadowVolumes {
     fn create_buffers(&self, ctx: &RenderContext<'_>) -> Buffers {
         let device = &ctx.gpu.device;
         let pipelines = self.pipelines.as_ref().expect("pipelines exist");
-        let scene = ctx.scene;
-        let flags = triangle_flags(scene);
-        let needed = volume_capacity(scene, self.params.volumes);
-        let limit = device.limits().max_storage_buffer_binding_size / 16;
-        if needed > limit {
-            zoo_host::log::warn!(
-                "sv-zfail: volumes may need {needed} vertices, the device binds at most {limit}; \
-                 extra volume geometry is dropped"
-            );
-        }
-        let capacity = needed.min(limit) as u32;
-        let init = |label: &str, contents: &[u8], usage| {
-            wgpu::util::DeviceExt::create_buffer_init(
-                device,
-                &wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage,
-                },
-            )
-        };
-        let empty = |label: &str, size: u64, usage| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: size.max(16),
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        let storage = wgpu::BufferUsages::STORAGE;
-        let triangle_flags = init(
-            "sv-zfail triangle flags",
-            bytemuck::cast_slice(&flags),
-            storage,
-        );
-        let weights = empty("sv-zfail triangle weights", 4 * flags.len() as u64, storage);
-        let volume = empty(
-            "sv-zfail volume vertices",
-            16 * capacity as u64,
-            storage | wgpu::BufferUsages::VERTEX,
-        );
-        let args = init(
-            "sv-zfail draw arguments",
-            bytemuck::cast_slice(&[0u32, 1, 0, 0, 0, 0, 0, 0]),
-            storage
-                | wgpu::BufferUsages::INDIRECT
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-        );
-        let params: Vec<Params> = (0..ctx.lights.len())
-            .map(|light| Params {
-                light: light as u32,
-                mode: u32::from(self.params.volumes == Volumes::PerTriangle),
-                triangle_count: flags.len() as u32,
-                edge_count: scene.adjacency.edges.len() as u32,
-                capacity,
-                _pad: [0; 59],
-            })
-            .collect();
-        let params = init(
-            "sv-zfail light parameters",
-            bytemuck::cast_slice(&params),
-            wgpu::BufferUsages::UNIFORM,
-        );
         let stats = std::sync::Mutex::new(ReadbackRing::new(
-            &ctx.gpu.device,
+            device,
             "sv-zfail workload counters",
             ctx.lights.len() as u64 * ARGS_BYTES,
             3,
@@ -508,40 +291,14 @@ impl ShadowVolumes {
             .chain(COUNT_LEVELS.iter().enumerate().map(|(i, _)| i as u32 + 1))
             .flat_map(|value| std::iter::once(value).chain(std::iter::repeat_n(0, 63)))
             .collect();
-        let levels = init(
-            "sv-zfail count levels",
-            bytemuck::cast_slice(&level_data),
-            wgpu::BufferUsages::UNIFORM,
+        let levels = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("sv-zfail count levels"),
+                contents: bytemuck::cast_slice(&level_data),
+                usage: wgpu::BufferUsages::UNIFORM,
+            },
         );
-        let b = scene_bindings(ctx);
-        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }
-        }
-        let compute_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sv-zfail volume generation bind group"),
-            layout: &pipelines.compute_layout,
-            entries: &[
-                entry(0, b.0),
-                entry(1, b.1),
-                entry(2, b.2),
-                entry(3, b.3),
-                entry(4, &triangle_flags),
-                entry(5, &weights),
-                entry(6, &volume),
-                entry(7, &args),
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(32),
-                    }),
-                },
-            ],
-        });
         let levels_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sv-zfail count levels bind group"),
             layout: &pipelines.count_layout,
@@ -555,12 +312,7 @@ impl ShadowVolumes {
             }],
         });
         Buffers {
-            triangle_flags,
-            weights,
-            volume,
-            args,
             stats,
-            compute_bind_group,
             levels_bind_group,
         }
     }
@@ -600,19 +352,6 @@ impl ShadowVolumes {
     }
 }
 
-/// Vertices, indices, edges and edge faces of the scene.
-fn scene_bindings<'a>(
-    ctx: &'a RenderContext<'_>,
-) -> (
-    &'a wgpu::Buffer,
-    &'a wgpu::Buffer,
-    &'a wgpu::Buffer,
-    &'a wgpu::Buffer,
-) {
-    let b = ctx.scene_buffers;
-    (&b.vertices, &b.indices, &b.edges, &b.edge_faces)
-}
-
 fn volume_pass_name(light: usize) -> String {
     format!("Shadow volumes: light {light}")
 }
@@ -637,25 +376,11 @@ impl ShadowTechnique for ShadowVolumes {
     }
 
     fn resources(&self) -> Vec<ResourceInfo> {
-        let mut out = Vec::new();
-        if let Some(b) = &self.buffers {
-            out.push(ResourceInfo::buffer(
-                "volume vertices",
-                &b.volume,
-                "vec4<f32>",
-            ));
-            out.push(ResourceInfo::buffer(
-                "triangle flags",
-                &b.triangle_flags,
-                "u32",
-            ));
-            out.push(ResourceInfo::buffer("triangle weights", &b.weights, "i32"));
-            out.push(ResourceInfo::buffer(
-                "draw arguments",
-                &b.args,
-                "DrawIndirectArgs + counter",
-            ));
-        }
+        let mut out = self
+            .pipelines
+            .as_ref()
+            .map(|p| p.generator.resources())
+            .unwrap_or_default();
         if let Some(d) = &self.debug {
             out.push(ResourceInfo::texture("stencil counts", &d.counts.0, true));
             out.push(ResourceInfo::texture("volumes", &d.overlay.0, true));
@@ -674,8 +399,8 @@ impl ShadowTechnique for ShadowVolumes {
         }
         if changes.scene || changes.lights || self.buffers.is_none() {
             self.lights = ctx.lights.len();
-            self.triangles = ctx.scene.triangle_count() as u32;
-            self.edges = ctx.scene.adjacency.edges.len() as u32;
+            let generator = &mut self.pipelines.as_mut().expect("created above").generator;
+            generator.prepare(ctx, self.params.volumes);
             self.buffers = Some(self.create_buffers(ctx));
         }
         if changes.resolution || self.debug.is_none() {
@@ -694,29 +419,17 @@ impl ShadowTechnique for ShadowVolumes {
                 "sv-zfail: record before prepare".into(),
             ));
         };
-        let (tri_x, tri_y) = dispatch_size(self.triangles);
-        let (edge_x, edge_y) = dispatch_size(self.edges);
+        let (Some(volume), Some(args)) = (p.generator.volume(), p.generator.args()) else {
+            return Err(TechniqueError::not_prepared());
+        };
         let stats = b
             .stats
             .lock()
             .ok()
             .and_then(|mut ring| ring.target().cloned());
         for light in 0..self.lights {
-            let offset = (light as u64 * SLOT) as u32;
-            // Reset the vertex count (keeping instance_count = 1) and the silhouette counter.
-            let encoder = recorder.encoder();
-            encoder.clear_buffer(&b.args, 0, Some(4));
-            encoder.clear_buffer(&b.args, 16, Some(4));
-            {
-                let name = generation_pass_name(light);
-                let mut pass = recorder.compute_pass(&name);
-                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-                pass.set_bind_group(1, &b.compute_bind_group, &[offset]);
-                pass.set_pipeline(&p.triangles);
-                pass.dispatch_workgroups(tri_x, tri_y, 1);
-                pass.set_pipeline(&p.edges);
-                pass.dispatch_workgroups(edge_x, edge_y, 1);
-            }
+            p.generator
+                .record(ctx, recorder, light, &generation_pass_name(light))?;
             {
                 let name = volume_pass_name(light);
                 let stencil = zoo_host::gpu::stencil_attachment(
@@ -725,15 +438,15 @@ impl ShadowTechnique for ShadowVolumes {
                 );
                 let mut pass = ctx.light_pass(recorder, &name, light, stencil);
                 pass.set_pipeline(&p.volume);
-                pass.set_vertex_buffer(0, b.volume.slice(..));
-                pass.draw_indirect(&b.args, 0);
+                pass.set_vertex_buffer(0, volume.slice(..));
+                pass.draw_indirect(args, 0);
                 pass.set_pipeline(&p.resolve);
                 pass.set_stencil_reference(0);
                 pass.draw(0..3, 0..1);
             }
             if let Some(stats) = &stats {
                 recorder.encoder().copy_buffer_to_buffer(
-                    &b.args,
+                    args,
                     0,
                     stats,
                     light as u64 * ARGS_BYTES,
@@ -770,8 +483,8 @@ impl ShadowTechnique for ShadowVolumes {
                     pass.draw(0..3, 0..1);
                 }
                 pass.set_pipeline(&p.overlay);
-                pass.set_vertex_buffer(0, b.volume.slice(..));
-                pass.draw_indirect(&b.args, 0);
+                pass.set_vertex_buffer(0, volume.slice(..));
+                pass.draw_indirect(args, 0);
             }
         }
         Ok(())
@@ -834,8 +547,6 @@ fn create(
         buffers: None,
         debug: None,
         lights: 0,
-        triangles: 0,
-        edges: 0,
     }))
 }
 
@@ -857,31 +568,4 @@ zoo_host::register_technique! {
     },
     params: SvParams::schema,
     create: create,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_struct};
-
-    #[test]
-    fn gpu_structs_mirror_the_shader() {
-        let source = zoo_host::ShaderLibrary::embedded()
-            .compose("sv-zfail/volumes.wgsl")
-            .unwrap()
-            .source;
-        // Uniforms at 256-byte dynamic offsets: the Rust struct fills the slot.
-        let (size, fields) = zoo_host::mirror_fields!(Params {
-            light,
-            mode,
-            triangle_count,
-            edge_count,
-            capacity
-        });
-        check_mirror(&source, "Params", size, &fields, SizeRule::AtLeast).unwrap();
-        assert_eq!(
-            wgsl_struct(&source, "DrawArgs").unwrap().size as u64,
-            ARGS_BYTES
-        );
-    }
 }

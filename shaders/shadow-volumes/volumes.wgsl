@@ -1,4 +1,4 @@
-// Shadow-volume generation for one light.
+// Shadow-volume generation for one light (the shadow-volume library, `zoo-shadow-volumes`).
 //
 // `triangles`: every shadow-casting triangle gets a weight: +1 when it faces the light, -1 when
 // it faces away and belongs to an open (or non-manifold) mesh, whose triangles all block light

@@ -1,0 +1,13 @@
+//! Shadow-volume building blocks shared by techniques (sv-zfail today; the hybrid SM/SV
+//! technique next): volume generation on the GPU from the scene's edge adjacency
+//! ([`generation`], `shaders/shadow-volumes/volumes.wgsl`), its CPU mirror ([`silhouette`]),
+//! and the stencil states that count volumes with z-fail or z-pass ([`stencil`]).
+
+pub mod generation;
+pub mod silhouette;
+pub mod stencil;
+
+pub use generation::{
+    ARGS_BYTES, VolumeGenerator, Volumes, dispatch_size, triangle_flags, volume_capacity,
+};
+pub use stencil::{Counting, VOLUME_VERTEX_LAYOUT, volume_depth_stencil, volume_primitive};

@@ -1,0 +1,63 @@
+//! Counting volume crossings in the stencil buffer.
+
+use zoo_host::render::gbuffer::DEPTH_FORMAT;
+use zoo_host::wgpu;
+
+zoo_host::param_choice! {
+    /// How volume crossings are counted.
+    pub enum Counting { ZFail, ZPass }
+}
+
+/// Volume vertices: `vec4<f32>` positions, w = 0 for points at infinity.
+pub const VOLUME_VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 16,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x4],
+};
+
+/// Volumes are drawn two-sided with unclipped depth (`DEPTH_CLIP_CONTROL`), so vertices at
+/// infinity are counted wherever the camera is.
+pub fn volume_primitive() -> wgpu::PrimitiveState {
+    wgpu::PrimitiveState {
+        cull_mode: None,
+        unclipped_depth: true,
+        ..Default::default()
+    }
+}
+
+/// Depth-stencil state of the volume draw on the G-buffer's depth-stencil: z-fail counts the
+/// crossings behind the visible surface (back faces increment, front faces decrement where
+/// the depth test fails), z-pass those in front of it (front faces increment where it passes),
+/// with wrapping; depth is tested, never written.
+pub fn volume_depth_stencil(
+    counting: Counting,
+    bias: wgpu::DepthBiasState,
+) -> wgpu::DepthStencilState {
+    let keep = wgpu::StencilOperation::Keep;
+    let face = |pass_op, depth_fail_op| wgpu::StencilFaceState {
+        compare: wgpu::CompareFunction::Always,
+        fail_op: keep,
+        depth_fail_op,
+        pass_op,
+    };
+    let (increment, decrement) = (
+        wgpu::StencilOperation::IncrementWrap,
+        wgpu::StencilOperation::DecrementWrap,
+    );
+    let (front, back) = match counting {
+        Counting::ZFail => (face(keep, decrement), face(keep, increment)),
+        Counting::ZPass => (face(increment, keep), face(decrement, keep)),
+    };
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: wgpu::StencilState {
+            front,
+            back,
+            read_mask: 0xff,
+            write_mask: 0xff,
+        },
+        bias,
+    }
+}
