@@ -1,12 +1,19 @@
 //! One frame: G-buffer, visibility clear, the technique's passes, then lighting or a debug view.
 
-use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::str::FromStr;
 use std::sync::Arc;
 
-use glam::{UVec2, Vec3, Vec4};
+use glam::UVec2;
 
-use super::debug_view::{DebugSource, DebugViewPass};
+mod containment;
+mod debug_source;
+mod readout;
+mod view;
+
+use containment::{ActiveTechnique, guarded, instantiate};
+pub use readout::GBufferData;
+pub use view::{Overlay, View};
+
+use super::debug_view::DebugViewPass;
 use super::frame::FrameBindings;
 use super::gbuffer::{GBuffer, GBufferPass};
 use super::lighting::{LightingPass, OUTPUT_FORMAT};
@@ -14,62 +21,14 @@ use super::scene_buffers::SceneBuffers;
 use super::visibility::{IndirectTarget, SlotAssignment, VisibilityTargets};
 use crate::gpu::{
     FrameTimings, GpuContext, PassOwner, PassRecorder, ShaderError, ShaderLibrary,
-    StatisticsQueries, TimestampQueries, readback,
+    StatisticsQueries, TimestampQueries,
 };
 use crate::params::{self, ParamValues};
 use crate::scene::{Camera, Light, Scene};
 use crate::technique::{
     self, Changes, ParamUpdate, RenderContext, ShadowTechnique, TechniqueError,
-    TechniqueRegistration, ViewMapping,
+    TechniqueRegistration,
 };
-
-/// What the output image shows.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum View {
-    /// The lit image.
-    Final,
-    /// Visibility of one light as greyscale.
-    Visibility { light: usize },
-    /// World normals as colour.
-    Normals,
-    /// Linearised depth.
-    Depth,
-    /// Albedo.
-    Albedo,
-    /// A resource the technique marks viewable.
-    Resource(String),
-}
-
-impl FromStr for View {
-    type Err = std::convert::Infallible;
-
-    /// `final`, `visibility` (light 0), `visibility:N`, `normals`, `depth`, `albedo`, or a
-    /// technique resource name.
-    fn from_str(s: &str) -> Result<View, Self::Err> {
-        Ok(match s {
-            "final" => View::Final,
-            "visibility" => View::Visibility { light: 0 },
-            "normals" => View::Normals,
-            "depth" => View::Depth,
-            "albedo" => View::Albedo,
-            other => match other
-                .strip_prefix("visibility:")
-                .and_then(|n| n.parse().ok())
-            {
-                Some(light) => View::Visibility { light },
-                None => View::Resource(other.to_string()),
-            },
-        })
-    }
-}
-
-/// A debug view blended over the final image.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Overlay {
-    pub view: View,
-    /// 0 (invisible) to 1 (opaque).
-    pub opacity: f32,
-}
 
 /// Errors creating the renderer.
 #[derive(Debug, thiserror::Error)]
@@ -82,25 +41,6 @@ pub enum RenderError {
     Technique(#[from] TechniqueError),
     #[error("view `{0}`: {1}")]
     View(String, String),
-}
-
-/// The G-buffer as read back for the judge: one entry per pixel, row-major from the top.
-#[derive(Debug, Clone)]
-pub struct GBufferData {
-    pub size: UVec2,
-    /// World position; w = 1 on geometry, 0 on background.
-    pub positions: Vec<Vec4>,
-    /// World normal (facing the camera).
-    pub normals: Vec<Vec3>,
-    /// Albedo (rgb), specular strength and shininess per pixel.
-    pub materials: Vec<crate::scene::shading::Material>,
-}
-
-struct ActiveTechnique {
-    registration: &'static TechniqueRegistration,
-    params: ParamValues,
-    instance: Box<dyn ShadowTechnique>,
-    pending: Changes,
 }
 
 /// Renders scenes with one technique at a time.
@@ -147,66 +87,6 @@ fn create_output(gpu: &GpuContext, size: UVec2) -> (wgpu::Texture, wgpu::Texture
         ..Default::default()
     });
     (texture, view)
-}
-
-fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "unknown panic".to_string())
-}
-
-/// Runs plugin code, turning panics and wgpu validation errors into [`TechniqueError`]s.
-fn guarded<T>(
-    gpu: &GpuContext,
-    id: &str,
-    f: impl FnOnce() -> Result<T, TechniqueError>,
-) -> Result<T, TechniqueError> {
-    let (outcome, validation) = gpu.validation_scope(|| catch_unwind(AssertUnwindSafe(f)));
-    let value = match outcome {
-        Ok(result) => result?,
-        Err(payload) => {
-            return Err(TechniqueError::Panicked {
-                id: id.to_string(),
-                message: panic_message(payload.as_ref()),
-            });
-        }
-    };
-    match validation {
-        Some(message) => Err(TechniqueError::Validation {
-            id: id.to_string(),
-            message,
-        }),
-        None => Ok(value),
-    }
-}
-
-/// Creates a technique through its factory after validating `values` against its schema.
-fn instantiate(
-    gpu: &GpuContext,
-    registration: &'static TechniqueRegistration,
-    values: &ParamValues,
-) -> Result<ActiveTechnique, TechniqueError> {
-    if let Some(reason) = registration.unavailable_reason(gpu) {
-        return Err(TechniqueError::Unavailable {
-            id: registration.id.to_string(),
-            reason,
-        });
-    }
-    let schema = (registration.params)();
-    let mut params = params::defaults(&schema);
-    for (key, value) in values {
-        params::find_spec(&schema, key)?.check(value)?;
-        params.insert(key.clone(), value.clone());
-    }
-    let instance = guarded(gpu, registration.id, || (registration.create)(gpu, &params))?;
-    Ok(ActiveTechnique {
-        registration,
-        params,
-        instance,
-        pending: Changes::ALL,
-    })
 }
 
 /// Borrows the renderer's fields (not the technique) as a [`RenderContext`].
@@ -599,166 +479,6 @@ impl Renderer {
             self.update_slots();
         }
         RenderError::Technique(error)
-    }
-
-    fn debug_source(&self, view: &View) -> Result<DebugSource<'_>, RenderError> {
-        let (lo, hi) = self.scene.bounds();
-        let farthest = [lo, hi]
-            .iter()
-            .map(|c| c.distance(self.camera.position))
-            .fold(0.0, f32::max);
-        Ok(match view {
-            View::Final => unreachable!("the final view is the lighting pass"),
-            View::Visibility { light } => {
-                if *light >= self.lights.len() {
-                    return Err(RenderError::View(
-                        format!("visibility:{light}"),
-                        format!("the scene has {} lights", self.lights.len()),
-                    ));
-                }
-                let (layer, channel) = self.visibility.slots.slot(*light);
-                DebugSource {
-                    view: &self.visibility.layer_views[layer as usize],
-                    mapping: ViewMapping::Channel {
-                        channel,
-                        min: 0.0,
-                        max: 1.0,
-                    },
-                    linearize: None,
-                }
-            }
-            View::Normals => DebugSource {
-                view: &self.gbuffer.normal_view,
-                mapping: ViewMapping::Color {
-                    min: -1.0,
-                    max: 1.0,
-                },
-                linearize: None,
-            },
-            View::Albedo => DebugSource {
-                view: &self.gbuffer.albedo_view,
-                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
-                linearize: None,
-            },
-            View::Depth => DebugSource {
-                view: &self.gbuffer.depth_sample_view,
-                mapping: ViewMapping::Depth {
-                    min: self.camera.near,
-                    max: farthest.min(self.camera.far),
-                },
-                linearize: Some((self.camera.near, self.camera.far)),
-            },
-            View::Resource(name) => {
-                let image = self.technique.instance.debug_view(name).ok_or_else(|| {
-                    let viewable: Vec<String> = self
-                        .technique
-                        .instance
-                        .resources()
-                        .into_iter()
-                        .filter(|r| r.viewable)
-                        .map(|r| r.name)
-                        .collect();
-                    RenderError::View(
-                        name.clone(),
-                        format!(
-                            "not a view of `{}`; choose final, visibility[:N], normals, depth, albedo{}",
-                            self.technique.registration.id,
-                            viewable.iter().map(|v| format!(", {v}")).collect::<String>()
-                        ),
-                    )
-                })?;
-                DebugSource {
-                    view: image.view,
-                    mapping: image.mapping,
-                    linearize: None,
-                }
-            }
-        })
-    }
-
-    /// The output image's view (sRGB RGBA8), e.g. to show it in a UI.
-    pub fn output_view(&self) -> &wgpu::TextureView {
-        &self.output_view
-    }
-
-    /// The output image (sRGB RGBA8).
-    pub fn read_output(&self) -> image::RgbaImage {
-        let bytes = readback::read_texture(&self.gpu, &self.output, 0, wgpu::TextureAspect::All, 4);
-        image::RgbaImage::from_raw(self.size.x, self.size.y, bytes)
-            .expect("readback has width * height texels")
-    }
-
-    /// Visibility of light `light` per pixel, in [0, 1].
-    pub fn read_visibility(&self, light: usize) -> Vec<f32> {
-        let (layer, channel) = self.visibility.slots.slot(light);
-        let bytes = readback::read_texture(
-            &self.gpu,
-            &self.visibility.texture,
-            layer,
-            wgpu::TextureAspect::All,
-            4,
-        );
-        bytes
-            .chunks_exact(4)
-            .map(|t| t[channel as usize] as f32 / 255.0)
-            .collect()
-    }
-
-    /// World positions and normals per pixel.
-    pub fn read_gbuffer(&self) -> GBufferData {
-        let depths = readback::f32s(&readback::read_texture(
-            &self.gpu,
-            &self.gbuffer.view_depth,
-            0,
-            wgpu::TextureAspect::All,
-            4,
-        ));
-        // The camera the G-buffer was rendered with (the last one uploaded).
-        let matrices = &self.frame.matrices;
-        let width = self.size.x.max(1);
-        let positions = depths
-            .iter()
-            .enumerate()
-            .map(|(i, &depth)| {
-                if depth > 0.0 {
-                    let pixel = UVec2::new(i as u32 % width, i as u32 / width);
-                    super::gbuffer::reconstruct_position(matrices, pixel, depth).extend(1.0)
-                } else {
-                    Vec4::ZERO
-                }
-            })
-            .collect();
-        let normals = readback::f16s(&readback::read_texture(
-            &self.gpu,
-            &self.gbuffer.normal,
-            0,
-            wgpu::TextureAspect::All,
-            8,
-        ));
-        let albedo = readback::read_texture(
-            &self.gpu,
-            &self.gbuffer.albedo,
-            0,
-            wgpu::TextureAspect::All,
-            4,
-        );
-        GBufferData {
-            size: self.size,
-            positions,
-            normals: normals
-                .chunks_exact(4)
-                .map(|n| Vec3::new(n[0], n[1], n[2]))
-                .collect(),
-            materials: albedo
-                .chunks_exact(4)
-                .zip(normals.chunks_exact(4))
-                .map(|(a, n)| crate::scene::shading::Material {
-                    albedo: Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32) / 255.0,
-                    specular: a[3] as f32 / 255.0,
-                    shininess: n[3] * 256.0,
-                })
-                .collect(),
-        }
     }
 }
 
