@@ -1,0 +1,157 @@
+//! Running one configuration: warm-up, measured frames, pass samples, counters and flicker.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+use zoo_host::gpu::{PassOwner, TimingSource};
+use zoo_host::judge::{Occluders, reference_visibility};
+use zoo_host::judging::surface_points;
+use zoo_host::scene::paths;
+use zoo_host::{GpuContext, Renderer, Scene, View};
+
+use super::flicker::{Flicker, FrameVisibility};
+use super::stats::Summary;
+pub use crate::cli::PathMode;
+
+use super::plan::*;
+
+/// Measurements of one configuration.
+#[derive(Debug, Clone)]
+pub struct ConfigResult {
+    pub config: Configuration,
+    pub passes: Vec<(String, PassOwner, Summary)>,
+    /// Median vertex, fragment and compute invocations per pass (same order as `passes`),
+    /// where the device has pipeline-statistics queries.
+    pub invocations: Vec<Option<[u64; 3]>>,
+    pub frame_gpu: Summary,
+    pub technique_gpu: Summary,
+    pub frame_cpu: Summary,
+    pub counters: Vec<(String, f64)>,
+    pub flicker: Option<f64>,
+    pub timing_source: TimingSource,
+    pub triangles: usize,
+}
+
+/// Per-frame samples of one pass.
+struct PassSamples {
+    name: String,
+    owner: PassOwner,
+    times: Vec<f64>,
+    invocations: Vec<[u64; 3]>,
+}
+
+/// Renders one configuration along the path and measures it.
+pub fn run_configuration(
+    gpu: &Arc<GpuContext>,
+    plan: &BenchPlan,
+    config: &Configuration,
+    mut tick: impl FnMut(),
+) -> anyhow::Result<ConfigResult> {
+    let base = plan.scene_path.parent().unwrap_or(Path::new("."));
+    let description = plan.description.with_tessellation(config.tessellation);
+    let scene = Scene::from_description(&description, &plan.scene_path, base)?;
+    let triangles = scene.triangle_count();
+    let occluders = plan.flicker.then(|| Occluders::new(&scene));
+    let mut renderer = Renderer::new(gpu.clone(), scene.clone(), config.size)?;
+    renderer.set_technique(config.technique.id, &config.params)?;
+    renderer.set_pipeline_statistics(true);
+    let (t0, t1) = paths::duration(&scene.paths);
+    let mut pass_samples: Vec<PassSamples> = Vec::new();
+    let (mut frame_gpu, mut technique_gpu, mut frame_cpu) = (Vec::new(), Vec::new(), Vec::new());
+    let mut timing_source = TimingSource::GpuTimestamps;
+    let mut flicker = Flicker::default();
+    for f in 0..plan.warmup + plan.frames {
+        let measured = f.saturating_sub(plan.warmup);
+        let time = if plan.frames > 1 {
+            t0 + (t1 - t0) * measured as f32 / (plan.frames - 1) as f32
+        } else {
+            t0
+        };
+        if matches!(plan.path, PathMode::Camera | PathMode::Both) {
+            renderer.set_camera(paths::camera_at(&scene.camera, &scene.paths.camera, time));
+        }
+        if matches!(plan.path, PathMode::Light | PathMode::Both) {
+            renderer.set_lights(paths::lights_at(&scene.lights, &scene.paths.lights, time));
+        }
+        let start = Instant::now();
+        let timings = renderer.render(&View::Final)?;
+        let cpu = start.elapsed().as_secs_f64() * 1e3;
+        tick();
+        if f < plan.warmup {
+            continue;
+        }
+        timing_source = timings.source;
+        frame_gpu.push(timings.frame_total());
+        technique_gpu.push(timings.total(PassOwner::Technique));
+        frame_cpu.push(cpu);
+        for pass in &timings.passes {
+            let index = match pass_samples.iter().position(|p| p.name == pass.name) {
+                Some(i) => i,
+                None => {
+                    pass_samples.push(PassSamples {
+                        name: pass.name.clone(),
+                        owner: pass.owner,
+                        times: Vec::new(),
+                        invocations: Vec::new(),
+                    });
+                    pass_samples.len() - 1
+                }
+            };
+            pass_samples[index].times.push(pass.milliseconds);
+            if let Some(counts) = pass.invocations {
+                pass_samples[index].invocations.push(counts);
+            }
+        }
+        if let Some(occluders) = &occluders {
+            let g = renderer.read_gbuffer();
+            let points = surface_points(&g);
+            let frame = FrameVisibility {
+                technique: (0..renderer.lights().len())
+                    .map(|l| renderer.read_visibility(l))
+                    .collect(),
+                reference: renderer
+                    .lights()
+                    .iter()
+                    .map(|light| {
+                        let r = reference_visibility(occluders, light, &points, 1);
+                        r.contributing
+                            .iter()
+                            .zip(&r.hard)
+                            .map(|(c, h)| c.then_some(*h >= 0.5))
+                            .collect()
+                    })
+                    .collect(),
+            };
+            flicker.push(frame);
+        }
+    }
+    let flicker = occluders.is_some().then(|| flicker.index());
+    let median_counts = |counts: &[[u64; 3]]| -> Option<[u64; 3]> {
+        (!counts.is_empty()).then(|| {
+            [0, 1, 2].map(|k| {
+                let mut v: Vec<u64> = counts.iter().map(|c| c[k]).collect();
+                v.sort_unstable();
+                v[v.len() / 2]
+            })
+        })
+    };
+    Ok(ConfigResult {
+        config: config.clone(),
+        invocations: pass_samples
+            .iter()
+            .map(|p| median_counts(&p.invocations))
+            .collect(),
+        passes: pass_samples
+            .into_iter()
+            .map(|p| (p.name, p.owner, Summary::of(&p.times)))
+            .collect(),
+        frame_gpu: Summary::of(&frame_gpu),
+        technique_gpu: Summary::of(&technique_gpu),
+        frame_cpu: Summary::of(&frame_cpu),
+        counters: renderer.wait_for_counters(),
+        flicker,
+        timing_source,
+        triangles,
+    })
+}

@@ -1,0 +1,407 @@
+//! Results as CSV, markdown tables with the seeds' figures beside ours, and PNG plots.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use zoo_host::gpu::PassOwner;
+
+use crate::cli::parse_size;
+
+use super::measure::*;
+use super::plan::*;
+use super::{plot, suite};
+
+/// The `unshadowed` result with the same run, size and tessellation as `r`.
+fn baseline<'a>(results: &'a [ConfigResult], r: &ConfigResult) -> Option<&'a ConfigResult> {
+    results.iter().find(|b| {
+        b.config.technique.id == zoo_host::builtin::UNSHADOWED_ID
+            && b.config.run == r.config.run
+            && b.config.common_key() == r.config.common_key()
+    })
+}
+
+pub(super) fn ratio_to_baseline(results: &[ConfigResult], r: &ConfigResult) -> Option<f64> {
+    baseline(results, r)
+        .map(|b| b.frame_gpu.median)
+        .filter(|m| *m > 0.0)
+        .map(|m| r.frame_gpu.median / m)
+}
+
+/// `bench.csv`: one row per configuration and pass (plus frame and technique totals).
+pub fn bench_csv(results: &[ConfigResult]) -> String {
+    let mut out = String::from(
+        "run,configuration,technique,size,tessellation,pass,owner,median_ms,p95_ms,p99_ms,min_ms,max_ms,frames,vertex_invocations,fragment_invocations,compute_invocations\n",
+    );
+    for r in results {
+        let c = &r.config;
+        let rows = r
+            .passes
+            .iter()
+            .zip(&r.invocations)
+            .map(|((name, owner, s), counts)| {
+                let owner = match owner {
+                    PassOwner::Host => "host",
+                    PassOwner::Technique => "technique",
+                };
+                (name.clone(), owner, *s, *counts)
+            })
+            .chain([
+                (
+                    "technique total (gpu)".to_string(),
+                    "total",
+                    r.technique_gpu,
+                    None,
+                ),
+                ("frame total (gpu)".to_string(), "total", r.frame_gpu, None),
+                ("frame (cpu wall)".to_string(), "total", r.frame_cpu, None),
+            ]);
+        for (name, owner, s, counts) in rows {
+            let counts = counts.map_or(",,".to_string(), |[v, f, c]| format!("{v},{f},{c}"));
+            let _ = writeln!(
+                out,
+                "{},\"{}\",{},{}x{},{},\"{}\",{},{:.4},{:.4},{:.4},{:.4},{:.4},{},{counts}",
+                c.run,
+                c.label().replace('"', "'"),
+                c.technique.id,
+                c.size.x,
+                c.size.y,
+                c.tessellation,
+                name.replace('"', "'"),
+                owner,
+                s.median,
+                s.p95,
+                s.p99,
+                s.min,
+                s.max,
+                s.count
+            );
+        }
+    }
+    out
+}
+
+/// `summary.csv`: one row per configuration.
+pub fn summary_csv(results: &[ConfigResult]) -> String {
+    let mut out = String::from(
+        "run,configuration,technique,size,tessellation,triangles,frame_median_ms,technique_median_ms,cpu_median_ms,ratio_to_unshadowed,flicker_index\n",
+    );
+    for r in results {
+        let c = &r.config;
+        let _ = writeln!(
+            out,
+            "{},\"{}\",{},{}x{},{},{},{:.4},{:.4},{:.4},{},{}",
+            c.run,
+            c.label().replace('"', "'"),
+            c.technique.id,
+            c.size.x,
+            c.size.y,
+            c.tessellation,
+            r.triangles,
+            r.frame_gpu.median,
+            r.technique_gpu.median,
+            r.frame_cpu.median,
+            ratio_to_baseline(results, r).map_or(String::new(), |x| format!("{x:.4}")),
+            r.flicker.map_or(String::new(), |x| format!("{x:.6}")),
+        );
+    }
+    out
+}
+
+/// Today's date (UTC) as YYYY-MM-DD.
+fn today() -> String {
+    let days = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs() / 86_400)
+        .unwrap_or(0) as i64;
+    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02}")
+}
+
+/// Median of a measure for a result: `frame`, `technique`, or the passes starting with a prefix.
+fn measure(r: &ConfigResult, passes: &str) -> f64 {
+    match passes {
+        "frame" => r.frame_gpu.median,
+        "technique" => r.technique_gpu.median,
+        prefix => r
+            .passes
+            .iter()
+            .filter(|(n, _, _)| n.starts_with(prefix))
+            .map(|(_, _, s)| s.median)
+            .sum(),
+    }
+}
+
+/// Suite ratios: (label, configuration key, value, seed figure) for every matching pair.
+pub fn suite_ratios(
+    s: &suite::Suite,
+    results: &[ConfigResult],
+) -> Vec<(String, String, f64, String)> {
+    let mut out = Vec::new();
+    for ratio in &s.ratios {
+        let (n, d) = (&ratio.numerator, &ratio.denominator);
+        for num in results
+            .iter()
+            .filter(|r| r.config.run == n.run && r.config.technique.id == n.technique)
+        {
+            // Same size and tessellation, and equal values for every sweep both sides share.
+            let den = results.iter().find(|r| {
+                r.config.run == d.run
+                    && r.config.technique.id == d.technique
+                    && r.config.common_key() == num.config.common_key()
+                    && num
+                        .config
+                        .swept
+                        .iter()
+                        .all(|(k, v)| r.config.swept.iter().all(|(k2, v2)| k2 != k || v2 == v))
+            });
+            if let Some(den) = den {
+                let bottom = measure(den, &d.passes);
+                if bottom > 0.0 {
+                    let key = format!(
+                        "{}x{}, tessellation {}{}",
+                        num.config.size.x,
+                        num.config.size.y,
+                        num.config.tessellation,
+                        if num.config.swept.is_empty() {
+                            String::new()
+                        } else {
+                            format!(" ({})", num.config.label())
+                        }
+                    );
+                    out.push((
+                        ratio.label.clone(),
+                        key,
+                        measure(num, &n.passes) / bottom,
+                        ratio.seed.clone(),
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// `bench.md`: readable tables with the environment, ratios and flicker.
+pub fn bench_md(
+    plans: &[BenchPlan],
+    results: &[ConfigResult],
+    adapter: &str,
+    suite: Option<&suite::Suite>,
+) -> String {
+    let mut out = String::new();
+    let w = &mut out;
+    let title = suite.map_or("Shadow Zoo benchmark".to_string(), |s| {
+        format!("Shadow Zoo benchmark suite `{}`", s.name)
+    });
+    let _ = writeln!(w, "# {title}\n");
+    if let Some(s) = suite {
+        let _ = writeln!(w, "{}\n", s.description.trim());
+    }
+    let _ = writeln!(w, "- Date: {}", today());
+    let _ = writeln!(w, "- Adapter: {adapter}");
+    let _ = writeln!(
+        w,
+        "- OS: {} ({})",
+        std::env::consts::OS,
+        std::env::consts::ARCH
+    );
+    let _ = writeln!(
+        w,
+        "- Timing: {}",
+        results.first().map_or("none", |r| r.timing_source.label())
+    );
+    for plan in plans {
+        let _ = writeln!(
+            w,
+            "- Run `{}`: scene `{}`, {}x{} (unless swept), {} frames after {} warm-up frames, path: {:?}",
+            plan.run,
+            plan.scene_path.display(),
+            plan.size.x,
+            plan.size.y,
+            plan.frames,
+            plan.warmup,
+            plan.path
+        );
+    }
+    let _ = writeln!(
+        w,
+        "\nFrame times are GPU pass sums (medians over frames); the ratio is to `unshadowed` with the same run, size and tessellation. The flicker index is the mean fraction of pixels whose visibility flips between consecutive frames where the reference visibility does not change.\n"
+    );
+    let _ = writeln!(
+        w,
+        "| run | configuration | triangles | frame median (ms) | p95 | technique median (ms) | CPU frame (ms) | × unshadowed | flicker |"
+    );
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|");
+    for r in results {
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} |",
+            r.config.run,
+            r.config.label(),
+            r.triangles,
+            r.frame_gpu.median,
+            r.frame_gpu.p95,
+            r.technique_gpu.median,
+            r.frame_cpu.median,
+            ratio_to_baseline(results, r).map_or("–".into(), |x| format!("{x:.2}")),
+            r.flicker.map_or("–".into(), |x| format!("{x:.5}")),
+        );
+    }
+    if let Some(s) = suite {
+        let ratios = suite_ratios(s, results);
+        if !ratios.is_empty() {
+            let _ = writeln!(w, "\n## This project beside the seeds\n");
+            let _ = writeln!(w, "| ratio | configuration | this project | seed |");
+            let _ = writeln!(w, "|---|---|---|---|");
+            for (label, key, value, seed) in ratios {
+                let _ = writeln!(w, "| {label} | {key} | {value:.2} | {seed} |");
+            }
+        }
+        if !s.seed_figures.is_empty() {
+            let _ = writeln!(w, "\nWhat the seeds report:\n");
+            for f in &s.seed_figures {
+                let _ = writeln!(w, "- {f}");
+            }
+        }
+    }
+    let _ = writeln!(
+        w,
+        "\n## Passes (median / p95 ms; vertex / fragment / compute invocations where counted)\n"
+    );
+    for r in results {
+        let passes: Vec<String> = r
+            .passes
+            .iter()
+            .zip(&r.invocations)
+            .map(|((n, _, s), counts)| match counts {
+                Some([v, f, c]) => format!("{n} {:.2}/{:.2} ({v}/{f}/{c})", s.median, s.p95),
+                None => format!("{n} {:.2}/{:.2}", s.median, s.p95),
+            })
+            .collect();
+        let _ = writeln!(
+            w,
+            "- {} `{}`: {}",
+            r.config.run,
+            r.config.label(),
+            passes.join(", ")
+        );
+    }
+    let counted: Vec<&ConfigResult> = results.iter().filter(|r| !r.counters.is_empty()).collect();
+    if !counted.is_empty() {
+        let _ = writeln!(w, "\n## Workload counters (last frame)\n");
+        for r in counted {
+            let values: Vec<String> = r.counters.iter().map(|(k, v)| format!("{k} {v}")).collect();
+            let _ = writeln!(
+                w,
+                "- {} `{}`: {}",
+                r.config.run,
+                r.config.label(),
+                values.join(", ")
+            );
+        }
+    }
+    out
+}
+
+fn file_name(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+pub(super) fn write_plots(
+    plans: &[BenchPlan],
+    results: &[ConfigResult],
+    out: &Path,
+) -> anyhow::Result<()> {
+    // One segment per pass family ("Shadow map: light 0 face 2" -> "Shadow map").
+    let bars: Vec<plot::Bar> = results
+        .iter()
+        .map(|r| {
+            let mut segments: Vec<(String, f64)> = Vec::new();
+            for (name, _, s) in &r.passes {
+                let family = name.split(':').next().unwrap_or(name).trim().to_string();
+                match segments.iter_mut().find(|(n, _)| *n == family) {
+                    Some((_, total)) => *total += s.median,
+                    None => segments.push((family, s.median)),
+                }
+            }
+            plot::Bar {
+                label: format!("{}: {}", r.config.run, r.config.label()),
+                segments,
+            }
+        })
+        .collect();
+    plot::pass_bars(&bars, "Per-pass GPU time (median)", &out.join("passes.png"))?;
+    for plan in plans {
+        for sweep in &plan.sweeps {
+            let x_of = |value: &str| -> Option<f64> {
+                match sweep.key {
+                    SweepKey::Size => parse_size(value).ok().map(|s| (s.x * s.y) as f64),
+                    _ => value.parse().ok(),
+                }
+            };
+            let mut lines: Vec<plot::Line> = Vec::new();
+            for r in results.iter().filter(|r| r.config.run == plan.run) {
+                let Some((_, value)) = r.config.swept.iter().find(|(k, _)| *k == sweep.name) else {
+                    continue;
+                };
+                let Some(x) = x_of(value) else { continue };
+                let others: Vec<String> = r
+                    .config
+                    .swept
+                    .iter()
+                    .filter(|(k, _)| *k != sweep.name)
+                    .map(|(k, v)| format!("{k}={v}"))
+                    .collect();
+                let name = if others.is_empty() {
+                    r.config.technique.id.to_string()
+                } else {
+                    format!("{} [{}]", r.config.technique.id, others.join(", "))
+                };
+                match lines.iter_mut().find(|l| l.name == name) {
+                    Some(line) => line.points.push((x, r.frame_gpu.median)),
+                    None => lines.push(plot::Line {
+                        name,
+                        points: vec![(x, r.frame_gpu.median)],
+                    }),
+                }
+            }
+            for line in &mut lines {
+                line.points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            }
+            if !lines.is_empty() {
+                let x_label = match sweep.key {
+                    SweepKey::Size => "pixels".to_string(),
+                    _ => sweep.name.clone(),
+                };
+                plot::sweep_lines(
+                    &lines,
+                    &format!("{}: frame time against {}", plan.run, sweep.name),
+                    &x_label,
+                    &out.join(format!(
+                        "sweep-{}-{}.png",
+                        file_name(&plan.run),
+                        file_name(&sweep.name)
+                    )),
+                )?;
+            }
+        }
+    }
+    Ok(())
+}
