@@ -25,7 +25,7 @@ struct Backfacing {
 
 impl ShadowTechnique for Backfacing {
     fn passes(&self) -> Vec<PassInfo> {
-        vec![PassInfo::render(NAME)]
+        self.pass.as_ref().map_or(Vec::new(), |p| p.passes(NAME))
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, _: Changes) -> TechniqueResult {

@@ -20,12 +20,27 @@ fn surfaces_facing_away_get_the_darkness_and_the_others_stay_lit() {
     )
     .unwrap();
     renderer.set_technique("backfacing", &values).unwrap();
-    renderer.render(&View::Final).unwrap();
+    let timings = renderer.render(&View::Final).unwrap();
     assert_eq!(
         renderer.technique().id,
         "backfacing",
         "the technique was disabled"
     );
+    // One pass per light, recorded under the names it declares.
+    let recorded: Vec<String> = timings
+        .passes
+        .iter()
+        .filter(|p| p.owner == zoo_host::gpu::PassOwner::Technique)
+        .map(|p| p.name.clone())
+        .collect();
+    let declared: Vec<String> = renderer
+        .technique_instance()
+        .passes()
+        .into_iter()
+        .map(|p| p.name)
+        .collect();
+    assert_eq!(recorded, declared);
+    assert_eq!(declared.len(), 3);
     let g = renderer.read_gbuffer();
     // The three lights share one layer's channels: each pass must leave the others alone.
     assert_eq!(renderer.slots().slot_count(), 3);

@@ -71,7 +71,7 @@ impl TechniqueRegistration {
         params: Vec::new,
         create: |_, _| {
             Err(TechniqueError::Other(
-                "the registration names no factory".into(),
+                "registered without `create:` (register_technique! needs a factory)".into(),
             ))
         },
     };

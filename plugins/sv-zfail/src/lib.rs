@@ -397,7 +397,10 @@ impl ShadowTechnique for ShadowVolumes {
         if self.pipelines.is_none() {
             self.pipelines = Some(self.create_pipelines(ctx)?);
         }
-        if changes.scene || changes.lights || self.buffers.is_none() {
+        // Volume buffers and the counter ring depend on the scene and the number of lights,
+        // not on where the lights are (moving one keeps its counters coming).
+        let count_changed = ctx.lights.len() != self.lights;
+        if changes.scene || count_changed || self.buffers.is_none() {
             self.lights = ctx.lights.len();
             let generator = &mut self.pipelines.as_mut().expect("created above").generator;
             generator.prepare(ctx, self.params.volumes);

@@ -79,8 +79,7 @@ fn gpu_silhouette_counts_match_the_cpu_mirror() {
         .set_technique("sv-zfail", &ParamValues::new())
         .unwrap();
     renderer.render(&View::Final).unwrap();
-    // Counters arrive a frame or two late without stalling; the first read may be empty.
-    assert!(renderer.technique_instance().counters().len() <= 2 * scene.lights.len());
+    // Counters arrive a frame or two late without stalling; tools wait for them.
     let counters = renderer.wait_for_counters();
     for (l, light) in scene.lights.iter().enumerate() {
         let mut expected = 0;

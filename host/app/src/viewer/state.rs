@@ -186,10 +186,12 @@ impl ViewerState {
         };
         let mut values = self.params_for(&self.technique);
         values.insert(key.to_string(), spec.clamp(&value));
-        self.settings.insert(self.technique.clone(), values.clone());
         // Applied to the live technique when it can take them; rebuilt otherwise.
         match self.renderer.set_params(&values) {
-            Ok(_) => self.error = None,
+            Ok(_) => {
+                self.settings.insert(self.technique.clone(), values);
+                self.error = None;
+            }
             Err(e) => self.error = Some(e.to_string()),
         }
         self.refresh_b();

@@ -173,20 +173,31 @@ impl ReadbackRing {
         }
     }
 
-    /// A free buffer to copy this frame's results into, or `None` when every buffer is still
-    /// in flight (this frame's results are then skipped).
+    /// A buffer to copy this frame's results into: a free one, else the oldest one written but
+    /// not yet read (its older results are superseded; copies stay in GPU order), or `None`
+    /// when every buffer is being mapped (this frame's results are then skipped).
     pub fn target(&mut self) -> Option<&wgpu::Buffer> {
         self.frame += 1;
         let frame = self.frame;
-        let slot = self.slots.iter().find(|s| {
-            let mut state = s.state.lock().expect("ring state");
-            if *state == SlotState::Free {
-                *state = SlotState::Written(frame);
-                true
-            } else {
-                false
-            }
-        })?;
+        let state_of = |s: &RingSlot| *s.state.lock().expect("ring state");
+        let free = self
+            .slots
+            .iter()
+            .position(|s| state_of(s) == SlotState::Free);
+        let oldest_written = || {
+            self.slots
+                .iter()
+                .enumerate()
+                .filter_map(|(i, s)| match state_of(s) {
+                    SlotState::Written(f) => Some((f, i)),
+                    _ => None,
+                })
+                .min()
+                .map(|(_, i)| i)
+        };
+        let index = free.or_else(oldest_written)?;
+        let slot = &self.slots[index];
+        *slot.state.lock().expect("ring state") = SlotState::Written(frame);
         Some(&slot.buffer)
     }
 

@@ -14,6 +14,14 @@ use crate::technique::{RenderContext, TechniqueError};
 pub struct FullscreenLightPass<T: Pod> {
     pipeline: wgpu::RenderPipeline,
     uniforms: UniformSlots<T>,
+    /// Lights at the last `new`, `ensure` or `record`.
+    lights: usize,
+}
+
+/// The name of light `light`'s pass: `"{base}: light {light}"` (passes of one family share
+/// `base`, which timing views group by).
+pub fn light_pass_name(base: &str, light: usize) -> String {
+    format!("{base}: light {light}")
 }
 
 impl<T: Pod> FullscreenLightPass<T> {
@@ -31,7 +39,11 @@ impl<T: Pod> FullscreenLightPass<T> {
         let mut layouts = vec![uniforms.layout()];
         layouts.extend_from_slice(groups);
         let pipeline = slot_fullscreen_pipeline(ctx, shader, &module, entry, &layouts);
-        Ok(FullscreenLightPass { pipeline, uniforms })
+        Ok(FullscreenLightPass {
+            pipeline,
+            uniforms,
+            lights: ctx.lights.len(),
+        })
     }
 
     /// The pass in `slot`, built there first if it is empty (a technique's `prepare` keeps
@@ -45,18 +57,28 @@ impl<T: Pod> FullscreenLightPass<T> {
         if slot.is_none() {
             *slot = Some(Self::new(ctx, shader, entry, &[])?);
         }
-        Ok(slot.as_mut().expect("just filled"))
+        let pass = slot.as_mut().expect("just filled");
+        pass.lights = ctx.lights.len();
+        Ok(pass)
     }
 
-    /// Records pass `label` for every light with the uniform `per_light(light)`.
+    /// The passes [`Self::record`] records, one per light, named by [`light_pass_name`].
+    pub fn passes(&self, base: &str) -> Vec<crate::PassInfo> {
+        (0..self.lights)
+            .map(|light| crate::PassInfo::render(light_pass_name(base, light)))
+            .collect()
+    }
+
+    /// Records one pass per light, named `"{base}: light {l}"` ([`light_pass_name`]), with
+    /// the uniform `per_light(light)`. Once per frame (see [`UniformSlots::write`]).
     pub fn record(
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-        label: &str,
+        base: &str,
         per_light: impl Fn(usize) -> T,
     ) {
-        self.record_with(ctx, recorder, label, per_light, |_, _| ());
+        self.record_with(ctx, recorder, base, per_light, |_, _| ());
     }
 
     /// As [`Self::record`], with `bind(light, pass)` setting the technique's own groups.
@@ -64,14 +86,16 @@ impl<T: Pod> FullscreenLightPass<T> {
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-        label: &str,
+        base: &str,
         per_light: impl Fn(usize) -> T,
         bind: impl Fn(usize, &mut wgpu::RenderPass<'_>),
     ) {
         let values: Vec<T> = (0..ctx.lights.len()).map(per_light).collect();
+        self.lights = values.len();
         self.uniforms.write(ctx.gpu, &values);
         for light in 0..values.len() {
-            let mut pass = ctx.light_pass(recorder, label, light, None);
+            let name = light_pass_name(base, light);
+            let mut pass = ctx.light_pass(recorder, &name, light, None);
             pass.set_pipeline(&self.pipeline);
             let offset = self.uniforms.offset(light);
             pass.set_bind_group(2, self.uniforms.bind_group(), &[offset]);

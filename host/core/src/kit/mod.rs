@@ -18,6 +18,6 @@ pub mod slot;
 pub mod uniforms;
 
 pub use layouts::{pipeline_layout, slot_fullscreen_pipeline, storage, texture, uniform};
-pub use light_pass::FullscreenLightPass;
+pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use slot::{LightSlot, slot_target};
 pub use uniforms::UniformSlots;

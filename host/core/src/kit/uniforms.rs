@@ -93,7 +93,9 @@ impl<T: Pod> UniformSlots<T> {
     }
 
     /// Writes `values` from slot 0 on, growing the buffer (and replacing the bind group, whose
-    /// layout stays the same) when they do not fit.
+    /// layout stays the same) when they do not fit. Once per frame: queued writes all land
+    /// before the frame is submitted, so a second write in the same frame replaces the first
+    /// for every draw of that frame.
     pub fn write(&mut self, gpu: &GpuContext, values: &[T]) {
         if values.len() > self.capacity {
             self.capacity = values.len().next_power_of_two();

@@ -380,6 +380,14 @@ impl Renderer {
             self.technique.pending = Changes::default();
         }
 
+        // Views are checked before recording, so a bad one never leaves a recorded frame
+        // unsubmitted (readbacks the technique set up for it would never arrive).
+        if *view != View::Final {
+            self.debug_source(view)?;
+        }
+        if let Some(overlay) = overlay {
+            self.debug_source(&overlay.view)?;
+        }
         let ctx = render_context!(self, resource);
         let mut recorder = PassRecorder::new(&self.gpu, self.timestamps.as_ref())
             .with_statistics(self.statistics.as_ref());
