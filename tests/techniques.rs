@@ -193,12 +193,7 @@ fn every_technique_renders_lit_and_finite() {
             .into_iter()
             .map(|p| p.name)
             .collect();
-        let recorded: Vec<String> = timings
-            .passes
-            .iter()
-            .filter(|p| p.owner == zoo_host::gpu::PassOwner::Technique)
-            .map(|p| p.name.clone())
-            .collect();
+        let recorded = timings.technique_pass_names();
         assert_eq!(
             recorded, declared,
             "{id}: recorded passes differ from its declared passes"

@@ -27,12 +27,7 @@ fn surfaces_facing_away_get_the_darkness_and_the_others_stay_lit() {
         "the technique was disabled"
     );
     // One pass per light, recorded under the names it declares.
-    let recorded: Vec<String> = timings
-        .passes
-        .iter()
-        .filter(|p| p.owner == zoo_host::gpu::PassOwner::Technique)
-        .map(|p| p.name.clone())
-        .collect();
+    let recorded = timings.technique_pass_names();
     let declared: Vec<String> = renderer
         .technique_instance()
         .passes()

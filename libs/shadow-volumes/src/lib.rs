@@ -10,4 +10,6 @@ pub mod stencil;
 pub use generation::{
     ARGS_BYTES, VolumeGenerator, Volumes, dispatch_size, triangle_flags, volume_capacity,
 };
-pub use stencil::{Counting, VOLUME_VERTEX_LAYOUT, volume_depth_stencil, volume_primitive};
+pub use stencil::{
+    Counting, VOLUME_VERTEX_LAYOUT, stencil_state, volume_depth_stencil, volume_primitive,
+};

@@ -48,10 +48,22 @@ pub fn volume_depth_stencil(
         Counting::ZFail => (face(keep, decrement), face(keep, increment)),
         Counting::ZPass => (face(increment, keep), face(decrement, keep)),
     };
+    stencil_state(wgpu::CompareFunction::Less, front, back, bias)
+}
+
+/// A state on the G-buffer's depth-stencil that tests depth with `depth_compare` (never
+/// writing it) and applies the `front` and `back` stencil faces: the volume draw, and the
+/// passes that read its counts.
+pub fn stencil_state(
+    depth_compare: wgpu::CompareFunction,
+    front: wgpu::StencilFaceState,
+    back: wgpu::StencilFaceState,
+    bias: wgpu::DepthBiasState,
+) -> wgpu::DepthStencilState {
     wgpu::DepthStencilState {
         format: DEPTH_FORMAT,
         depth_write_enabled: Some(false),
-        depth_compare: Some(wgpu::CompareFunction::Less),
+        depth_compare: Some(depth_compare),
         stencil: wgpu::StencilState {
             front,
             back,

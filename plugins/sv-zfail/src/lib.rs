@@ -12,7 +12,6 @@
 
 use zoo_host::gpu::readback::ReadbackRing;
 use zoo_host::params::TechniqueParams;
-use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::render::visibility::VISIBILITY_FORMAT;
 use zoo_host::scene::LightKind;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
@@ -22,7 +21,8 @@ use zoo_host::{
 };
 
 use zoo_shadow_volumes::{
-    ARGS_BYTES, VOLUME_VERTEX_LAYOUT, VolumeGenerator, volume_depth_stencil, volume_primitive,
+    ARGS_BYTES, VOLUME_VERTEX_LAYOUT, VolumeGenerator, stencil_state, volume_depth_stencil,
+    volume_primitive,
 };
 pub use zoo_shadow_volumes::{Counting, Volumes, silhouette};
 
@@ -122,18 +122,6 @@ impl ShadowVolumes {
             depth_fail_op,
             pass_op,
         };
-        let depth_state = |compare, front, back, bias| wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(false),
-            depth_compare: Some(compare),
-            stencil: wgpu::StencilState {
-                front,
-                back,
-                read_mask: 0xff,
-                write_mask: 0xff,
-            },
-            bias,
-        };
         let target = |format, write_mask, blend| {
             Some(wgpu::ColorTargetState {
                 format,
@@ -184,7 +172,7 @@ impl ShadowVolumes {
                     buffers: &[],
                 },
                 primitive: Default::default(),
-                depth_stencil: Some(depth_state(
+                depth_stencil: Some(stencil_state(
                     wgpu::CompareFunction::Always,
                     test(compare),
                     test(compare),
@@ -247,7 +235,7 @@ impl ShadowVolumes {
                 buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
             },
             primitive: volume_primitive,
-            depth_stencil: Some(depth_state(
+            depth_stencil: Some(stencil_state(
                 wgpu::CompareFunction::Always,
                 test(wgpu::CompareFunction::Always),
                 test(wgpu::CompareFunction::Always),

@@ -57,6 +57,15 @@ pub struct FrameTimings {
 }
 
 impl FrameTimings {
+    /// Names of the technique's passes, in recording order.
+    pub fn technique_pass_names(&self) -> Vec<String> {
+        self.passes
+            .iter()
+            .filter(|p| p.owner == PassOwner::Technique)
+            .map(|p| p.name.clone())
+            .collect()
+    }
+
     /// Sum over the passes of `owner`.
     pub fn total(&self, owner: PassOwner) -> f64 {
         self.passes
