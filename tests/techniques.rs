@@ -333,9 +333,17 @@ fn parameter_changes_apply_in_place_or_rebuild() {
         renderer.read_output()
     };
     for (id, in_place, rebuilt) in [
-        ("sm-pcf", ("filter", "Pcss"), ("map_size", "1024")),
-        ("planar", ("opacity", "0.4"), ("depth_offset", "32")),
-        ("sv-zfail", ("debug_light", "1"), ("counting", "ZPass")),
+        ("sm-pcf", ("filter", "Pcss"), Some(("slope_bias", "2.5"))),
+        // The map set replans for a new resolution without a rebuild.
+        ("sm-pcf", ("map_size", "1024"), Some(("cull_front", "true"))),
+        ("planar", ("opacity", "0.4"), Some(("depth_offset", "32"))),
+        (
+            "sv-zfail",
+            ("debug_light", "1"),
+            Some(("counting", "ZPass")),
+        ),
+        ("vsm", ("map_size", "1024"), None),
+        ("vsm", ("blur_radius", "4"), None),
     ] {
         let mut renderer = Renderer::new(gpu(), scene.clone(), size).unwrap();
         renderer.set_technique(id, &ParamValues::new()).unwrap();
@@ -352,6 +360,7 @@ fn parameter_changes_apply_in_place_or_rebuild() {
         );
         // Visible parameters do change the frame (the debug light only changes debug views).
         assert_eq!(after != before, id != "sv-zfail", "{id}: {in_place:?}");
+        let Some(rebuilt) = rebuilt else { continue };
         let applied = renderer
             .set_params(&values_for(id, &[in_place, rebuilt]))
             .unwrap();

@@ -7,20 +7,23 @@
 #import "common/gbuffer.wgsl"
 #import "common/fullscreen.wgsl"
 #import "shadow-maps/filters.wgsl"
+#import "shadow-maps/layers.wgsl"
 
+// Filter modes, one per variant of the Rust `Filter` parameter (`FILTER_` and its name in
+// capitals). The plugin reads their values from this module, so no number is kept twice.
 const FILTER_NONE: u32 = 0u;
-const FILTER_HARDWARE_2X2: u32 = 1u;
-const FILTER_PCF_3X3: u32 = 2u;
-const FILTER_PCF_5X5: u32 = 3u;
-const FILTER_PCF_7X7: u32 = 4u;
-const FILTER_PCF_9X9: u32 = 5u;
+const FILTER_HARDWARE2X2: u32 = 1u;
+const FILTER_PCF3X3: u32 = 2u;
+const FILTER_PCF5X5: u32 = 3u;
+const FILTER_PCF7X7: u32 = 4u;
+const FILTER_PCF9X9: u32 = 5u;
 const FILTER_POISSON: u32 = 6u;
 const FILTER_PCSS: u32 = 7u;
 
 // One layer's camera, in a 256-byte slot (shared with the depth pass's dynamic uniform).
 struct Slot {
-    view_proj: mat4x4<f32>,
-    _pad: array<vec4<f32>, 12>,
+    camera: LayerCamera,
+    _pad: array<vec4<f32>, 11>,
 }
 
 struct ShadowLight {
@@ -40,11 +43,11 @@ struct ShadowLight {
     kernel_texels: f32,
     // Light radius (point, spot) or tangent of the angular radius (directional).
     light_size: f32,
-    map_size: f32,
-    position: vec3<f32>,
     search_texels: f32,
+    position: vec3<f32>,
+    _pad0: f32,
     direction: vec3<f32>,
-    _pad: f32,
+    _pad1: f32,
 }
 
 struct Current {
@@ -72,23 +75,9 @@ struct MapPoint {
     inside: bool,
 }
 
-fn cube_face(d: vec3<f32>) -> u32 {
-    let a = abs(d);
-    if a.x >= a.y && a.x >= a.z {
-        return select(1u, 0u, d.x >= 0.0);
-    }
-    if a.y >= a.z {
-        return select(3u, 2u, d.y >= 0.0);
-    }
-    return select(5u, 4u, d.z >= 0.0);
-}
-
 fn project(sl: ShadowLight, p: vec3<f32>) -> MapPoint {
-    var layer = sl.first_layer;
-    if sl.layer_count == 6u {
-        layer += cube_face(p - sl.position);
-    }
-    let clip = slots[layer].view_proj * vec4<f32>(p, 1.0);
+    let layer = light_layer(sl.first_layer, sl.layer_count, sl.position, p);
+    let clip = slots[layer].camera.view_proj * vec4<f32>(p, 1.0);
     let ndc = clip.xyz / clip.w;
     var m: MapPoint;
     m.uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
@@ -192,11 +181,11 @@ fn fs_lookup(in: FullscreenOut) -> Outputs {
     var visibility = 1.0;
     switch sl.filter_mode {
         case FILTER_NONE: { visibility = shadow_tap(p, false); }
-        case FILTER_HARDWARE_2X2: { visibility = shadow_tap(p, true); }
-        case FILTER_PCF_3X3: { visibility = grid_pcf(p, frame, texel, 3); }
-        case FILTER_PCF_5X5: { visibility = grid_pcf(p, frame, texel, 5); }
-        case FILTER_PCF_7X7: { visibility = grid_pcf(p, frame, texel, 7); }
-        case FILTER_PCF_9X9: { visibility = grid_pcf(p, frame, texel, 9); }
+        case FILTER_HARDWARE2X2: { visibility = shadow_tap(p, true); }
+        case FILTER_PCF3X3: { visibility = grid_pcf(p, frame, texel, 3); }
+        case FILTER_PCF5X5: { visibility = grid_pcf(p, frame, texel, 5); }
+        case FILTER_PCF7X7: { visibility = grid_pcf(p, frame, texel, 7); }
+        case FILTER_PCF9X9: { visibility = grid_pcf(p, frame, texel, 9); }
         case FILTER_POISSON: { visibility = poisson_pcf(p, frame, sl.kernel_texels * texel, r); }
         default: {
             let light = PcssLight(sl.light_size, sl.near, sl.perspective == 1u, sl.search_texels);

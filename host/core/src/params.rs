@@ -348,6 +348,10 @@ macro_rules! param_choice {
             pub fn name(self) -> &'static str {
                 match self { $($name::$variant => stringify!($variant)),+ }
             }
+            /// This variant's position in [`Self::NAMES`].
+            pub fn index(self) -> usize {
+                Self::NAMES.iter().position(|n| *n == self.name()).expect("every variant is named")
+            }
         }
 
         impl $crate::params::ParamType for $name {
@@ -492,6 +496,8 @@ mod tests {
         );
         assert_eq!(schema[0].doc, "Map size.");
         assert_eq!(schema[3].default, ParamValue::Choice("Exact".into()));
+        assert_eq!((Mode::Fast.index(), Mode::Exact.index()), (0, 1));
+        assert_eq!(Mode::NAMES[Mode::Exact.index()], Mode::Exact.name());
     }
 
     #[test]

@@ -1,10 +1,14 @@
 //! The depth pass: every caster rendered into each layer of a [`MapArray`] from that layer's
-//! camera (`shaders/shadow-maps/depth.wgsl`).
+//! camera (`shaders/shadow-maps/depth.wgsl`), optionally with a fragment stage that writes a
+//! colour map as well (moments for variance shadow maps, fluxes for reflective ones).
 
+use bytemuck::{Pod, Zeroable};
+use zoo_host::glam::Vec4;
 use zoo_host::gpu::PassRecorder;
 use zoo_host::render::Vertex;
 use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
 
+use crate::light_space::{LightFrustum, Projection};
 use crate::maps::{MAP_FORMAT, MapArray};
 use crate::planning::LightMaps;
 
@@ -12,8 +16,44 @@ use crate::planning::LightMaps;
 /// element for lookups that project into any layer.
 pub const CAMERA_STRIDE: u64 = 256;
 
-/// Rasterisation state of the depth pass.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// `LayerCamera` in `shadow-maps/layers.wgsl`: one layer's camera.
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct LayerCamera {
+    pub view_proj: [f32; 16],
+    /// Perspective layers: the light's position and 1 / far; orthographic layers: w = 0.
+    pub eye: [f32; 4],
+}
+
+impl LayerCamera {
+    /// The camera of `frustum`.
+    pub fn new(frustum: &LightFrustum) -> LayerCamera {
+        let eye = match frustum.projection {
+            Projection::Perspective { far, .. } => {
+                frustum.view.inverse().w_axis.truncate().extend(1.0 / far)
+            }
+            Projection::Orthographic { .. } => Vec4::ZERO,
+        };
+        LayerCamera {
+            view_proj: frustum.view_proj.to_cols_array(),
+            eye: eye.to_array(),
+        }
+    }
+}
+
+/// A fragment stage that writes a colour map beside the depth: entry `entry` of shader
+/// `shader`, which imports `shadow-maps/depth.wgsl` and takes its `DepthVertex`.
+#[derive(Debug, Clone, Copy)]
+pub struct ColorOutput<'a> {
+    pub shader: &'a str,
+    pub entry: &'a str,
+    pub format: wgpu::TextureFormat,
+    /// What texels no caster covers hold.
+    pub clear: wgpu::Color,
+}
+
+/// Rasterisation state of the depth pass (the default: no bias, no culling).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct DepthState {
     /// Constant depth bias, in units of the depth format's resolution.
     pub constant_bias: i32,
@@ -27,6 +67,7 @@ pub struct DepthState {
 pub struct DepthPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
+    clear: Option<wgpu::Color>,
     cameras: Option<(wgpu::Buffer, wgpu::BindGroup)>,
 }
 
@@ -37,22 +78,39 @@ impl DepthPass {
         label: &str,
         state: DepthState,
     ) -> Result<DepthPass, TechniqueError> {
+        Self::with_color(ctx, label, state, None)
+    }
+
+    /// As [`Self::new`], with a colour map written by `color` (record with
+    /// [`Self::record_color`]).
+    pub fn with_color(
+        ctx: &RenderContext<'_>,
+        label: &str,
+        state: DepthState,
+        color: Option<ColorOutput<'_>>,
+    ) -> Result<DepthPass, TechniqueError> {
         let device = &ctx.gpu.device;
-        let module = ctx
-            .shaders
-            .create_module(device, "shadow-maps/depth.wgsl")?;
+        let shader = color.map_or("shadow-maps/depth.wgsl", |c| c.shader);
+        let module = ctx.shaders.create_module(device, shader)?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some(&format!("{label} layer camera layout")),
             entries: &[wgpu::BindGroupLayoutEntry {
                 binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Uniform,
                     has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(64),
+                    min_binding_size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
                 },
                 count: None,
             }],
+        });
+        let targets = color.map(|c| {
+            [Some(wgpu::ColorTargetState {
+                format: c.format,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })]
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(&format!("{label} pipeline layout")),
@@ -64,7 +122,11 @@ impl DepthPass {
             layout: Some(&pipeline_layout),
             vertex: wgpu::VertexState {
                 module: &module,
-                entry_point: Some("vs_depth"),
+                entry_point: Some(if color.is_some() {
+                    "vs_depth_world"
+                } else {
+                    "vs_depth"
+                }),
                 compilation_options: Default::default(),
                 buffers: &[Some(Vertex::LAYOUT)],
             },
@@ -84,13 +146,21 @@ impl DepthPass {
                 },
             }),
             multisample: Default::default(),
-            fragment: None,
+            fragment: color
+                .zip(targets.as_ref())
+                .map(|(c, targets)| wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(c.entry),
+                    compilation_options: Default::default(),
+                    targets,
+                }),
             multiview_mask: None,
             cache: None,
         });
         Ok(DepthPass {
             pipeline,
             layout,
+            clear: color.map(|c| c.clear),
             cameras: None,
         })
     }
@@ -101,7 +171,8 @@ impl DepthPass {
         let mut bytes = Vec::new();
         for frustum in lights.iter().flat_map(|l| &l.frustums) {
             let mut slot = [0u8; CAMERA_STRIDE as usize];
-            slot[..64].copy_from_slice(bytemuck::bytes_of(&frustum.view_proj.to_cols_array()));
+            let camera = LayerCamera::new(frustum);
+            slot[..size_of::<LayerCamera>()].copy_from_slice(bytemuck::bytes_of(&camera));
             bytes.extend_from_slice(&slot);
         }
         let needed = (bytes.len() as u64).max(CAMERA_STRIDE);
@@ -126,7 +197,7 @@ impl DepthPass {
                     resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &buffer,
                         offset: 0,
-                        size: wgpu::BufferSize::new(64),
+                        size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
                     }),
                 }],
             });
@@ -145,6 +216,21 @@ impl DepthPass {
         self.cameras.as_ref().map(|(buffer, _)| buffer)
     }
 
+    /// The names of the passes [`Self::record`] records for `lights`, in order.
+    pub fn pass_names(
+        lights: &[LightMaps],
+        name: impl Fn(usize, Option<usize>) -> String,
+    ) -> Vec<String> {
+        let mut names = Vec::new();
+        for light_maps in lights {
+            let cube = light_maps.frustums.len() == 6;
+            for face in 0..light_maps.frustums.len() {
+                names.push(name(light_maps.light, cube.then_some(face)));
+            }
+        }
+        names
+    }
+
     /// Records one depth pass per layer of `lights` into `maps`, named by
     /// `name(light, face)` (`face` is `Some` for cube faces).
     pub fn record(
@@ -155,20 +241,58 @@ impl DepthPass {
         lights: &[LightMaps],
         name: impl Fn(usize, Option<usize>) -> String,
     ) -> Result<(), TechniqueError> {
+        self.record_into(ctx, recorder, None, maps, lights, name)
+    }
+
+    /// As [`Self::record`] for a pass with a [`ColorOutput`]: the colour goes into the layers
+    /// of `color`, and `depth` (one layer of the same resolution, cleared for every layer) is
+    /// the depth test's scratch.
+    pub fn record_color(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        color: &MapArray,
+        depth: &MapArray,
+        lights: &[LightMaps],
+        name: impl Fn(usize, Option<usize>) -> String,
+    ) -> Result<(), TechniqueError> {
+        self.record_into(ctx, recorder, Some(color), depth, lights, name)
+    }
+
+    fn record_into(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        color: Option<&MapArray>,
+        depth: &MapArray,
+        lights: &[LightMaps],
+        name: impl Fn(usize, Option<usize>) -> String,
+    ) -> Result<(), TechniqueError> {
         let (_, bind_group) = self
             .cameras
             .as_ref()
             .ok_or_else(TechniqueError::not_prepared)?;
+        if color.is_some() != self.clear.is_some() {
+            return Err(TechniqueError::Other(
+                "depth pass: colour maps go with a ColorOutput (record_color)".into(),
+            ));
+        }
         for light_maps in lights {
             let cube = light_maps.frustums.len() == 6;
             for face in 0..light_maps.frustums.len() {
                 let layer = light_maps.first_layer + face as u32;
                 let label = name(light_maps.light, cube.then_some(face));
+                let clear = wgpu::LoadOp::Clear(self.clear.unwrap_or_default());
+                let colors: Vec<_> = color
+                    .map(|c| zoo_host::gpu::color_attachment(&c.layer_views[layer as usize], clear))
+                    .into_iter()
+                    .collect();
+                let depth_layer = if color.is_some() { 0 } else { layer as usize };
                 let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&label),
-                    color_attachments: &[],
+                    color_attachments: &colors,
                     depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &maps.layer_views[layer as usize],
+                        view: &depth.layer_views[depth_layer],
                         depth_ops: Some(wgpu::Operations {
                             load: wgpu::LoadOp::Clear(1.0),
                             store: wgpu::StoreOp::Store,
@@ -191,7 +315,7 @@ impl DepthPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::wgsl_struct;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
 
     #[test]
     fn layer_cameras_mirror_the_shader() {
@@ -199,9 +323,9 @@ mod tests {
             .compose("shadow-maps/depth.wgsl")
             .unwrap()
             .source;
-        let camera = wgsl_struct(&source, "LayerCamera").unwrap();
-        assert_eq!(camera.members, [("view_proj".to_string(), 0)]);
-        assert_eq!(camera.size, 64);
+        let (size, fields) = zoo_host::mirror_fields!(LayerCamera { view_proj, eye });
+        check_mirror(&source, "LayerCamera", size, &fields, SizeRule::Equal).unwrap();
         assert_eq!(CAMERA_STRIDE % 256, 0, "a dynamic-offset slot");
+        assert!(size as u64 <= CAMERA_STRIDE);
     }
 }

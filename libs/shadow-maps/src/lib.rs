@@ -1,17 +1,25 @@
 //! Shadow-map building blocks shared by techniques (sm-pcf today; VSM, PSSM, the hybrid and
 //! SSSS next): light frusta fitted to spot cones, cube faces and what the camera sees
 //! ([`light_space`]), the per-light layer plan with screen scissors ([`planning`]), the depth
-//! array under a memory budget ([`maps`]) and the depth pass that fills it ([`depth`]).
+//! array under a memory budget ([`maps`]), the depth pass that fills it, optionally with a
+//! colour map such as moments ([`depth`]), and a separable blur of colour map layers
+//! ([`blur`]). [`ShadowMapSet`] keeps them up to date for a technique in one call per frame.
 //!
 //! Filters that read the maps live in WGSL: `shaders/shadow-maps/`.
 
+pub mod blur;
 pub mod depth;
 pub mod light_space;
 pub mod maps;
 pub mod planning;
+pub mod set;
 
-pub use depth::{CAMERA_STRIDE, DepthPass, DepthState};
-pub use maps::{CUBE_GUARD, MAP_FORMAT, MEMORY_BUDGET, MapArray, effective_resolution};
-pub use planning::{
-    LightMaps, PlanInputs, layers_needed, light_scissor, light_size, object_bounds, plan,
+pub use blur::LayerBlur;
+pub use depth::{CAMERA_STRIDE, ColorOutput, DepthPass, DepthState, LayerCamera};
+pub use maps::{
+    CUBE_GUARD, MAP_FORMAT, MEMORY_BUDGET, MapArray, effective_resolution, filterable_rg_format,
 };
+pub use planning::{
+    LightMaps, MapScale, PlanInputs, layers_needed, light_scissor, light_size, object_bounds, plan,
+};
+pub use set::{ShadowMapSet, layer_pass_name};

@@ -11,12 +11,19 @@ pub const CUBE_GUARD: u32 = 2;
 pub const MEMORY_BUDGET: u64 = 1 << 30;
 
 /// The resolution to use: `requested` clamped to the device and to [`MEMORY_BUDGET`] for
-/// `layers` layers, with a note saying why when it was lowered.
-pub fn effective_resolution(requested: u32, device_max: u32, layers: u32) -> (u32, Option<String>) {
+/// `layers` layers of `bytes_per_texel`, with a note saying why when it was lowered.
+pub fn effective_resolution(
+    requested: u32,
+    device_max: u32,
+    layers: u32,
+    bytes_per_texel: u64,
+) -> (u32, Option<String>) {
     let mut resolution = requested.min(device_max);
     let mut note = (resolution < requested)
         .then(|| format!("map_size {requested} exceeds the device limit; using {resolution}"));
-    while resolution > 256 && layers as u64 * (resolution as u64).pow(2) * 4 > MEMORY_BUDGET {
+    while resolution > 256
+        && layers as u64 * (resolution as u64).pow(2) * bytes_per_texel > MEMORY_BUDGET
+    {
         resolution /= 2;
         note = Some(format!(
             "{layers} map layers at {requested} texels exceed {} MiB; using {resolution}",
@@ -24,6 +31,19 @@ pub fn effective_resolution(requested: u32, device_max: u32, layers: u32) -> (u3
         ));
     }
     (resolution, note)
+}
+
+/// The two-channel float format for filtered colour maps (moments): `Rg32Float` where the
+/// device filters 32-bit floats (`FLOAT32_FILTERABLE`), `Rg16Float` elsewhere.
+pub fn filterable_rg_format(device: &wgpu::Device) -> wgpu::TextureFormat {
+    if device
+        .features()
+        .contains(wgpu::Features::FLOAT32_FILTERABLE)
+    {
+        wgpu::TextureFormat::Rg32Float
+    } else {
+        wgpu::TextureFormat::Rg16Float
+    }
 }
 
 /// `layers` square depth maps of `resolution` texels in one array texture.
@@ -40,8 +60,20 @@ pub struct MapArray {
 }
 
 impl MapArray {
-    /// Creates the array (`label` names the texture and its views).
+    /// Creates a depth array ([`MAP_FORMAT`]; `label` names the texture and its views).
     pub fn new(gpu: &GpuContext, label: &str, resolution: u32, layers: u32) -> MapArray {
+        Self::with_format(gpu, label, resolution, layers, MAP_FORMAT)
+    }
+
+    /// Creates an array of `format` (a depth format, or a colour format for moment or flux
+    /// maps), usable as render attachment and sampled texture.
+    pub fn with_format(
+        gpu: &GpuContext,
+        label: &str,
+        resolution: u32,
+        layers: u32,
+        format: wgpu::TextureFormat,
+    ) -> MapArray {
         let allocated = zoo_host::gpu::array_layers(gpu, resolution, resolution, layers);
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
@@ -53,7 +85,7 @@ impl MapArray {
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: MAP_FORMAT,
+            format,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
@@ -90,13 +122,17 @@ mod tests {
 
     #[test]
     fn resolution_is_clamped_to_device_and_memory() {
-        assert_eq!(effective_resolution(2048, 16384, 3), (2048, None));
-        let (r, note) = effective_resolution(8192, 4096, 1);
+        assert_eq!(effective_resolution(2048, 16384, 3, 4), (2048, None));
+        let (r, note) = effective_resolution(8192, 4096, 1, 4);
         assert_eq!(r, 4096);
         assert!(note.unwrap().contains("device limit"));
         // 224 layers at 2048 would need 3.5 GiB.
-        let (r, note) = effective_resolution(2048, 16384, 224);
+        let (r, note) = effective_resolution(2048, 16384, 224, 4);
         assert!(224 * (r as u64).pow(2) * 4 <= MEMORY_BUDGET);
         assert!(note.unwrap().contains("exceed"));
+        // Twice the bytes per texel: the next step down.
+        let (wide, _) = effective_resolution(2048, 16384, 224, 8);
+        assert!(224 * (wide as u64).pow(2) * 8 <= MEMORY_BUDGET);
+        assert_eq!(wide, r / 2);
     }
 }

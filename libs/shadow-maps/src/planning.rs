@@ -3,7 +3,9 @@
 use zoo_host::glam::{Mat4, UVec2, Vec2, Vec3};
 use zoo_host::scene::{Camera, Light, LightKind, Scene};
 
-use crate::light_space::{Aabb, LightFrustum, cube_frustums, directional_frustum, spot_frustum};
+use crate::light_space::{
+    Aabb, LightFrustum, Projection, cube_frustums, directional_frustum, spot_frustum,
+};
 use crate::maps::CUBE_GUARD;
 
 /// One light's layers of the map array.
@@ -16,6 +18,41 @@ pub struct LightMaps {
     pub frustums: Vec<LightFrustum>,
     /// Screen rectangle (x, y, width, height) its lookups can touch.
     pub scissor: [u32; 4],
+}
+
+/// How a light's layers project, as lookups need it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapScale {
+    /// World size of a texel: per unit of distance along the layer's axis (perspective) or
+    /// absolute (orthographic).
+    pub texel_scale: f32,
+    pub perspective: bool,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl LightMaps {
+    /// The projection of this light's layers (all alike) for `resolution`-texel maps.
+    pub fn scale(&self, resolution: u32) -> MapScale {
+        match self.frustums[0].projection {
+            Projection::Perspective {
+                tan_half_fov,
+                near,
+                far,
+            } => MapScale {
+                texel_scale: 2.0 * tan_half_fov / resolution as f32,
+                perspective: true,
+                near,
+                far,
+            },
+            Projection::Orthographic { extent, near, far } => MapScale {
+                texel_scale: extent / resolution as f32,
+                perspective: false,
+                near,
+                far,
+            },
+        }
+    }
 }
 
 /// Layers the lights need: six for a point light, one otherwise (at least one in all).

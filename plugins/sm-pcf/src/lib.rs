@@ -11,6 +11,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::glam::UVec2;
+use zoo_host::gpu::layout::ChoiceCodes;
 use zoo_host::params::TechniqueParams;
 use zoo_host::scene::LightKind;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
@@ -19,11 +20,7 @@ use zoo_host::{
     ShadowTechnique, TechniqueError, wgpu,
 };
 
-use zoo_shadow_maps::light_space::{Aabb, Projection};
-use zoo_shadow_maps::{
-    DepthPass, DepthState, LightMaps, MapArray, PlanInputs, effective_resolution, layers_needed,
-    light_size, object_bounds,
-};
+use zoo_shadow_maps::{DepthState, ShadowMapSet, light_size};
 
 zoo_host::param_choice! {
     /// How shadow-map comparisons are filtered.
@@ -57,15 +54,6 @@ zoo_host::technique_params! {
     }
 }
 
-impl Filter {
-    fn code(self) -> u32 {
-        Filter::NAMES
-            .iter()
-            .position(|n| *n == self.name())
-            .expect("every variant is named") as u32
-    }
-}
-
 /// `ShadowLight` in `sm-pcf/lookup.wgsl`.
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 #[repr(C)]
@@ -81,11 +69,11 @@ struct ShadowLight {
     normal_offset: f32,
     kernel_texels: f32,
     light_size: f32,
-    map_size: f32,
-    position: [f32; 3],
     search_texels: f32,
+    position: [f32; 3],
+    _pad0: f32,
     direction: [f32; 3],
-    _pad: f32,
+    _pad1: f32,
 }
 
 /// `Current` in `sm-pcf/lookup.wgsl`, in a 256-byte slot.
@@ -98,12 +86,14 @@ struct Current {
 }
 
 const SLOT: u64 = 256;
+const LOOKUP_SHADER: &str = "sm-pcf/lookup.wgsl";
 const DIAGNOSTICS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 struct Pipelines {
-    depth: DepthPass,
     /// Without and with diagnostics output; each writes the light's slot (`kit::slot_target`).
     lookup: Vec<wgpu::RenderPipeline>,
     lookup_layout: wgpu::BindGroupLayout,
+    /// The lookup's value of each `Filter` (its `FILTER_*` constants).
+    filter_codes: ChoiceCodes,
 }
 
 struct Buffers {
@@ -116,29 +106,20 @@ struct Buffers {
 pub struct ShadowMaps {
     params: SmParams,
     pipelines: Option<Pipelines>,
-    maps: Option<MapArray>,
+    /// The lights' depth maps, their frusta and the depth pass.
+    maps: Option<ShadowMapSet>,
     buffers: Option<Buffers>,
     diagnostics: Option<(wgpu::Texture, wgpu::TextureView)>,
     samplers: Option<(wgpu::Sampler, wgpu::Sampler)>,
-    lights: Vec<LightMaps>,
-    /// World bounds of every object and of each caster, for fitting directional maps.
-    object_bounds: Vec<Aabb>,
-    caster_bounds: Vec<Aabb>,
 }
 
 impl ShadowMaps {
     fn create_pipelines(&self, ctx: &RenderContext<'_>) -> Result<Pipelines, TechniqueError> {
         let device = &ctx.gpu.device;
-        let depth = DepthPass::new(
-            ctx,
-            "sm-pcf depth",
-            DepthState {
-                constant_bias: self.params.constant_bias as i32,
-                slope_bias: self.params.slope_bias,
-                cull_front: self.params.cull_front,
-            },
-        )?;
-        let lookup_module = ctx.shaders.create_module(device, "sm-pcf/lookup.wgsl")?;
+        let lookup_module = ctx.shaders.create_module(device, LOOKUP_SHADER)?;
+        let lookup_source = ctx.shaders.compose(LOOKUP_SHADER)?.source;
+        let filter_codes = ChoiceCodes::read(&lookup_source, "FILTER", Filter::NAMES)
+            .map_err(|e| TechniqueError::Other(format!("{LOOKUP_SHADER}: {e}")))?;
 
         let texture_entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -254,88 +235,46 @@ impl ShadowMaps {
             })
             .collect();
         Ok(Pipelines {
-            depth,
             lookup,
             lookup_layout,
+            filter_codes,
         })
     }
 
-    /// Plans layers for every light and (re)creates the map array when its size changes.
-    fn plan_maps(&mut self, ctx: &RenderContext<'_>) {
-        let layers = layers_needed(ctx.lights);
-        let device_max = ctx.gpu.device.limits().max_texture_dimension_2d;
-        let (resolution, note) = effective_resolution(self.params.map_size, device_max, layers);
-        if let Some(note) = note {
-            zoo_host::log::warn!("sm-pcf: {note}");
-        }
-        let reuse = self
-            .maps
-            .as_ref()
-            .is_some_and(|m| m.resolution == resolution && m.layers == layers);
-        if !reuse {
-            self.maps = Some(MapArray::new(
-                ctx.gpu,
-                "sm-pcf shadow maps",
-                resolution,
-                layers,
-            ));
-            self.buffers = None;
-        }
-    }
-
-    /// Fits every light's frustums to the current lights and camera and uploads them.
-    fn fit(&mut self, ctx: &RenderContext<'_>) {
-        let resolution = self.maps.as_ref().expect("maps planned").resolution;
-        self.lights = zoo_shadow_maps::plan(&PlanInputs {
-            lights: ctx.lights,
-            camera: ctx.camera,
-            view_proj: ctx.frame.matrices.view_proj,
-            size: ctx.size,
-            objects: &self.object_bounds,
-            casters: &self.caster_bounds,
-            resolution,
-            stable: self.params.stable_fit,
-        });
-        let pipelines = self.pipelines.as_mut().expect("pipelines exist");
-        if pipelines.depth.write_cameras(ctx.gpu, &self.lights) {
-            self.buffers = None;
-        }
-        let shadow_lights: Vec<ShadowLight> = self
-            .lights
+    /// Uploads every light's lookup parameters (after the maps were refitted or a parameter
+    /// changed).
+    fn upload(&mut self, ctx: &RenderContext<'_>) {
+        let pipelines = self.pipelines.as_ref().expect("pipelines exist");
+        let maps = self.maps.as_ref().expect("maps exist");
+        let resolution = maps.resolution();
+        let filter_mode = pipelines.filter_codes.code(self.params.filter.index());
+        let shadow_lights: Vec<ShadowLight> = maps
+            .lights()
             .iter()
             .map(|maps| {
                 let light = &ctx.lights[maps.light];
-                let (texel_scale, perspective, near, far) = match maps.frustums[0].projection {
-                    Projection::Perspective {
-                        tan_half_fov,
-                        near,
-                        far,
-                    } => (2.0 * tan_half_fov / resolution as f32, 1, near, far),
-                    Projection::Orthographic { extent, near, far } => {
-                        (extent / resolution as f32, 0, near, far)
-                    }
-                };
+                let scale = maps.scale(resolution);
                 ShadowLight {
                     first_layer: maps.first_layer,
                     layer_count: maps.frustums.len() as u32,
-                    filter_mode: self.params.filter.code(),
+                    filter_mode,
                     light: maps.light as u32,
-                    texel_scale,
-                    perspective,
-                    near,
-                    far,
+                    texel_scale: scale.texel_scale,
+                    perspective: u32::from(scale.perspective),
+                    near: scale.near,
+                    far: scale.far,
                     normal_offset: self.params.normal_offset,
                     kernel_texels: self.params.kernel_radius,
                     light_size: light_size(light),
-                    map_size: resolution as f32,
-                    position: light.position.to_array(),
                     search_texels: self.params.pcss_max_texels,
+                    position: light.position.to_array(),
+                    _pad0: 0.0,
                     direction: light.direction.to_array(),
-                    _pad: 0.0,
+                    _pad1: 0.0,
                 }
             })
             .collect();
-        let currents: Vec<Current> = (0..self.lights.len())
+        let currents: Vec<Current> = (0..maps.lights().len())
             .map(|i| Current {
                 index: i as u32,
                 debug: u32::from(i as u32 == self.params.debug_light),
@@ -369,7 +308,8 @@ impl ShadowMaps {
     ) -> Buffers {
         let device = &ctx.gpu.device;
         let pipelines = self.pipelines.as_ref().expect("pipelines exist");
-        let maps = self.maps.as_ref().expect("maps exist");
+        let set = self.maps.as_ref().expect("maps exist");
+        let maps = set.maps().expect("maps prepared");
         let (linear, nearest) = self.samplers.as_ref().expect("samplers exist");
         let buffer = |label: &str, bytes: usize, usage: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -379,7 +319,7 @@ impl ShadowMaps {
                 mapped_at_creation: false,
             })
         };
-        let cameras = pipelines.depth.cameras().expect("cameras written");
+        let cameras = set.cameras().expect("cameras written");
         let lights = buffer(
             "sm-pcf shadow lights",
             light_bytes,
@@ -474,12 +414,8 @@ impl ShadowMaps {
     }
 }
 
-fn depth_pass_name(light: usize, face: Option<usize>) -> String {
-    match face {
-        Some(f) => format!("Shadow map: light {light} face {f}"),
-        None => format!("Shadow map: light {light}"),
-    }
-}
+/// Base name of the depth passes (see `zoo_shadow_maps::layer_pass_name`).
+const DEPTH_PASS: &str = "Shadow map";
 
 fn lookup_pass_name(light: usize) -> String {
     format!("Shadow lookup: light {light}")
@@ -487,25 +423,19 @@ fn lookup_pass_name(light: usize) -> String {
 
 impl ShadowTechnique for ShadowMaps {
     fn passes(&self) -> Vec<PassInfo> {
-        let mut out = Vec::new();
-        for maps in &self.lights {
-            let cube = maps.frustums.len() == 6;
-            for face in 0..maps.frustums.len() {
-                out.push(PassInfo::render(depth_pass_name(
-                    maps.light,
-                    cube.then_some(face),
-                )));
-            }
-        }
-        for maps in &self.lights {
-            out.push(PassInfo::render(lookup_pass_name(maps.light)));
-        }
-        out
+        let Some(maps) = &self.maps else {
+            return Vec::new();
+        };
+        let lookups = maps.lights().iter().map(|l| lookup_pass_name(l.light));
+        (maps.pass_names(DEPTH_PASS).into_iter())
+            .chain(lookups)
+            .map(PassInfo::render)
+            .collect()
     }
 
     fn resources(&self) -> Vec<ResourceInfo> {
         let mut out = Vec::new();
-        if let Some(maps) = &self.maps {
+        if let Some(maps) = self.maps.as_ref().and_then(|m| m.maps()) {
             out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
         }
         if let Some((texture, _)) = &self.diagnostics {
@@ -518,11 +448,11 @@ impl ShadowTechnique for ShadowMaps {
                 });
             }
         }
-        if let Some(cameras) = self.pipelines.as_ref().and_then(|p| p.depth.cameras()) {
+        if let Some(cameras) = self.maps.as_ref().and_then(|m| m.cameras()) {
             out.push(ResourceInfo::buffer(
                 "layer cameras",
                 cameras,
-                "mat4 in 256-byte slots",
+                "LayerCamera in 256-byte slots",
             ));
         }
         if let Some(b) = &self.buffers {
@@ -544,20 +474,24 @@ impl ShadowTechnique for ShadowMaps {
         if self.pipelines.is_none() {
             self.pipelines = Some(self.create_pipelines(ctx)?);
             self.samplers = Some(Self::create_samplers(&ctx.gpu.device));
-        }
-        if changes.scene {
-            self.object_bounds = object_bounds(ctx.scene, false);
-            self.caster_bounds = object_bounds(ctx.scene, true);
+            let state = DepthState {
+                constant_bias: self.params.constant_bias as i32,
+                slope_bias: self.params.slope_bias,
+                cull_front: self.params.cull_front,
+            };
+            self.maps = Some(ShadowMapSet::new(ctx, "sm-pcf shadow maps", state, None)?);
         }
         if changes.resolution || self.diagnostics.is_none() {
             self.diagnostics = Some(Self::diagnostics_texture(&ctx.gpu.device, ctx.size));
         }
-        if changes.scene || changes.lights || self.maps.is_none() {
-            self.plan_maps(ctx);
-        }
         // Directional maps follow the camera; spot and point maps follow their lights.
+        let maps = self.maps.as_mut().expect("created above");
+        let p = &self.params;
+        if maps.prepare(ctx, changes, p.map_size, p.stable_fit) {
+            self.buffers = None;
+        }
         if changes != Changes::default() || self.buffers.is_none() {
-            self.fit(ctx);
+            self.upload(ctx);
         }
         Ok(())
     }
@@ -573,14 +507,10 @@ impl ShadowTechnique for ShadowMaps {
             &self.buffers,
             &self.diagnostics,
         ) else {
-            return Err(TechniqueError::Other(
-                "sm-pcf: record before prepare".into(),
-            ));
+            return Err(TechniqueError::not_prepared());
         };
-        pipelines
-            .depth
-            .record(ctx, recorder, maps, &self.lights, depth_pass_name)?;
-        for (k, light_maps) in self.lights.iter().enumerate() {
+        maps.record(ctx, recorder, DEPTH_PASS)?;
+        for (k, light_maps) in maps.lights().iter().enumerate() {
             let debug = light_maps.light as u32 == self.params.debug_light;
             let name = lookup_pass_name(light_maps.light);
             let diagnostics = zoo_host::gpu::color_attachment(
@@ -602,16 +532,10 @@ impl ShadowTechnique for ShadowMaps {
 
     fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
         let next = SmParams::from_values(values)?;
-        // Map size, depth biases and culling live in the maps and the depth pipeline; the
-        // rest reaches the shader through the per-light buffers `fit` rewrites.
-        let built = |p: &SmParams| {
-            (
-                p.map_size,
-                p.constant_bias,
-                p.slope_bias.to_bits(),
-                p.cull_front,
-            )
-        };
+        // Depth biases and culling live in the depth pipeline; the map size is applied by
+        // the map set at the next `prepare`, the rest reaches the shader through the per-light
+        // buffers `upload` rewrites.
+        let built = |p: &SmParams| (p.constant_bias, p.slope_bias.to_bits(), p.cull_front);
         if built(&next) != built(&self.params) {
             return Ok(ParamUpdate::Rebuild);
         }
@@ -622,13 +546,11 @@ impl ShadowTechnique for ShadowMaps {
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
         match resource {
             "shadow maps" => {
-                let maps = self.maps.as_ref()?;
-                let light = self
-                    .lights
-                    .iter()
-                    .find(|l| l.light as u32 == self.params.debug_light)?;
+                let set = self.maps.as_ref()?;
+                let light =
+                    (set.lights().iter()).find(|l| l.light as u32 == self.params.debug_light)?;
                 Some(DebugImage {
-                    view: &maps.layer_views[light.first_layer as usize],
+                    view: &set.maps()?.layer_views[light.first_layer as usize],
                     mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
                 })
             }
@@ -653,8 +575,11 @@ impl ShadowTechnique for ShadowMaps {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        let layers: usize = self.lights.iter().map(|l| l.frustums.len()).sum();
-        let resolution = self.maps.as_ref().map_or(0, |m| m.resolution);
+        let Some(maps) = &self.maps else {
+            return Vec::new();
+        };
+        let layers: usize = maps.lights().iter().map(|l| l.frustums.len()).sum();
+        let resolution = maps.resolution();
         vec![
             ("map layers".into(), layers as f64),
             ("map resolution".into(), resolution as f64),
@@ -673,9 +598,6 @@ fn create(
         buffers: None,
         diagnostics: None,
         samplers: None,
-        lights: Vec::new(),
-        object_bounds: Vec::new(),
-        caster_bounds: Vec::new(),
     }))
 }
 
@@ -695,27 +617,15 @@ zoo_host::register_technique! {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_integer_constant, wgsl_struct};
+    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_struct};
 
     #[test]
-    fn filter_codes_match_the_shader() {
-        let source = shader("sm-pcf/lookup.wgsl");
-        for (filter, constant) in [
-            (Filter::None, "FILTER_NONE"),
-            (Filter::Hardware2x2, "FILTER_HARDWARE_2X2"),
-            (Filter::Pcf3x3, "FILTER_PCF_3X3"),
-            (Filter::Pcf5x5, "FILTER_PCF_5X5"),
-            (Filter::Pcf7x7, "FILTER_PCF_7X7"),
-            (Filter::Pcf9x9, "FILTER_PCF_9X9"),
-            (Filter::Poisson, "FILTER_POISSON"),
-            (Filter::Pcss, "FILTER_PCSS"),
-        ] {
-            assert_eq!(
-                Ok(i64::from(filter.code())),
-                wgsl_integer_constant(&source, constant),
-                "{filter:?}"
-            );
-        }
+    fn every_filter_has_a_distinct_shader_constant() {
+        let codes = ChoiceCodes::read(&shader(LOOKUP_SHADER), "FILTER", Filter::NAMES).unwrap();
+        let mut values: Vec<u32> = (0..Filter::NAMES.len()).map(|i| codes.code(i)).collect();
+        values.sort();
+        values.dedup();
+        assert_eq!(values.len(), Filter::NAMES.len());
     }
 
     fn shader(name: &str) -> String {
@@ -740,17 +650,15 @@ mod tests {
             normal_offset,
             kernel_texels,
             light_size,
-            map_size,
-            position,
             search_texels,
-            direction,
-            _pad
+            position,
+            direction
         });
         check_mirror(&lookup, "ShadowLight", size, &fields, SizeRule::Equal).unwrap();
         // The layer cameras come from the shadow-map library's depth pass, 256 bytes apart.
         let slot = wgsl_struct(&lookup, "Slot").unwrap();
         assert_eq!(slot.size as u64, zoo_shadow_maps::CAMERA_STRIDE);
-        assert_eq!(slot.members[0], ("view_proj".to_string(), 0));
+        assert_eq!(slot.members[0], ("camera".to_string(), 0));
         // Uniforms at 256-byte dynamic offsets: the Rust struct fills the slot.
         let (size, fields) = zoo_host::mirror_fields!(Current { index, debug });
         check_mirror(&lookup, "Current", size, &fields, SizeRule::AtLeast).unwrap();

@@ -54,6 +54,44 @@ pub fn wgsl_integer_constant(source: &str, name: &str) -> Result<i64, String> {
     }
 }
 
+/// The WGSL values of a choice parameter's options (see [`param_choice!`](crate::param_choice)),
+/// read from the shader that switches on them: option `Pcf3x3` of prefix `FILTER` is constant
+/// `FILTER_PCF3X3`. The numbers live only in the shader; a missing, non-integer or repeated
+/// constant is an error when the technique builds its pipelines.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ChoiceCodes(Vec<u32>);
+
+impl ChoiceCodes {
+    /// Reads `{prefix}_{NAME}` for every name of `names` (a choice's `NAMES`) from WGSL `source`
+    /// (a composed module).
+    pub fn read(source: &str, prefix: &str, names: &[&str]) -> Result<ChoiceCodes, String> {
+        let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+        let mut codes = Vec::with_capacity(names.len());
+        for name in names {
+            let constant_name = format!("{prefix}_{}", name.to_uppercase());
+            let (_, constant) = module
+                .constants
+                .iter()
+                .find(|(_, c)| c.name.as_deref() == Some(constant_name.as_str()))
+                .ok_or_else(|| format!("option `{name}` has no constant `{constant_name}`"))?;
+            let code = match module.global_expressions[constant.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => v,
+                _ => return Err(format!("`{constant_name}` is not a u32 literal")),
+            };
+            if codes.contains(&code) {
+                return Err(format!("`{constant_name}` repeats the value {code}"));
+            }
+            codes.push(code);
+        }
+        Ok(ChoiceCodes(codes))
+    }
+
+    /// The value of the option at `index` (the choice's `index()`).
+    pub fn code(&self, index: usize) -> u32 {
+        self.0[index]
+    }
+}
+
 /// How the Rust size may relate to the WGSL size.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SizeRule {
@@ -130,6 +168,20 @@ macro_rules! mirror_fields {
 mod tests {
     use super::*;
     use crate::ShaderLibrary;
+
+    #[test]
+    fn choice_codes_come_from_the_shader() {
+        let source = "const MODE_A: u32 = 3u;\nconst MODE_LONG2X2: u32 = 0u;\n";
+        let codes = ChoiceCodes::read(source, "MODE", &["A", "Long2x2"]).unwrap();
+        assert_eq!((codes.code(0), codes.code(1)), (3, 0));
+        let missing = ChoiceCodes::read(source, "MODE", &["A", "B"]).unwrap_err();
+        assert!(missing.contains("`MODE_B`"), "{missing}");
+        let repeated = "const MODE_A: u32 = 1u;\nconst MODE_B: u32 = 1u;\n";
+        let error = ChoiceCodes::read(repeated, "MODE", &["A", "B"]).unwrap_err();
+        assert!(error.contains("repeats"), "{error}");
+        let signed = "const MODE_A: i32 = 1;\n";
+        assert!(ChoiceCodes::read(signed, "MODE", &["A"]).is_err());
+    }
     use crate::render::frame::{CameraUniform, GpuLight, GpuObject};
 
     fn frame() -> String {

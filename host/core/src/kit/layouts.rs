@@ -56,6 +56,54 @@ pub fn texture(
     }
 }
 
+/// A sampler at `binding`.
+pub fn sampler(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    ty: wgpu::SamplerBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Sampler(ty),
+        count: None,
+    }
+}
+
+/// A bind group of `layout` with `resources` at bindings 0, 1, 2, ...
+pub fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource<'_>],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+        .iter()
+        .enumerate()
+        .map(|(binding, resource)| wgpu::BindGroupEntry {
+            binding: binding as u32,
+            resource: resource.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// A bind group layout of `entries` (from [`uniform`], [`storage`], [`texture`], [`sampler`]).
+pub fn bind_group_layout(
+    device: &wgpu::Device,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries,
+    })
+}
+
 /// A pipeline layout of the frame (group 0) and G-buffer (group 1) layouts followed by a
 /// technique's own `groups` (2, 3, ...).
 pub fn pipeline_layout(

@@ -4,8 +4,8 @@
 //!   the channel) and open a pass on it with the frame and G-buffer groups bound.
 //! - [`uniforms`]: per-light (or per-draw) uniforms in one buffer, at the device's dynamic
 //!   offset alignment.
-//! - [`layouts`]: terse bind group layout entries and pipeline layouts that put the frame
-//!   (group 0) and G-buffer (group 1) layouts first.
+//! - [`layouts`]: terse bind group layout entries, bind groups by position, and pipeline
+//!   layouts that put the frame (group 0) and G-buffer (group 1) layouts first.
 //! - [`light_pass`]: a full-screen fragment shader run once per light into its slot, with
 //!   per-light uniforms.
 //!
@@ -17,7 +17,10 @@ pub mod light_pass;
 pub mod slot;
 pub mod uniforms;
 
-pub use layouts::{pipeline_layout, slot_fullscreen_pipeline, storage, texture, uniform};
+pub use layouts::{
+    bind_group, bind_group_layout, pipeline_layout, sampler, slot_fullscreen_pipeline, storage,
+    texture, uniform,
+};
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use slot::{LightSlot, slot_target};
 pub use uniforms::UniformSlots;

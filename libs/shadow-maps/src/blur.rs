@@ -1,0 +1,215 @@
+//! A separable Gaussian blur of colour map layers (moment maps, for example) through a
+//! one-layer scratch texture (`shaders/shadow-maps/blur.wgsl`).
+
+use bytemuck::{Pod, Zeroable};
+use zoo_host::gpu::PassRecorder;
+use zoo_host::kit::{UniformSlots, bind_group, bind_group_layout, texture};
+use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
+
+use crate::maps::MapArray;
+use crate::planning::LightMaps;
+use crate::set::layer_pass_name;
+
+/// `BlurParams` in `shadow-maps/blur.wgsl`.
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+struct BlurParams {
+    layer: u32,
+    radius: u32,
+    sigma: f32,
+    vertical: u32,
+}
+
+/// The scratch layer and the source bind groups for one map array.
+struct Bound {
+    maps: wgpu::Texture,
+    scratch: MapArray,
+    maps_group: wgpu::BindGroup,
+    scratch_group: wgpu::BindGroup,
+}
+
+/// The blur's pipeline, its per-pass parameters and its bindings to one map array.
+pub struct LayerBlur {
+    label: String,
+    format: wgpu::TextureFormat,
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    params: UniformSlots<BlurParams>,
+    bound: Option<Bound>,
+}
+
+impl LayerBlur {
+    /// Builds the pipeline for maps of `format` (`label` names it).
+    pub fn new(
+        ctx: &RenderContext<'_>,
+        label: &str,
+        format: wgpu::TextureFormat,
+    ) -> Result<LayerBlur, TechniqueError> {
+        let device = &ctx.gpu.device;
+        let module = ctx.shaders.create_module(device, "shadow-maps/blur.wgsl")?;
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
+        let layout = bind_group_layout(
+            device,
+            &format!("{label} source layout"),
+            &[texture(
+                0,
+                fragment,
+                unfiltered,
+                wgpu::TextureViewDimension::D2Array,
+            )],
+        );
+        let params = UniformSlots::new(ctx.gpu, &format!("{label} parameters"), 2, fragment);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(&format!("{label} pipeline layout")),
+            bind_group_layouts: &[Some(&layout), Some(params.layout())],
+            immediate_size: 0,
+        });
+        let pipeline = zoo_host::gpu::fullscreen_pipeline(
+            device,
+            &format!("{label} pipeline"),
+            Some(&pipeline_layout),
+            &module,
+            "fs_blur",
+            wgpu::ColorTargetState::from(format),
+        );
+        Ok(LayerBlur {
+            label: label.to_string(),
+            format,
+            pipeline,
+            layout,
+            params,
+            bound: None,
+        })
+    }
+
+    /// The names of the passes [`Self::record`] records for `lights`: each layer's
+    /// [`layer_pass_name`] with `base`, followed by ` (horizontal)` and ` (vertical)`.
+    pub fn pass_names(lights: &[LightMaps], base: &str) -> Vec<String> {
+        crate::depth::DepthPass::pass_names(lights, |l, f| layer_pass_name(base, l, f))
+            .into_iter()
+            .flat_map(|n| [format!("{n} (horizontal)"), format!("{n} (vertical)")])
+            .collect()
+    }
+
+    /// Blurs every layer of `lights` in `maps` with a Gaussian of `radius` texels on each side
+    /// (standard deviation radius / 2); nothing for radius 0. Once per frame.
+    pub fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        maps: &MapArray,
+        lights: &[LightMaps],
+        radius: u32,
+        base: &str,
+    ) {
+        if radius == 0 {
+            return;
+        }
+        if self.bound.as_ref().is_none_or(|b| b.maps != maps.texture) {
+            self.bound = Some(self.bind(ctx.gpu, maps));
+        }
+        let bound = self.bound.as_ref().expect("bound above");
+        // Each layer's horizontal pass reads it from the maps; every vertical pass reads the
+        // scratch's layer 0.
+        let layers: Vec<(String, u32)> = lights
+            .iter()
+            .flat_map(|l| {
+                let cube = l.frustums.len() == 6;
+                (0..l.frustums.len()).map(move |face| {
+                    let name = layer_pass_name(base, l.light, cube.then_some(face));
+                    (name, l.first_layer + face as u32)
+                })
+            })
+            .collect();
+        let step = |layer, vertical| BlurParams {
+            layer,
+            radius,
+            sigma: radius as f32 * 0.5,
+            vertical: u32::from(vertical),
+        };
+        let params: Vec<BlurParams> = (layers.iter())
+            .flat_map(|(_, layer)| [step(*layer, false), step(0, true)])
+            .collect();
+        self.params.write(ctx.gpu, &params);
+        for (i, (base, layer)) in layers.iter().enumerate() {
+            let steps = [
+                (
+                    "horizontal",
+                    &bound.maps_group,
+                    &bound.scratch.layer_views[0],
+                ),
+                (
+                    "vertical",
+                    &bound.scratch_group,
+                    &maps.layer_views[*layer as usize],
+                ),
+            ];
+            for (k, (direction, source, target)) in steps.into_iter().enumerate() {
+                let label = format!("{base} ({direction})");
+                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(&label),
+                    color_attachments: &[zoo_host::gpu::color_attachment(
+                        target,
+                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    )],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, source, &[]);
+                let offset = self.params.offset(2 * i + k);
+                pass.set_bind_group(1, self.params.bind_group(), &[offset]);
+                pass.draw(0..3, 0..1);
+            }
+        }
+    }
+
+    fn bind(&self, gpu: &GpuContext, maps: &MapArray) -> Bound {
+        let label = &self.label;
+        let scratch = MapArray::with_format(
+            gpu,
+            &format!("{label} scratch"),
+            maps.resolution,
+            1,
+            self.format,
+        );
+        let group = |name: String, view: &wgpu::TextureView| {
+            bind_group(
+                &gpu.device,
+                &name,
+                &self.layout,
+                &[wgpu::BindingResource::TextureView(view)],
+            )
+        };
+        Bound {
+            maps: maps.texture.clone(),
+            maps_group: group(format!("{label} maps"), &maps.array_view),
+            scratch_group: group(format!("{label} scratch"), &scratch.array_view),
+            scratch,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    #[test]
+    fn blur_params_mirror_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose("shadow-maps/blur.wgsl")
+            .unwrap()
+            .source;
+        let (size, fields) = zoo_host::mirror_fields!(BlurParams {
+            layer,
+            radius,
+            sigma,
+            vertical
+        });
+        check_mirror(&source, "BlurParams", size, &fields, SizeRule::Equal).unwrap();
+    }
+}

@@ -1,0 +1,41 @@
+// Shadow-map layers as lookups see them: each layer's camera, the depth that moment maps
+// store, and the cube face a direction falls in. No bindings: the importer binds the cameras.
+
+// One layer's camera (the depth pass's uniform; an array element of 256-byte slots for
+// lookups).
+struct LayerCamera {
+    view_proj: mat4x4<f32>,
+    // Perspective layers: the light's position and 1 / far. Orthographic layers: w = 0.
+    eye: vec4<f32>,
+}
+
+// The light-space depth of `world` that moment maps store: distance to the light over far
+// (perspective layers, the same on every cube face) or the depth coordinate (orthographic
+// layers). 0 at the light, 1 at the far plane.
+fn light_depth(camera: LayerCamera, world: vec3<f32>) -> f32 {
+    if camera.eye.w > 0.0 {
+        return length(world - camera.eye.xyz) * camera.eye.w;
+    }
+    return (camera.view_proj * vec4<f32>(world, 1.0)).z;
+}
+
+// The cube face (+x, -x, +y, -y, +z, -z) direction `d` from a point light falls in.
+fn cube_face(d: vec3<f32>) -> u32 {
+    let a = abs(d);
+    if a.x >= a.y && a.x >= a.z {
+        return select(1u, 0u, d.x >= 0.0);
+    }
+    if a.y >= a.z {
+        return select(3u, 2u, d.y >= 0.0);
+    }
+    return select(5u, 4u, d.z >= 0.0);
+}
+
+// The layer of a light's maps that world point `p` projects into: its only layer, or the
+// cube face seen from `light_position` when the light has six.
+fn light_layer(first_layer: u32, layer_count: u32, light_position: vec3<f32>, p: vec3<f32>) -> u32 {
+    if layer_count == 6u {
+        return first_layer + cube_face(p - light_position);
+    }
+    return first_layer;
+}
