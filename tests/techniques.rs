@@ -297,6 +297,7 @@ fn every_standard_scene_loads_and_renders() {
         "inside-shadow",
         "thin-casters",
         "contact",
+        "stacked",
     ] {
         let scene = load(&format!("{name}.ron"));
         match name {

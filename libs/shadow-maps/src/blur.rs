@@ -28,7 +28,9 @@ struct Bound {
     scratch_group: wgpu::BindGroup,
 }
 
-/// The blur's pipeline, its per-pass parameters and its bindings to one map array.
+/// The blur's pipeline, its per-pass parameters and its bindings to one map array. Blurring
+/// is per layer: on cube maps, kernels wider than the guard band ([`crate::CUBE_GUARD`]) do
+/// not reach across face edges.
 pub struct LayerBlur {
     label: String,
     format: wgpu::TextureFormat,
@@ -86,7 +88,7 @@ impl LayerBlur {
     /// The names of the passes [`Self::record`] records for `lights`: each layer's
     /// [`layer_pass_name`] with `base`, followed by ` (horizontal)` and ` (vertical)`.
     pub fn pass_names(lights: &[LightMaps], base: &str) -> Vec<String> {
-        crate::depth::DepthPass::pass_names(lights, |l, f| layer_pass_name(base, l, f))
+        crate::depth::DepthPass::pass_names(lights, |l, k| layer_pass_name(base, l, k))
             .into_iter()
             .flat_map(|n| [format!("{n} (horizontal)"), format!("{n} (vertical)")])
             .collect()
@@ -104,6 +106,8 @@ impl LayerBlur {
         base: &str,
     ) {
         if radius == 0 {
+            // Nothing to blur: let go of the scratch (and any replaced maps it still holds).
+            self.bound = None;
             return;
         }
         if self.bound.as_ref().is_none_or(|b| b.maps != maps.texture) {
@@ -115,9 +119,8 @@ impl LayerBlur {
         let layers: Vec<(String, u32)> = lights
             .iter()
             .flat_map(|l| {
-                let cube = l.frustums.len() == 6;
                 (0..l.frustums.len()).map(move |face| {
-                    let name = layer_pass_name(base, l.light, cube.then_some(face));
+                    let name = layer_pass_name(base, l, face);
                     (name, l.first_layer + face as u32)
                 })
             })

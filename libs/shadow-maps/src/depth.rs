@@ -65,6 +65,7 @@ pub struct DepthState {
 
 /// The depth pipeline and the layer cameras.
 pub struct DepthPass {
+    label: String,
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     clear: Option<wgpu::Color>,
@@ -158,6 +159,7 @@ impl DepthPass {
             cache: None,
         });
         Ok(DepthPass {
+            label: label.to_string(),
             pipeline,
             layout,
             clear: color.map(|c| c.clear),
@@ -182,7 +184,7 @@ impl DepthPass {
             .is_none_or(|(buffer, _)| buffer.size() < needed);
         if replaced {
             let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadow-map layer cameras"),
+                label: Some(&format!("{} layer cameras", self.label)),
                 size: needed.next_power_of_two().max(CAMERA_STRIDE),
                 usage: wgpu::BufferUsages::UNIFORM
                     | wgpu::BufferUsages::STORAGE
@@ -190,7 +192,7 @@ impl DepthPass {
                 mapped_at_creation: false,
             });
             let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("shadow-map layer camera bind group"),
+                label: Some(&format!("{} layer camera bind group", self.label)),
                 layout: &self.layout,
                 entries: &[wgpu::BindGroupEntry {
                     binding: 0,
@@ -219,27 +221,26 @@ impl DepthPass {
     /// The names of the passes [`Self::record`] records for `lights`, in order.
     pub fn pass_names(
         lights: &[LightMaps],
-        name: impl Fn(usize, Option<usize>) -> String,
+        name: impl Fn(&LightMaps, usize) -> String,
     ) -> Vec<String> {
         let mut names = Vec::new();
         for light_maps in lights {
-            let cube = light_maps.frustums.len() == 6;
-            for face in 0..light_maps.frustums.len() {
-                names.push(name(light_maps.light, cube.then_some(face)));
+            for layer in 0..light_maps.frustums.len() {
+                names.push(name(light_maps, layer));
             }
         }
         names
     }
 
     /// Records one depth pass per layer of `lights` into `maps`, named by
-    /// `name(light, face)` (`face` is `Some` for cube faces).
+    /// `name(light_maps, layer)` (`layer` counts within the light's layers).
     pub fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         maps: &MapArray,
         lights: &[LightMaps],
-        name: impl Fn(usize, Option<usize>) -> String,
+        name: impl Fn(&LightMaps, usize) -> String,
     ) -> Result<(), TechniqueError> {
         self.record_into(ctx, recorder, None, maps, lights, name)
     }
@@ -254,7 +255,7 @@ impl DepthPass {
         color: &MapArray,
         depth: &MapArray,
         lights: &[LightMaps],
-        name: impl Fn(usize, Option<usize>) -> String,
+        name: impl Fn(&LightMaps, usize) -> String,
     ) -> Result<(), TechniqueError> {
         self.record_into(ctx, recorder, Some(color), depth, lights, name)
     }
@@ -266,7 +267,7 @@ impl DepthPass {
         color: Option<&MapArray>,
         depth: &MapArray,
         lights: &[LightMaps],
-        name: impl Fn(usize, Option<usize>) -> String,
+        name: impl Fn(&LightMaps, usize) -> String,
     ) -> Result<(), TechniqueError> {
         let (_, bind_group) = self
             .cameras
@@ -278,10 +279,9 @@ impl DepthPass {
             ));
         }
         for light_maps in lights {
-            let cube = light_maps.frustums.len() == 6;
             for face in 0..light_maps.frustums.len() {
                 let layer = light_maps.first_layer + face as u32;
-                let label = name(light_maps.light, cube.then_some(face));
+                let label = name(light_maps, face);
                 let clear = wgpu::LoadOp::Clear(self.clear.unwrap_or_default());
                 let colors: Vec<_> = color
                     .map(|c| zoo_host::gpu::color_attachment(&c.layer_views[layer as usize], clear))

@@ -8,8 +8,10 @@
 //! Filters that read the maps live in WGSL: `shaders/shadow-maps/`.
 
 pub mod blur;
+pub mod cascades;
 pub mod depth;
 pub mod light_space;
+pub mod lookup;
 pub mod maps;
 pub mod planning;
 pub mod set;
@@ -20,6 +22,7 @@ pub use maps::{
     CUBE_GUARD, MAP_FORMAT, MEMORY_BUDGET, MapArray, effective_resolution, filterable_rg_format,
 };
 pub use planning::{
-    LightMaps, MapScale, PlanInputs, layers_needed, light_scissor, light_size, object_bounds, plan,
+    LayerPlan, LightMaps, MapScale, PlanInputs, StandardLayers, layers_needed, layers_needed_with,
+    light_scissor, light_size, object_bounds, plan, plan_with,
 };
 pub use set::{ShadowMapSet, layer_pass_name};

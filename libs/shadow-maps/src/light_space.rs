@@ -28,7 +28,7 @@ pub struct LightFrustum {
 }
 
 impl LightFrustum {
-    fn new(view: Mat4, projection: Projection) -> LightFrustum {
+    pub(crate) fn new(view: Mat4, projection: Projection) -> LightFrustum {
         let proj = match projection {
             Projection::Perspective {
                 tan_half_fov,
@@ -67,7 +67,7 @@ impl LightFrustum {
 }
 
 /// An up vector not parallel to `direction`.
-fn up_for(direction: Vec3) -> Vec3 {
+pub(crate) fn up_for(direction: Vec3) -> Vec3 {
     if direction.cross(Vec3::Y).length_squared() < 1e-4 {
         Vec3::Z
     } else {
@@ -139,7 +139,7 @@ pub fn cube_face(direction: Vec3) -> usize {
 /// World-space axis-aligned box.
 pub type Aabb = (Vec3, Vec3);
 
-fn corners((lo, hi): Aabb) -> [Vec3; 8] {
+pub(crate) fn corners((lo, hi): Aabb) -> [Vec3; 8] {
     [0, 1, 2, 3, 4, 5, 6, 7].map(|i| {
         Vec3::new(
             if i & 1 == 0 { lo.x } else { hi.x },
@@ -149,7 +149,7 @@ fn corners((lo, hi): Aabb) -> [Vec3; 8] {
     })
 }
 
-fn transformed_bounds(m: Mat4, points: &[Vec3]) -> Aabb {
+pub(crate) fn transformed_bounds(m: Mat4, points: &[Vec3]) -> Aabb {
     points.iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(lo, hi), p| {

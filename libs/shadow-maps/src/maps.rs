@@ -1,4 +1,5 @@
-//! The depth array that holds every light's shadow-map layers.
+//! The arrays that hold every light's shadow-map layers: depth maps, or colour maps (moments,
+//! fluxes) rendered beside a depth scratch.
 
 use zoo_host::GpuContext;
 use zoo_host::wgpu;
@@ -46,14 +47,14 @@ pub fn filterable_rg_format(device: &wgpu::Device) -> wgpu::TextureFormat {
     }
 }
 
-/// `layers` square depth maps of `resolution` texels in one array texture.
+/// `layers` square maps of `resolution` texels in one array texture (depth or colour).
 pub struct MapArray {
     pub resolution: u32,
     /// Layers in use (the texture may hold a spare one on GL, see
     /// `zoo_host::gpu::array_layers`).
     pub layers: u32,
     pub texture: wgpu::Texture,
-    /// One 2D view per layer, for depth attachments and debug views.
+    /// One 2D view per layer, for attachments and debug views.
     pub layer_views: Vec<wgpu::TextureView>,
     /// All layers in use, for lookups.
     pub array_view: wgpu::TextureView,

@@ -14,8 +14,12 @@ pub struct LightMaps {
     /// Index of the scene light.
     pub light: usize,
     pub first_layer: u32,
-    /// One frustum per layer: 1 (spot, directional) or 6 (point: cube faces).
+    /// One frustum per layer: 1 (spot, directional) or 6 (point: cube faces) under the
+    /// standard plan; a technique's own plan may use others (cascade splits), or none for a
+    /// light it does not shadow.
     pub frustums: Vec<LightFrustum>,
+    /// What one of its layers is called in pass names ("face", "split").
+    pub layer_word: &'static str,
     /// Screen rectangle (x, y, width, height) its lookups can touch.
     pub scissor: [u32; 4],
 }
@@ -55,13 +59,56 @@ impl LightMaps {
     }
 }
 
-/// Layers the lights need: six for a point light, one otherwise (at least one in all).
+/// How a technique lays out and fits each light's layers. [`StandardLayers`] is the usual
+/// plan; techniques with their own (cascades, warped maps) implement this.
+pub trait LayerPlan {
+    /// Layers `light` needs (the same until the lights or the plan's settings change).
+    fn layers(&self, light: &Light) -> u32;
+    /// The frusta of `light`, exactly [`Self::layers`] of them, fitted to `inputs`.
+    fn frustums(&self, light: &Light, inputs: &PlanInputs<'_>) -> Vec<LightFrustum>;
+    /// What one layer of a light with several is called in pass names.
+    fn layer_word(&self, _light: &Light) -> &'static str {
+        "face"
+    }
+}
+
+/// The usual plan: a perspective frustum on a spot cone, six guarded cube faces for a point
+/// light, and for a directional light one orthographic box fitted to the receivers the camera
+/// sees, reaching back to every caster.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StandardLayers;
+
+impl LayerPlan for StandardLayers {
+    fn layers(&self, light: &Light) -> u32 {
+        if light.kind == LightKind::Point { 6 } else { 1 }
+    }
+
+    fn frustums(&self, light: &Light, inputs: &PlanInputs<'_>) -> Vec<LightFrustum> {
+        let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
+        match light.kind {
+            LightKind::Spot => vec![spot_frustum(light)],
+            LightKind::Point => cube_frustums(light, inputs.resolution, CUBE_GUARD).to_vec(),
+            LightKind::Directional => vec![directional_frustum(
+                light.direction,
+                inputs.camera,
+                aspect,
+                inputs.objects,
+                inputs.casters,
+                inputs.stable.then_some(inputs.resolution),
+            )],
+        }
+    }
+}
+
+/// Layers the lights need under the standard plan: six for a point light, one otherwise (at
+/// least one in all).
 pub fn layers_needed(lights: &[Light]) -> u32 {
-    lights
-        .iter()
-        .map(|l| if l.kind == LightKind::Point { 6 } else { 1 })
-        .sum::<u32>()
-        .max(1)
+    layers_needed_with(lights, &StandardLayers)
+}
+
+/// Layers the lights need under `layout` (at least one in all).
+pub fn layers_needed_with(lights: &[Light], layout: &dyn LayerPlan) -> u32 {
+    lights.iter().map(|l| layout.layers(l)).sum::<u32>().max(1)
 }
 
 /// What [`plan`] fits the maps to.
@@ -80,33 +127,27 @@ pub struct PlanInputs<'a> {
     pub stable: bool,
 }
 
-/// Consecutive layers for every light with their frusta: a perspective frustum on a spot
-/// cone, six guarded cube faces for a point light, and for a directional light an
-/// orthographic box fitted to the receivers the camera sees, reaching back to every caster.
+/// Consecutive layers for every light with their frusta under the standard plan
+/// ([`StandardLayers`]).
 pub fn plan(inputs: &PlanInputs<'_>) -> Vec<LightMaps> {
-    let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
+    plan_with(inputs, &StandardLayers)
+}
+
+/// Consecutive layers for every light with the frusta `layout` fits.
+pub fn plan_with(inputs: &PlanInputs<'_>, layout: &dyn LayerPlan) -> Vec<LightMaps> {
     let mut next_layer = 0;
     inputs
         .lights
         .iter()
         .enumerate()
         .map(|(i, light)| {
-            let frustums = match light.kind {
-                LightKind::Spot => vec![spot_frustum(light)],
-                LightKind::Point => cube_frustums(light, inputs.resolution, CUBE_GUARD).to_vec(),
-                LightKind::Directional => vec![directional_frustum(
-                    light.direction,
-                    inputs.camera,
-                    aspect,
-                    inputs.objects,
-                    inputs.casters,
-                    inputs.stable.then_some(inputs.resolution),
-                )],
-            };
+            let frustums = layout.frustums(light, inputs);
+            debug_assert_eq!(frustums.len() as u32, layout.layers(light));
             let maps = LightMaps {
                 light: i,
                 first_layer: next_layer,
                 frustums,
+                layer_word: layout.layer_word(light),
                 scissor: light_scissor(light, inputs.view_proj, inputs.size),
             };
             next_layer += maps.frustums.len() as u32;

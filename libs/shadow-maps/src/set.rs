@@ -2,30 +2,25 @@
 //! arrays and the depth pass that fills them, kept up to date from one call per frame.
 
 use zoo_host::gpu::PassRecorder;
-use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
 use zoo_host::{Changes, RenderContext, TechniqueResult, wgpu};
 
 use crate::depth::{ColorOutput, DepthPass, DepthState};
 use crate::light_space::Aabb;
+use crate::lookup::LookupGroup;
 use crate::maps::{MAP_FORMAT, MapArray, effective_resolution};
-use crate::planning::{LightMaps, PlanInputs, layers_needed, object_bounds, plan};
+use crate::planning::{
+    LayerPlan, LightMaps, PlanInputs, StandardLayers, layers_needed_with, object_bounds, plan_with,
+};
 
-/// The name of the pass that renders light `light`'s layer (`face` of a cube):
-/// `"{base}: light {light}"` or `"{base}: light {light} face {face}"`.
-pub fn layer_pass_name(base: &str, light: usize, face: Option<usize>) -> String {
-    match face {
-        Some(face) => format!("{base}: light {light} face {face}"),
-        None => format!("{base}: light {light}"),
+/// The name of the pass that renders `layer` of a light's layers: `"{base}: light {l}"` for
+/// a light with one layer, else `"{base}: light {l} {word} {layer}"` with the plan's word for
+/// its layers ("face" for cube faces, "split" for cascades).
+pub fn layer_pass_name(base: &str, maps: &LightMaps, layer: usize) -> String {
+    let light = maps.light;
+    match maps.frustums.len() {
+        1 => format!("{base}: light {light}"),
+        _ => format!("{base}: light {light} {} {layer}", maps.layer_word),
     }
-}
-
-/// The bind group colour-map lookups read: the maps (`texture_2d_array<f32>`, filterable) at
-/// binding 0, a linear clamping sampler at 1 and the layer cameras (`array` of 256-byte slots
-/// holding a `LayerCamera`, storage) at 2.
-struct LookupGroup {
-    layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
-    group: Option<wgpu::BindGroup>,
 }
 
 /// Shadow maps of every light: depth maps, or colour maps (moments, fluxes) with a one-layer
@@ -34,7 +29,7 @@ pub struct ShadowMapSet {
     label: String,
     depth_pass: DepthPass,
     color_format: Option<wgpu::TextureFormat>,
-    lookup: Option<LookupGroup>,
+    lookup: LookupGroup,
     objects: Vec<Aabb>,
     casters: Vec<Aabb>,
     lights: Vec<LightMaps>,
@@ -51,27 +46,19 @@ impl ShadowMapSet {
         state: DepthState,
         color: Option<ColorOutput<'_>>,
     ) -> TechniqueResult<ShadowMapSet> {
-        let stage = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let filterable = wgpu::TextureSampleType::Float { filterable: true };
-        let device = &ctx.gpu.device;
-        let lookup = color.map(|_| LookupGroup {
-            layout: bind_group_layout(
-                device,
-                &format!("{label} lookup layout"),
-                &[
-                    texture(0, stage, filterable, wgpu::TextureViewDimension::D2Array),
-                    sampler(1, stage, wgpu::SamplerBindingType::Filtering),
-                    storage(2, stage, true),
-                ],
-            ),
-            sampler: device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some(&format!("{label} sampler")),
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                ..Default::default()
-            }),
-            group: None,
-        });
+        if let Some(color) = color {
+            let features = ctx.gpu.adapter.get_texture_format_features(color.format);
+            let needed = wgpu::TextureFormatFeatureFlags::FILTERABLE;
+            let usages =
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+            if !features.flags.contains(needed) || !features.allowed_usages.contains(usages) {
+                return Err(zoo_host::TechniqueError::Other(format!(
+                    "{label}: this device cannot render into and filter {:?} maps",
+                    color.format
+                )));
+            }
+        }
+        let lookup = LookupGroup::new(&ctx.gpu.device, label, color.is_none());
         Ok(ShadowMapSet {
             label: label.to_string(),
             depth_pass: DepthPass::with_color(ctx, label, state, color)?,
@@ -97,60 +84,81 @@ impl ShadowMapSet {
         resolution: u32,
         stable: bool,
     ) -> bool {
-        if changes.scene || !self.fitted {
-            self.objects = object_bounds(ctx.scene, false);
-            self.casters = object_bounds(ctx.scene, true);
-        }
-        let replanned = self.plan_maps(ctx, resolution);
+        self.prepare_with(ctx, changes, resolution, stable, &StandardLayers)
+    }
+
+    /// As [`Self::prepare`] with the technique's own layer plan.
+    pub fn prepare_with(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        changes: Changes,
+        resolution: u32,
+        stable: bool,
+        layout: &dyn LayerPlan,
+    ) -> bool {
+        self.update_bounds(ctx, changes);
+        let replanned = self.plan_maps(ctx, resolution, layout);
         if !replanned && self.fitted && changes == Changes::default() {
             return false;
         }
         let resolution = self.resolution();
-        self.lights = plan(&PlanInputs {
-            lights: ctx.lights,
-            camera: ctx.camera,
-            view_proj: ctx.frame.matrices.view_proj,
-            size: ctx.size,
-            objects: &self.objects,
-            casters: &self.casters,
-            resolution,
-            stable,
-        });
+        self.lights = plan_with(
+            &PlanInputs {
+                lights: ctx.lights,
+                camera: ctx.camera,
+                view_proj: ctx.frame.matrices.view_proj,
+                size: ctx.size,
+                objects: &self.objects,
+                casters: &self.casters,
+                resolution,
+                stable,
+            },
+            layout,
+        );
         self.fitted = true;
         let replaced = self.depth_pass.write_cameras(ctx.gpu, &self.lights) || replanned;
-        if let (Some(lookup), Some(color), Some(cameras)) =
-            (&mut self.lookup, &self.color, self.depth_pass.cameras())
+        let lookup = &mut self.lookup;
+        let maps = self.color.as_ref().or(self.depth.as_ref());
+        if let (Some(maps), Some(cameras)) = (maps, self.depth_pass.cameras())
             && (replaced || lookup.group.is_none())
         {
-            lookup.group = Some(bind_group(
-                &ctx.gpu.device,
-                &format!("{} lookup", self.label),
-                &lookup.layout,
-                &[
-                    wgpu::BindingResource::TextureView(&color.array_view),
-                    wgpu::BindingResource::Sampler(&lookup.sampler),
-                    cameras.as_entire_binding(),
-                ],
-            ));
+            lookup.bind(&ctx.gpu.device, maps, cameras);
         }
         replaced
     }
 
-    /// For sets with colour maps: the layout of [`Self::lookup_group`] (maps at binding 0,
-    /// linear sampler at 1, layer cameras at 2), for the lookup's pipeline layout.
-    pub fn lookup_layout(&self) -> Option<&wgpu::BindGroupLayout> {
-        self.lookup.as_ref().map(|l| &l.layout)
+    /// The layout of [`Self::lookup_group`] (see [`crate::lookup`]), for the lookup's
+    /// pipeline layout.
+    pub fn lookup_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.lookup.layout
     }
 
-    /// For sets with colour maps, once prepared: the lookup's bind group over the current
-    /// maps and cameras.
+    /// Once prepared: the lookup's bind group over the current maps and layer cameras.
     pub fn lookup_group(&self) -> Option<&wgpu::BindGroup> {
-        self.lookup.as_ref().and_then(|l| l.group.as_ref())
+        self.lookup.group.as_ref()
+    }
+
+    fn update_bounds(&mut self, ctx: &RenderContext<'_>, changes: Changes) {
+        if changes.scene || !self.fitted {
+            self.objects = object_bounds(ctx.scene, false);
+            self.casters = object_bounds(ctx.scene, true);
+        }
+    }
+
+    /// World bounds of every object and of each caster (for fitting; current after
+    /// [`Self::prepare`]).
+    pub fn bounds(&self) -> (&[Aabb], &[Aabb]) {
+        (&self.objects, &self.casters)
     }
 
     /// (Re)creates the maps when the layer count or the resolution changes.
-    fn plan_maps(&mut self, ctx: &RenderContext<'_>, requested: u32) -> bool {
-        let layers = layers_needed(ctx.lights);
+    fn plan_maps(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        requested: u32,
+        layout: &dyn LayerPlan,
+    ) -> bool {
+        let layers = layers_needed_with(ctx.lights, layout);
         let device_max = ctx.gpu.device.limits().max_texture_dimension_2d;
         let format = self.color_format.unwrap_or(MAP_FORMAT);
         let bytes = u64::from(format.block_copy_size(None).unwrap_or(4));
@@ -194,7 +202,7 @@ impl ShadowMapSet {
 
     /// The passes [`Self::record`] records, named by [`layer_pass_name`] with `base`.
     pub fn pass_names(&self, base: &str) -> Vec<String> {
-        DepthPass::pass_names(&self.lights, |l, f| layer_pass_name(base, l, f))
+        DepthPass::pass_names(&self.lights, |l, k| layer_pass_name(base, l, k))
     }
 
     /// Renders every layer, one pass each named by [`layer_pass_name`] with `base`.
@@ -208,7 +216,7 @@ impl ShadowMapSet {
             .depth
             .as_ref()
             .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
-        let name = |l, f| layer_pass_name(base, l, f);
+        let name = |l: &LightMaps, k| layer_pass_name(base, l, k);
         match &self.color {
             Some(color) => {
                 (self.depth_pass).record_color(ctx, recorder, color, depth, &self.lights, name)

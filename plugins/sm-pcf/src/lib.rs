@@ -30,7 +30,7 @@ zoo_host::param_choice! {
 zoo_host::technique_params! {
     /// Parameters of shadow maps with PCF.
     pub struct SmParams {
-        /// Shadow-map resolution in texels per side (clamped to the device limit).
+        /// Shadow-map resolution in texels per side (clamped to the device and memory budget).
         map_size: u32 = 2048, range(256, 8192), step(256);
         /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
         filter: Filter = Filter::Pcf3x3;

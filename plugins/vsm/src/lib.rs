@@ -4,6 +4,7 @@
 //! light-bleeding reduction cuts the bound's loose tail where casters overlap. Maps, fitting and
 //! the blur come from the shadow-map library (spot cones, directional boxes, point cubes).
 
+use zoo_host::kit::light_pass_name;
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::{ColorOutput, DepthState, LayerBlur, ShadowMapSet, filterable_rg_format};
@@ -15,7 +16,8 @@ zoo_host::technique_params! {
         map_size: u32 = 2048, range(256, 8192), step(256);
         /// Gaussian blur of the moments, in taps on each side (0: bilinear filtering only).
         blur_radius: u32 = 2, range(0, 16), step(1);
-        /// Smallest variance, in squared light-depth units (the map's depth range is 0 to 1).
+        /// Smallest variance, in squared light-depth units (0 to 1 over the map; at least 1e-4
+        /// with 16-bit moments).
         min_variance: f32 = 0.000001, range(0.0, 0.001), step(0.000001);
         /// Light-bleeding reduction: bounds below it become 0 and the rest is rescaled.
         bleeding_reduction: f32 = 0.2, range(0.0, 0.95), step(0.05);
@@ -62,9 +64,7 @@ impl Gpu {
             clear: wgpu::Color::WHITE,
         };
         let maps = ShadowMapSet::new(ctx, "vsm moments", DepthState::default(), Some(output))?;
-        let lookup_layout = maps
-            .lookup_layout()
-            .expect("colour maps have a lookup group");
+        let lookup_layout = maps.lookup_layout();
         Ok(Gpu {
             lookup: FullscreenLightPass::new(ctx, "vsm/lookup.wgsl", "fs_vsm", &[lookup_layout])?,
             blur: LayerBlur::new(ctx, "vsm blur", format)?,
@@ -87,19 +87,29 @@ impl ShadowTechnique for Vsm {
         if self.params.blur_radius > 0 {
             names.extend(LayerBlur::pass_names(gpu.maps.lights(), BLUR));
         }
-        let lookups = gpu.lookup.passes(LOOKUP);
+        let lookups = gpu
+            .maps
+            .lights()
+            .iter()
+            .map(|l| light_pass_name(LOOKUP, l.light));
         names
             .into_iter()
-            .map(PassInfo::render)
             .chain(lookups)
+            .map(PassInfo::render)
             .collect()
     }
 
     fn resources(&self) -> Vec<ResourceInfo> {
-        let maps = self.gpu.as_ref().and_then(|g| g.maps.maps());
-        maps.map(|m| ResourceInfo::texture("moments", &m.texture, true))
-            .into_iter()
-            .collect()
+        let Some(maps) = self.gpu.as_ref().map(|g| &g.maps) else {
+            return Vec::new();
+        };
+        let moments = maps
+            .maps()
+            .map(|m| ResourceInfo::texture("moments", &m.texture, true));
+        let cameras = maps
+            .cameras()
+            .map(|c| ResourceInfo::buffer("layer cameras", c, "LayerCamera"));
+        moments.into_iter().chain(cameras).collect()
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
@@ -127,6 +137,9 @@ impl ShadowTechnique for Vsm {
         gpu.blur
             .record(ctx, recorder, maps, lights, self.params.blur_radius, BLUR);
         let p = &self.params;
+        // Half floats hold E[z²] - E[z]² only to about 1e-4 near depth 1.
+        let half = maps.texture.format() == wgpu::TextureFormat::Rg16Float;
+        let floor = if half { 1e-4 } else { 0.0 };
         let uniform = |light: usize| {
             let scale = lights[light].scale(maps.resolution);
             VsmLight {
@@ -136,7 +149,7 @@ impl ShadowTechnique for Vsm {
                 perspective: u32::from(scale.perspective),
                 texel_scale: scale.texel_scale,
                 normal_offset: p.normal_offset,
-                min_variance: p.min_variance,
+                min_variance: p.min_variance.max(floor),
                 bleeding_reduction: p.bleeding_reduction,
             }
         };

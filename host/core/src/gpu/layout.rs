@@ -56,8 +56,8 @@ pub fn wgsl_integer_constant(source: &str, name: &str) -> Result<i64, String> {
 
 /// The WGSL values of a choice parameter's options (see [`param_choice!`](crate::param_choice)),
 /// read from the shader that switches on them: option `Pcf3x3` of prefix `FILTER` is constant
-/// `FILTER_PCF3X3`. The numbers live only in the shader; a missing, non-integer or repeated
-/// constant is an error when the technique builds its pipelines.
+/// `FILTER_PCF3X3`. The numbers live only in the shader; a missing or repeated constant, or
+/// one that is not a `u32` literal, is an error when the technique builds its pipelines.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ChoiceCodes(Vec<u32>);
 

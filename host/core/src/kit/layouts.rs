@@ -132,13 +132,44 @@ pub fn slot_fullscreen_pipeline(
     entry: &str,
     groups: &[&wgpu::BindGroupLayout],
 ) -> wgpu::RenderPipeline {
+    slot_fullscreen_pipeline_with(ctx, label, module, entry, groups, &[])
+}
+
+/// As [`slot_fullscreen_pipeline`], with more colour targets after the slot (locations 1, 2,
+/// ...), for example diagnostics a debug view shows; open its passes with
+/// [`RenderContext::light_pass_with`].
+pub fn slot_fullscreen_pipeline_with(
+    ctx: &RenderContext<'_>,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    groups: &[&wgpu::BindGroupLayout],
+    more_targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
     let layout = pipeline_layout(ctx, &format!("{label} layout"), groups);
-    crate::gpu::fullscreen_pipeline(
-        &ctx.gpu.device,
-        label,
-        Some(&layout),
-        module,
-        entry,
-        super::slot_target(),
-    )
+    let mut targets = vec![Some(super::slot_target())];
+    targets.extend_from_slice(more_targets);
+    ctx.gpu
+        .device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("fullscreen_vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
 }

@@ -1,0 +1,262 @@
+//! Parallel-split (cascaded) shadow maps for directional lights (Zhang et al. 2006; seed 000
+//! section 13.1): the visible depth range is split by a blend of the logarithmic and uniform
+//! schemes, and each split gets an orthographic crop of its slice of the view frustum, reaching
+//! back towards the light to every caster that can shadow it.
+
+use zoo_host::glam::camera::rh::view::look_to_mat4;
+use zoo_host::glam::{Mat4, Vec3};
+use zoo_host::scene::Camera;
+
+use crate::light_space::{Aabb, LightFrustum, Projection, corners, transformed_bounds, up_for};
+
+/// The view depths [near, far] the scene occupies: the camera's clip planes pulled in to the
+/// nearest and farthest corners of the objects' boxes in front of the camera.
+pub fn visible_depth_range(camera: &Camera, objects: &[Aabb]) -> (f32, f32) {
+    let view = camera.view();
+    let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+    for object in objects {
+        for corner in corners(*object) {
+            let depth = -view.transform_point3(corner).z;
+            lo = lo.min(depth);
+            hi = hi.max(depth);
+        }
+    }
+    let near = lo.clamp(camera.near, camera.far);
+    let far = hi.min(camera.far).max(near * 1.001 + 1e-4);
+    (near, far)
+}
+
+/// Split distances C_0 = near, ..., C_m = far of `splits` parts:
+/// C_i = λ·n·(f/n)^(i/m) + (1 - λ)·(n + (f - n)·i/m). λ = 0 is uniform, λ = 1 logarithmic.
+pub fn split_distances(near: f32, far: f32, splits: u32, lambda: f32) -> Vec<f32> {
+    let m = splits.max(1);
+    (0..=m)
+        .map(|i| match i {
+            0 => near,
+            i if i == m => far,
+            i => {
+                let t = i as f32 / m as f32;
+                let logarithmic = near * (far / near).powf(t);
+                let uniform = near + (far - near) * t;
+                lambda * logarithmic + (1.0 - lambda) * uniform
+            }
+        })
+        .collect()
+}
+
+/// World corners of the slice of the camera's view frustum between view depths `near` and
+/// `far` (near corners first).
+pub fn slice_corners(camera: &Camera, aspect: f32, near: f32, far: f32) -> [Vec3; 8] {
+    let to_world = camera.view().inverse();
+    let tan_y = (camera.fov_y * 0.5).tan();
+    let tan_x = tan_y * aspect;
+    let mut out = [Vec3::ZERO; 8];
+    for (i, corner) in out.iter_mut().enumerate() {
+        let depth = if i < 4 { near } else { far };
+        let x = if i & 1 == 0 { -1.0 } else { 1.0 } * tan_x * depth;
+        let y = if i & 2 == 0 { -1.0 } else { 1.0 } * tan_y * depth;
+        *corner = to_world.transform_point3(Vec3::new(x, y, -depth));
+    }
+    out
+}
+
+/// The smallest sphere around a slice of a symmetric view frustum (corners as from
+/// [`slice_corners`]): its centre lies on the view axis, and its radius depends only on the
+/// split distances and the field of view, not on where the camera looks.
+pub fn slice_sphere(corners: &[Vec3; 8]) -> (Vec3, f32) {
+    let near_centre = corners[..4].iter().copied().sum::<Vec3>() / 4.0;
+    let far_centre = corners[4..].iter().copied().sum::<Vec3>() / 4.0;
+    let near_radius = corners[0].distance(near_centre);
+    let far_radius = corners[4].distance(far_centre);
+    let length = near_centre.distance(far_centre).max(1e-6);
+    let axis = (far_centre - near_centre) / length;
+    // Equal distance to a near and a far corner along the axis, kept inside the slice.
+    let t = ((length * length + far_radius * far_radius - near_radius * near_radius)
+        / (2.0 * length))
+        .clamp(0.0, length);
+    let centre = near_centre + axis * t;
+    let radius = ((length - t).hypot(far_radius)).max(t.hypot(near_radius));
+    (centre, radius)
+}
+
+/// An orthographic frustum for a directional light travelling along `direction` around the
+/// view-frustum slice `corners`, its near plane moved towards the light to the nearest caster
+/// whose box overlaps the crop.
+///
+/// With `stable_texels` = Some(resolution) the crop is the slice's bounding sphere, its extent
+/// quantised (steps of 1/64 of a power of two) and its centre snapped to whole texels, so the
+/// crop does not change as the camera turns and moves by whole texels as it walks: shadow
+/// edges do not shimmer. Without, the crop is the tight box around the slice.
+pub fn cascade_frustum(
+    direction: Vec3,
+    corners: &[Vec3; 8],
+    casters: &[Aabb],
+    stable_texels: Option<u32>,
+) -> LightFrustum {
+    let view = look_to_mat4(Vec3::ZERO, direction, up_for(direction));
+    let (mut lo, mut hi) = transformed_bounds(view, corners);
+    let (mut centre, mut extent);
+    if let Some(resolution) = stable_texels {
+        let (sphere_centre, radius) = slice_sphere(corners);
+        let quantum = 2f32.powf((2.0 * radius).max(1e-6).log2().floor()) / 64.0;
+        extent = ((2.0 * radius) / quantum).ceil() * quantum;
+        let texel = extent / resolution as f32;
+        centre = view.transform_point3(sphere_centre);
+        centre.x = (centre.x / texel).round() * texel;
+        centre.y = (centre.y / texel).round() * texel;
+        // Snapping moves the sphere by up to half a texel: keep it inside.
+        extent += 2.0 * texel;
+        lo.z = centre.z - radius;
+        hi.z = centre.z + radius;
+    } else {
+        extent = (hi.x - lo.x).max(hi.y - lo.y).max(1e-4) * 1.01;
+        centre = (lo + hi) * 0.5;
+    }
+    let half = extent * 0.5;
+    let mut nearest = hi.z;
+    for caster in casters {
+        let (clo, chi) = transformed_bounds(view, &crate::light_space::corners(*caster));
+        let overlaps = clo.x <= centre.x + half
+            && chi.x >= centre.x - half
+            && clo.y <= centre.y + half
+            && chi.y >= centre.y - half;
+        if overlaps && clo.z <= hi.z {
+            nearest = nearest.max(chi.z);
+        }
+    }
+    let margin = (nearest - lo.z).max(1e-3) * 0.01;
+    let (mut near, mut far) = (-nearest - margin, -lo.z + margin);
+    if stable_texels.is_some() {
+        // The depth range moves outward in coarse steps too.
+        let step = extent / 16.0;
+        near = (near / step).floor() * step;
+        far = (far / step).ceil() * step;
+    }
+    let view = Mat4::from_translation(Vec3::new(-centre.x, -centre.y, 0.0)) * view;
+    LightFrustum::new(view, Projection::Orthographic { extent, near, far })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera {
+            position: Vec3::new(0.0, 1.7, 0.0),
+            target: Vec3::new(0.3, 1.2, -20.0),
+            fov_y: 55f32.to_radians(),
+            near: 0.1,
+            far: 800.0,
+        }
+    }
+
+    #[test]
+    fn splits_follow_the_practical_scheme() {
+        let (n, f) = (0.1, 500.0);
+        for m in 1..=8 {
+            for lambda in [0.0, 0.3, 0.5, 1.0] {
+                let c = split_distances(n, f, m, lambda);
+                assert_eq!(c.len() as u32, m + 1);
+                assert_eq!((c[0], c[m as usize]), (n, f), "endpoints exactly n and f");
+                assert!(c.windows(2).all(|w| w[0] < w[1]), "monotone: {c:?}");
+            }
+        }
+        let uniform = split_distances(n, f, 4, 0.0);
+        let logarithmic = split_distances(n, f, 4, 1.0);
+        for i in 1..4 {
+            let t = i as f32 / 4.0;
+            assert!((uniform[i] - (n + (f - n) * t)).abs() < 1e-3);
+            assert!((logarithmic[i] / (n * (f / n).powf(t)) - 1.0).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn visible_range_hugs_the_objects() {
+        let c = Camera {
+            position: Vec3::new(0.0, 0.0, 10.0),
+            target: Vec3::ZERO,
+            fov_y: 1.0,
+            near: 0.1,
+            far: 1000.0,
+        };
+        let boxes = [(Vec3::splat(-1.0), Vec3::splat(1.0))];
+        let (n, f) = visible_depth_range(&c, &boxes);
+        assert!((n - 9.0).abs() < 1e-4 && (f - 11.0).abs() < 1e-4, "{n} {f}");
+        // A box around the camera reaches the near plane; nothing in front keeps far > near.
+        let (n, _) = visible_depth_range(&c, &[(Vec3::splat(-20.0), Vec3::splat(20.0))]);
+        assert_eq!(n, 0.1);
+        let (n, f) = visible_depth_range(&c, &[]);
+        assert!(f > n);
+    }
+
+    fn inside(frustum: &LightFrustum, p: Vec3) -> bool {
+        let q = frustum.view_proj.project_point3(p);
+        q.x.abs() <= 1.0 + 1e-5 && q.y.abs() <= 1.0 + 1e-5 && (-1e-5..=1.0 + 1e-5).contains(&q.z)
+    }
+
+    #[test]
+    fn every_crop_holds_its_slice_and_the_casters_between_it_and_the_light() {
+        let direction = Vec3::new(0.82, -0.32, -0.48).normalize();
+        let c = camera();
+        let splits = split_distances(0.1, 500.0, 4, 0.5);
+        // A tall caster far up the light's path from the first slice.
+        let slice = slice_corners(&c, 1.5, splits[0], splits[1]);
+        let centre = slice.iter().copied().sum::<Vec3>() / 8.0;
+        let up_light = centre - direction * 30.0;
+        let caster = (up_light - Vec3::splat(0.5), up_light + Vec3::splat(0.5));
+        for stable in [None, Some(1024)] {
+            for w in splits.windows(2) {
+                let corners = slice_corners(&c, 1.5, w[0], w[1]);
+                let f = cascade_frustum(direction, &corners, &[caster], stable);
+                for corner in corners {
+                    assert!(inside(&f, corner), "slice corner outside ({stable:?})");
+                }
+            }
+            let first = cascade_frustum(direction, &slice, &[caster], stable);
+            // The caster lies between the slice and the light: in the map, nearer the light.
+            assert!(inside(&first, up_light), "caster outside ({stable:?})");
+        }
+    }
+
+    #[test]
+    fn stable_crops_move_only_by_whole_texels() {
+        let direction = Vec3::new(0.82, -0.32, -0.48).normalize();
+        let resolution = 1024;
+        let frustum = |c: &Camera| {
+            let corners = slice_corners(c, 1.5, 0.1, 12.0);
+            cascade_frustum(direction, &corners, &[], Some(resolution))
+        };
+        let base = camera();
+        let reference = frustum(&base);
+        let Projection::Orthographic { extent, .. } = reference.projection else {
+            unreachable!()
+        };
+        let texel = extent / resolution as f32;
+        let mut unchanged = 0;
+        for k in 0..50 {
+            // Moves and turns well under a texel.
+            let offset =
+                Vec3::new((k as f32 * 0.37).sin(), 0.0, (k as f32 * 0.71).cos()) * 0.2 * texel;
+            let mut c = base;
+            c.position += offset;
+            c.target += offset + Vec3::new(0.0, 0.0, (k as f32 * 0.13).sin() * 1e-3);
+            let moved = frustum(&c);
+            let Projection::Orthographic { extent: e, .. } = moved.projection else {
+                unreachable!()
+            };
+            assert_eq!(e, extent, "the extent does not follow small moves");
+            // The texel grid stays put: the origin moves by whole texels in x and y.
+            let shift = (moved.view_proj.project_point3(Vec3::ZERO)
+                - reference.view_proj.project_point3(Vec3::ZERO))
+                * 0.5
+                * resolution as f32;
+            assert!((shift.x - shift.x.round()).abs() < 1e-2, "x shift {shift}");
+            assert!((shift.y - shift.y.round()).abs() < 1e-2, "y shift {shift}");
+            unchanged += usize::from(moved.view_proj.abs_diff_eq(reference.view_proj, 1e-6));
+        }
+        assert!(
+            unchanged >= 25,
+            "only {unchanged} of 50 sub-texel moves left the crop unchanged"
+        );
+    }
+}

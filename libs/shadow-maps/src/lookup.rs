@@ -1,0 +1,106 @@
+//! The bind group lookups read a [`crate::ShadowMapSet`]'s maps through.
+//!
+//! - Colour maps (moments, fluxes): the maps (`texture_2d_array<f32>`, filterable) at binding
+//!   0, a linear clamping sampler at 1, the layer cameras (storage, 256-byte `LayerCamera`
+//!   slots) at 2.
+//! - Depth maps: the layout of `shaders/shadow-maps/depth_lookup.wgsl` (group 3): the maps with
+//!   linear and nearest comparison samplers, the layer cameras, the maps as plain floats, and
+//!   the maps again for the nearest sampler (GLSL pairs each texture with one sampler).
+
+use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
+use zoo_host::wgpu;
+
+use crate::maps::MapArray;
+
+/// Layout, samplers and the current bind group.
+pub(crate) struct LookupGroup {
+    label: String,
+    depth: bool,
+    pub(crate) layout: wgpu::BindGroupLayout,
+    samplers: Vec<wgpu::Sampler>,
+    pub(crate) group: Option<wgpu::BindGroup>,
+}
+
+impl LookupGroup {
+    /// The layout for depth maps (`depth`) or colour maps.
+    pub(crate) fn new(device: &wgpu::Device, label: &str, depth: bool) -> LookupGroup {
+        let stage = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let array = wgpu::TextureViewDimension::D2Array;
+        let sampler_of = |name: &str, filter, compare| {
+            device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(&format!("{label} {name} sampler")),
+                mag_filter: filter,
+                min_filter: filter,
+                compare,
+                ..Default::default()
+            })
+        };
+        let (entries, samplers) = if depth {
+            let comparison = wgpu::SamplerBindingType::Comparison;
+            let less_equal = Some(wgpu::CompareFunction::LessEqual);
+            (
+                vec![
+                    texture(0, stage, wgpu::TextureSampleType::Depth, array),
+                    sampler(1, stage, comparison),
+                    sampler(2, stage, comparison),
+                    storage(3, stage, true),
+                    texture(
+                        4,
+                        stage,
+                        wgpu::TextureSampleType::Float { filterable: false },
+                        array,
+                    ),
+                    texture(5, stage, wgpu::TextureSampleType::Depth, array),
+                ],
+                vec![
+                    sampler_of("linear compare", wgpu::FilterMode::Linear, less_equal),
+                    sampler_of("nearest compare", wgpu::FilterMode::Nearest, less_equal),
+                ],
+            )
+        } else {
+            (
+                vec![
+                    texture(
+                        0,
+                        stage,
+                        wgpu::TextureSampleType::Float { filterable: true },
+                        array,
+                    ),
+                    sampler(1, stage, wgpu::SamplerBindingType::Filtering),
+                    storage(2, stage, true),
+                ],
+                vec![sampler_of("linear", wgpu::FilterMode::Linear, None)],
+            )
+        };
+        LookupGroup {
+            label: label.to_string(),
+            depth,
+            layout: bind_group_layout(device, &format!("{label} lookup layout"), &entries),
+            samplers,
+            group: None,
+        }
+    }
+
+    /// Rebuilds the bind group over `maps` and `cameras`.
+    pub(crate) fn bind(&mut self, device: &wgpu::Device, maps: &MapArray, cameras: &wgpu::Buffer) {
+        let view = wgpu::BindingResource::TextureView(&maps.array_view);
+        let resources = if self.depth {
+            vec![
+                view.clone(),
+                wgpu::BindingResource::Sampler(&self.samplers[0]),
+                wgpu::BindingResource::Sampler(&self.samplers[1]),
+                cameras.as_entire_binding(),
+                view.clone(),
+                view,
+            ]
+        } else {
+            vec![
+                view,
+                wgpu::BindingResource::Sampler(&self.samplers[0]),
+                cameras.as_entire_binding(),
+            ]
+        };
+        let label = format!("{} lookup", self.label);
+        self.group = Some(bind_group(device, &label, &self.layout, &resources));
+    }
+}
