@@ -5,9 +5,63 @@
 
 use zoo_host::glam::camera::rh::view::look_to_mat4;
 use zoo_host::glam::{Mat4, Vec3};
-use zoo_host::scene::Camera;
+use zoo_host::scene::{Camera, Light, LightKind};
 
 use crate::light_space::{Aabb, LightFrustum, Projection, corners, transformed_bounds, up_for};
+use crate::planning::{LayerPlan, PlanInputs};
+
+/// The cascade plan: `splits` layers for every directional light (none for other lights),
+/// split by [`split_distances`] over [`visible_depth_range`]. Each split's crop also covers
+/// the last `blend` fraction of the split before it, where lookups blend the two.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cascades {
+    pub splits: u32,
+    /// Weight of the logarithmic scheme against the uniform one, in [0, 1].
+    pub lambda: f32,
+    /// Fraction of each split blended into the next, in [0, 1).
+    pub blend: f32,
+}
+
+impl Cascades {
+    /// The split distances C_0..C_m for `camera` over the scene's `objects`.
+    pub fn distances(&self, camera: &Camera, objects: &[Aabb]) -> Vec<f32> {
+        let (near, far) = visible_depth_range(camera, objects);
+        split_distances(near, far, self.splits, self.lambda)
+    }
+}
+
+impl LayerPlan for Cascades {
+    fn layers(&self, light: &Light) -> u32 {
+        if light.kind == LightKind::Directional {
+            self.splits.max(1)
+        } else {
+            0
+        }
+    }
+
+    fn frustums(&self, light: &Light, inputs: &PlanInputs<'_>) -> Vec<LightFrustum> {
+        if light.kind != LightKind::Directional {
+            return Vec::new();
+        }
+        let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
+        let c = self.distances(inputs.camera, inputs.objects);
+        let stable = inputs.stable.then_some(inputs.resolution);
+        (0..c.len() - 1)
+            .map(|i| {
+                let start = match i {
+                    0 => c[0],
+                    _ => c[i] - self.blend * (c[i] - c[i - 1]),
+                };
+                let corners = slice_corners(inputs.camera, aspect, start, c[i + 1]);
+                cascade_frustum(light.direction, &corners, inputs.casters, stable)
+            })
+            .collect()
+    }
+
+    fn layer_word(&self, _light: &Light) -> &'static str {
+        "split"
+    }
+}
 
 /// The view depths [near, far] the scene occupies: the camera's clip planes pulled in to the
 /// nearest and farthest corners of the objects' boxes in front of the camera.

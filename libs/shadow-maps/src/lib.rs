@@ -17,6 +17,7 @@ pub mod planning;
 pub mod set;
 
 pub use blur::LayerBlur;
+pub use cascades::Cascades;
 pub use depth::{CAMERA_STRIDE, ColorOutput, DepthPass, DepthState, LayerCamera};
 pub use maps::{
     CUBE_GUARD, MAP_FORMAT, MEMORY_BUDGET, MapArray, effective_resolution, filterable_rg_format,

@@ -1,0 +1,450 @@
+//! Parallel-split shadow maps (Zhang et al. 2006; seed 000 sections 7.6 and 13.1) against
+//! perspective aliasing in large views. The visible depth range [n, f] of each frame is split
+//! at C_i = λ·n·(f/n)^(i/m) + (1 - λ)·(n + (f - n)·i/m); every split of a directional light gets
+//! its own orthographic crop (the split's slice of the view frustum, reaching back to the
+//! casters) in one depth array, optionally stabilised (bounding sphere, whole-texel snapping).
+//! Lookups pick the split by view depth and blend across split borders; filters are the
+//! shadow-map library's (PCF, Poisson, PCSS). Spot and point lights are not shadowed (they
+//! are declared unsupported).
+
+mod top_view;
+
+use zoo_host::gpu::layout::ChoiceCodes;
+use zoo_host::kit::{UniformSlots, light_pass_name, slot_fullscreen_pipeline_with};
+use zoo_host::prelude::*;
+use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+use zoo_shadow_maps::light_space::Projection;
+use zoo_shadow_maps::{Cascades, DepthState, LightMaps, ShadowMapSet};
+
+zoo_host::param_choice! {
+    /// How each split's map is filtered.
+    pub enum Filter { None, Hardware2x2, Pcf3x3, Pcf5x5, Poisson, Pcss }
+}
+
+zoo_host::technique_params! {
+    /// Parameters of parallel-split shadow maps.
+    pub struct PssmParams {
+        /// Number of splits of the view's depth range.
+        splits: u32 = 4, range(1, 8), step(1);
+        /// Split scheme: 0 uniform, 1 logarithmic, between them a blend.
+        lambda: f32 = 0.5, range(0.0, 1.0), step(0.05);
+        /// Fraction of each split, at its far end, blended into the next split.
+        blend: f32 = 0.1, range(0.0, 0.5), step(0.01);
+        /// Stable crops (bounding sphere, centre snapped to whole texels): no shimmering edges.
+        stabilise: bool = true;
+        /// Resolution of each split's map, in texels per side.
+        map_size: u32 = 2048, range(256, 8192), step(256);
+        /// Filter: none, hardware 2x2, 3x3 or 5x5 grid PCF, rotated Poisson disc, or PCSS.
+        filter: Filter = Filter::Pcf3x3;
+        /// Constant depth bias of the depth pass, in units of the depth format's resolution.
+        constant_bias: u32 = 0, range(0, 100000), step(100);
+        /// Slope-scaled depth bias of the depth pass.
+        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
+        /// Normal offset: lookups move off the surface by this many texels of their split.
+        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
+        /// Poisson disc radius in texels.
+        kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
+        /// Largest PCSS blocker search and penumbra radius, in texels.
+        pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
+        /// Light whose splits the debug views show.
+        debug_light: u32 = 0, range(0, 1023), step(1);
+    }
+}
+
+/// `PssmLight` in `pssm/lookup.wgsl`.
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+struct PssmLight {
+    light: u32,
+    first_layer: u32,
+    splits: u32,
+    filter_mode: u32,
+    blend: f32,
+    normal_offset: f32,
+    kernel_texels: f32,
+    search_texels: f32,
+    light_size: f32,
+    diagnostics: u32,
+    _pad: [u32; 2],
+    distances: [f32; 12],
+    texel: [f32; 8],
+    depth_near: [f32; 8],
+    depth_far: [f32; 8],
+}
+
+const SHADER: &str = "pssm/lookup.wgsl";
+const MAP_PASS: &str = "PSSM map";
+const LOOKUP_PASS: &str = "PSSM lookup";
+const DIAGNOSTICS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+const SPLITS_VIEW: &str = "splits";
+const DENSITY_VIEW: &str = "texel density";
+const TOP_VIEW: &str = "split frusta (top view)";
+
+/// Screen-sized diagnostics (split colours, texel density) and the top view.
+struct Diagnostics {
+    splits: (wgpu::Texture, wgpu::TextureView),
+    density: (wgpu::Texture, wgpu::TextureView),
+    top_view: (wgpu::Texture, wgpu::TextureView),
+}
+
+impl Diagnostics {
+    fn new(device: &wgpu::Device, size: zoo_host::glam::UVec2) -> Diagnostics {
+        let target = |label| {
+            let usage = wgpu::TextureUsages::empty();
+            zoo_host::gpu::render_target(device, label, size, DIAGNOSTICS_FORMAT, usage)
+        };
+        let top = zoo_host::glam::UVec2::splat(top_view::SIZE);
+        Diagnostics {
+            splits: target("pssm split colours"),
+            density: target("pssm texel density"),
+            top_view: zoo_host::gpu::render_target(
+                device,
+                "pssm split frusta (top view)",
+                top,
+                DIAGNOSTICS_FORMAT,
+                wgpu::TextureUsages::COPY_DST,
+            ),
+        }
+    }
+}
+
+/// Pipelines, maps and per-light uniforms, built at the first `prepare`.
+struct Gpu {
+    maps: ShadowMapSet,
+    uniforms: UniformSlots<PssmLight>,
+    /// Without and with diagnostics written.
+    lookup: [wgpu::RenderPipeline; 2],
+    filter_codes: ChoiceCodes,
+    diagnostics: Diagnostics,
+}
+
+impl Gpu {
+    fn new(ctx: &RenderContext<'_>, params: &PssmParams) -> TechniqueResult<Gpu> {
+        let state = DepthState {
+            constant_bias: params.constant_bias as i32,
+            slope_bias: params.slope_bias,
+            cull_front: false,
+        };
+        let maps = ShadowMapSet::new(ctx, "pssm maps", state, None)?;
+        let stage = wgpu::ShaderStages::FRAGMENT;
+        let uniforms = UniformSlots::new(ctx.gpu, "pssm lights", ctx.lights.len(), stage);
+        let module = ctx.shaders.create_module(&ctx.gpu.device, SHADER)?;
+        let source = ctx.shaders.compose(SHADER)?.source;
+        let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
+            .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
+        let groups = [uniforms.layout(), maps.lookup_layout()];
+        let lookup = [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|mask| {
+            let diagnostics = Some(wgpu::ColorTargetState {
+                format: DIAGNOSTICS_FORMAT,
+                blend: None,
+                write_mask: mask,
+            });
+            let label = format!("pssm lookup (diagnostics {})", !mask.is_empty());
+            let targets = [diagnostics.clone(), diagnostics];
+            slot_fullscreen_pipeline_with(ctx, &label, &module, "fs_pssm", &groups, &targets)
+        });
+        Ok(Gpu {
+            maps,
+            uniforms,
+            lookup,
+            filter_codes,
+            diagnostics: Diagnostics::new(&ctx.gpu.device, ctx.size),
+        })
+    }
+}
+
+/// Parallel-split shadow maps.
+pub struct Pssm {
+    params: PssmParams,
+    gpu: Option<Gpu>,
+}
+
+impl Pssm {
+    fn cascades(&self) -> Cascades {
+        Cascades {
+            splits: self.params.splits,
+            lambda: self.params.lambda,
+            blend: self.params.blend,
+        }
+    }
+}
+
+/// The lookup's uniform for one light's splits at `distances` (filter mode and light size
+/// left for the caller).
+fn light_uniform(
+    p: &PssmParams,
+    maps: &LightMaps,
+    distances: &[f32],
+    resolution: u32,
+) -> PssmLight {
+    let mut light = PssmLight {
+        light: maps.light as u32,
+        first_layer: maps.first_layer,
+        splits: maps.frustums.len() as u32,
+        filter_mode: 0,
+        blend: p.blend,
+        normal_offset: p.normal_offset,
+        kernel_texels: p.kernel_radius,
+        search_texels: p.pcss_max_texels,
+        light_size: 0.0,
+        diagnostics: u32::from(maps.light as u32 == p.debug_light),
+        _pad: [0; 2],
+        distances: [0.0; 12],
+        texel: [0.0; 8],
+        depth_near: [0.0; 8],
+        depth_far: [0.0; 8],
+    };
+    light.distances[..distances.len()].copy_from_slice(distances);
+    for (i, frustum) in maps.frustums.iter().enumerate() {
+        if let Projection::Orthographic { extent, near, far } = frustum.projection {
+            light.texel[i] = extent / resolution as f32;
+            light.depth_near[i] = near;
+            light.depth_far[i] = far;
+        }
+    }
+    light
+}
+
+impl ShadowTechnique for Pssm {
+    fn passes(&self) -> Vec<PassInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let shadowed = gpu.maps.lights().iter().filter(|l| !l.frustums.is_empty());
+        let lookups = shadowed.map(|l| light_pass_name(LOOKUP_PASS, l.light));
+        let names = gpu.maps.pass_names(MAP_PASS).into_iter().chain(lookups);
+        names.map(PassInfo::render).collect()
+    }
+
+    fn resources(&self) -> Vec<ResourceInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        if let Some(maps) = gpu.maps.maps() {
+            out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
+        }
+        let d = &gpu.diagnostics;
+        out.push(ResourceInfo::texture(SPLITS_VIEW, &d.splits.0, true));
+        out.push(ResourceInfo::texture(DENSITY_VIEW, &d.density.0, true));
+        out.push(ResourceInfo::texture(TOP_VIEW, &d.top_view.0, true));
+        if let Some(cameras) = gpu.maps.cameras() {
+            out.push(ResourceInfo::buffer(
+                "layer cameras",
+                cameras,
+                "LayerCamera",
+            ));
+        }
+        out
+    }
+
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
+        if self.gpu.is_none() {
+            self.gpu = Some(Gpu::new(ctx, &self.params)?);
+        }
+        let cascades = self.cascades();
+        let gpu = self.gpu.as_mut().expect("built above");
+        if changes.resolution {
+            gpu.diagnostics = Diagnostics::new(&ctx.gpu.device, ctx.size);
+        }
+        let p = &self.params;
+        (gpu.maps).prepare_with(ctx, changes, p.map_size, p.stabilise, &cascades);
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> TechniqueResult {
+        let cascades = self.cascades();
+        let p = &self.params;
+        let Gpu {
+            maps,
+            uniforms,
+            lookup,
+            filter_codes,
+            diagnostics: d,
+        } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        let group = maps
+            .lookup_group()
+            .ok_or_else(TechniqueError::not_prepared)?;
+        maps.record(ctx, recorder, MAP_PASS)?;
+        let distances = cascades.distances(ctx.camera, maps.bounds().0);
+        let filter_mode = filter_codes.code(p.filter.index());
+        let shadowed: Vec<&LightMaps> = (maps.lights().iter())
+            .filter(|l| !l.frustums.is_empty())
+            .collect();
+        let values: Vec<PssmLight> = shadowed
+            .iter()
+            .map(|l| PssmLight {
+                filter_mode,
+                light_size: ctx.lights[l.light].radius.tan(),
+                ..light_uniform(p, l, &distances, maps.resolution())
+            })
+            .collect();
+        uniforms.write(ctx.gpu, &values);
+        for (k, light_maps) in shadowed.iter().enumerate() {
+            let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
+            let targets = [
+                zoo_host::gpu::color_attachment(&d.splits.1, clear),
+                zoo_host::gpu::color_attachment(&d.density.1, clear),
+            ];
+            let name = light_pass_name(LOOKUP_PASS, light_maps.light);
+            let mut pass = ctx.light_pass_with(recorder, &name, light_maps.light, &targets, None);
+            pass.set_pipeline(&lookup[values[k].diagnostics as usize]);
+            pass.set_bind_group(2, uniforms.bind_group(), &[uniforms.offset(k)]);
+            pass.set_bind_group(3, group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        if ctx.debug_view == Some(TOP_VIEW) {
+            let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
+            let debug: Vec<LightMaps> = (shadowed.iter())
+                .filter(|l| l.light as u32 == p.debug_light)
+                .map(|l| (*l).clone())
+                .collect();
+            let pixels = top_view::draw(ctx.camera, aspect, &debug, &distances);
+            write_top_view(ctx.gpu, &d.top_view.0, &pixels);
+        }
+        Ok(())
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+        let next = PssmParams::from_values(values)?;
+        // The depth biases live in the depth pipeline; everything else applies at `prepare`.
+        let built = |p: &PssmParams| (p.constant_bias, p.slope_bias.to_bits());
+        if built(&next) != built(&self.params) {
+            return Ok(ParamUpdate::Rebuild);
+        }
+        self.params = next;
+        Ok(ParamUpdate::Applied)
+    }
+
+    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let gpu = self.gpu.as_ref()?;
+        let colour = ViewMapping::Color { min: 0.0, max: 1.0 };
+        let image = |view| {
+            Some(DebugImage {
+                view,
+                mapping: colour,
+            })
+        };
+        match resource {
+            SPLITS_VIEW => image(&gpu.diagnostics.splits.1),
+            DENSITY_VIEW => image(&gpu.diagnostics.density.1),
+            TOP_VIEW => image(&gpu.diagnostics.top_view.1),
+            "shadow maps" => {
+                let light = (gpu.maps.lights().iter()).find(|l| {
+                    l.light as u32 == self.params.debug_light && !l.frustums.is_empty()
+                })?;
+                Some(DebugImage {
+                    view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
+                    mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
+                })
+            }
+            _ => None,
+        }
+    }
+
+    fn counters(&self) -> Vec<(String, f64)> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let layers: usize = gpu.maps.lights().iter().map(|l| l.frustums.len()).sum();
+        vec![
+            ("map layers".into(), layers as f64),
+            ("map resolution".into(), gpu.maps.resolution() as f64),
+        ]
+    }
+}
+
+fn write_top_view(gpu: &GpuContext, texture: &wgpu::Texture, pixels: &[u8]) {
+    let size = top_view::SIZE;
+    gpu.queue.write_texture(
+        texture.as_image_copy(),
+        pixels,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(size * 4),
+            rows_per_image: Some(size),
+        },
+        wgpu::Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 1,
+        },
+    );
+}
+
+fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    let params = PssmParams::from_values(values)?;
+    Ok(Box::new(Pssm { params, gpu: None }))
+}
+
+zoo_host::register_technique! {
+    id: "pssm",
+    name: "Parallel-split shadow maps",
+    description: "Directional lights: the view's depth range split by the practical scheme, one stable orthographic crop per split, blended split borders",
+    source: "seed 000 sections 7.6 and 13.1 (Zhang et al. 2006); seed 004",
+    light_kinds: &[LightKind::Directional],
+    params: PssmParams::schema,
+    create: create,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    fn shader() -> String {
+        zoo_host::ShaderLibrary::embedded()
+            .compose(SHADER)
+            .unwrap()
+            .source
+    }
+
+    #[test]
+    fn pssm_light_mirrors_the_shader() {
+        let (size, fields) = zoo_host::mirror_fields!(PssmLight {
+            light,
+            first_layer,
+            splits,
+            filter_mode,
+            blend,
+            normal_offset,
+            kernel_texels,
+            search_texels,
+            light_size,
+            diagnostics,
+            distances,
+            texel,
+            depth_near,
+            depth_far
+        });
+        check_mirror(&shader(), "PssmLight", size, &fields, SizeRule::Equal).unwrap();
+    }
+
+    #[test]
+    fn every_filter_has_a_shader_constant() {
+        ChoiceCodes::read(&shader(), "FILTER", Filter::NAMES).unwrap();
+    }
+
+    #[test]
+    fn the_uniform_holds_every_split() {
+        // Eight splits and their nine distances fit.
+        let p = PssmParams::from_values(&ParamValues::new()).unwrap();
+        assert!(PssmParams::schema().iter().any(|s| s.key == "splits"));
+        let distances: Vec<f32> = (0..9).map(|i| i as f32).collect();
+        let maps = LightMaps {
+            light: 0,
+            first_layer: 3,
+            frustums: Vec::new(),
+            layer_word: "split",
+            scissor: [0; 4],
+        };
+        let light = light_uniform(&p, &maps, &distances, 1024);
+        assert_eq!(light.distances[8], 8.0);
+        assert_eq!(light.first_layer, 3);
+    }
+}

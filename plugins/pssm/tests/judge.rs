@@ -1,0 +1,77 @@
+//! Parallel-split shadow maps against the reference judge, with the bounds of the PSSM issue.
+
+// Link the plugin so its technique registers.
+use zoo_plugin_pssm as _;
+
+use zoo_host::glam::UVec2;
+use zoo_host::test_support::{JudgeRun, Metric, judge};
+
+const SIZE: UVec2 = UVec2::new(256, 256);
+
+fn assert_core_bounds(run: &JudgeRun) {
+    for light in 0..run.loaded.lights.len() {
+        let kind = run.loaded.lights[light].kind;
+        if kind != zoo_host::LightKind::Directional {
+            continue;
+        }
+        let m = run.metrics(light);
+        eprintln!("{} light {light} ({}): {m:?}", run.scene, kind.name());
+        run.assert_bounds(
+            light,
+            &m,
+            &[
+                (Metric::FalseShadowCore, 0.005),
+                (Metric::FalseLitCore, 0.01),
+            ],
+        );
+    }
+}
+
+const FOUR_BY_2048: [(&str, &str); 2] = [("splits", "4"), ("map_size", "2048")];
+
+#[test]
+fn vista_within_bounds_with_four_2048_splits() {
+    assert_core_bounds(&judge("vista.ron", "pssm", &FOUR_BY_2048, SIZE));
+}
+
+#[test]
+fn atrium_within_bounds_with_four_2048_splits() {
+    assert_core_bounds(&judge("atrium.ron", "pssm", &FOUR_BY_2048, SIZE));
+}
+
+#[test]
+fn more_splits_lower_the_core_error_on_vista() {
+    let core_error = |splits: &str, lambda: &str| {
+        let params = [("splits", splits), ("lambda", lambda), ("map_size", "2048")];
+        let run = judge("vista.ron", "pssm", &params, SIZE);
+        let m = run.metrics(0);
+        eprintln!("vista, {splits} splits, lambda {lambda}: {m:?}");
+        (run, m.false_shadow_core + m.false_lit_core)
+    };
+    let errors: Vec<f64> = ["1", "2", "4"].map(|m| core_error(m, "0.5").1).to_vec();
+    assert!(
+        errors[0] > errors[1] && errors[1] > errors[2],
+        "core error not falling with the split count: {errors:?}"
+    );
+    // Eight logarithmic splits hold the bounds too.
+    let (run, _) = core_error("8", "1");
+    assert_core_bounds(&run);
+}
+
+#[test]
+fn spot_and_point_lights_are_declared_unsupported() {
+    let registration = zoo_host::find_technique("pssm").unwrap();
+    assert!(registration.supports(zoo_host::LightKind::Directional));
+    assert!(!registration.supports(zoo_host::LightKind::Spot));
+    assert!(!registration.supports(zoo_host::LightKind::Point));
+    // planar-room has all three kinds: the directional light is scored, the others are not.
+    let run = judge("planar-room.ron", "pssm", &[], SIZE);
+    let scored: Vec<bool> = run
+        .judged
+        .scores
+        .iter()
+        .map(|s| s.metrics.is_some())
+        .collect();
+    assert_eq!(scored, [false, false, true]);
+    assert_core_bounds(&run);
+}

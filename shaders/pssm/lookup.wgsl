@@ -1,0 +1,162 @@
+// Parallel-split shadow maps: the lookup. Each pixel picks its split by view depth and filters
+// that split's map with the shadow-map library's filters; in the last `blend` fraction of a
+// split it blends with the next split's result, so split borders do not show. Diagnostics
+// (for the debug light): split colours and the effective texel density.
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "common/fullscreen.wgsl"
+#import "shadow-maps/filters.wgsl"
+#import "shadow-maps/depth_lookup.wgsl"
+
+// Filter modes, one per variant of the Rust `Filter` parameter (`FILTER_` and its name in
+// capitals); the plugin reads their values from here.
+const FILTER_NONE: u32 = 0u;
+const FILTER_HARDWARE2X2: u32 = 1u;
+const FILTER_PCF3X3: u32 = 2u;
+const FILTER_PCF5X5: u32 = 3u;
+const FILTER_POISSON: u32 = 4u;
+const FILTER_PCSS: u32 = 5u;
+
+struct PssmLight {
+    // Index of the scene light (directional).
+    light: u32,
+    first_layer: u32,
+    splits: u32,
+    filter_mode: u32,
+    // Fraction of each split blended into the next.
+    blend: f32,
+    // Normal offset in texels of the split's map.
+    normal_offset: f32,
+    // Poisson disc radius and PCSS search limit, in texels.
+    kernel_texels: f32,
+    search_texels: f32,
+    // Tangent of the light's angular radius (PCSS).
+    light_size: f32,
+    // 1 when this light's diagnostics are written.
+    diagnostics: u32,
+    _pad: vec2<u32>,
+    // Split distances C_0..C_8 (view depths), four per vector.
+    distances: array<vec4<f32>, 3>,
+    // Per split: world size of one texel, and the map's depth range.
+    texel: array<vec4<f32>, 2>,
+    depth_near: array<vec4<f32>, 2>,
+    depth_far: array<vec4<f32>, 2>,
+}
+
+@group(2) @binding(0) var<uniform> pssm: PssmLight;
+
+const SPLIT_COLOURS: array<vec3<f32>, 8> = array<vec3<f32>, 8>(
+    vec3<f32>(0.95, 0.3, 0.25),
+    vec3<f32>(0.3, 0.85, 0.3),
+    vec3<f32>(0.3, 0.5, 1.0),
+    vec3<f32>(0.95, 0.85, 0.2),
+    vec3<f32>(0.85, 0.35, 0.95),
+    vec3<f32>(0.2, 0.9, 0.9),
+    vec3<f32>(1.0, 0.6, 0.2),
+    vec3<f32>(0.7, 0.7, 0.7),
+);
+
+fn distance_at(i: u32) -> f32 {
+    return pssm.distances[i / 4u][i % 4u];
+}
+
+// The split a lookup reads (set before calling the filters).
+var<private> tap_layer: u32;
+var<private> tap_near: f32;
+var<private> tap_far: f32;
+
+// One comparison tap in the current split (the filters' map access).
+fn shadow_tap(p: vec3<f32>, linear: bool) -> f32 {
+    return compare_map(map_point(tap_layer, p), linear);
+}
+
+// (inside, receiver depth, stored depth) at p in the current split, depths along the light.
+fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
+    let m = map_point(tap_layer, p);
+    if !m.inside {
+        return vec3<f32>(0.0);
+    }
+    let range = tap_far - tap_near;
+    return vec3<f32>(1.0, tap_near + m.depth * range, tap_near + stored_map_depth(m) * range);
+}
+
+fn split_visibility(s: Surface, split: u32, direction: vec3<f32>, r: mat2x2<f32>) -> f32 {
+    tap_layer = pssm.first_layer + split;
+    tap_near = pssm.depth_near[split / 4u][split % 4u];
+    tap_far = pssm.depth_far[split / 4u][split % 4u];
+    let texel = pssm.texel[split / 4u][split % 4u];
+    let p = s.position + s.normal * (pssm.normal_offset * texel);
+    let frame = tangent_frame(direction);
+    switch pssm.filter_mode {
+        case FILTER_NONE: { return shadow_tap(p, false); }
+        case FILTER_HARDWARE2X2: { return shadow_tap(p, true); }
+        case FILTER_PCF3X3: { return grid_pcf(p, frame, texel, 3); }
+        case FILTER_PCF5X5: { return grid_pcf(p, frame, texel, 5); }
+        case FILTER_POISSON: { return poisson_pcf(p, frame, pssm.kernel_texels * texel, r); }
+        default: {
+            let light = PcssLight(pssm.light_size, tap_near, false, pssm.search_texels);
+            return pcss(p, frame, texel, r, light);
+        }
+    }
+}
+
+// False colour for shadow-map texels per screen pixel (linear): red where one texel covers
+// several pixels (blocky), green at one to one, blue where texels are finer than pixels.
+fn density_colour(texels_per_pixel: f32) -> vec3<f32> {
+    let t = clamp(log2(max(texels_per_pixel, 1e-6)) / 3.0, -1.0, 1.0);
+    if t < 0.0 {
+        return mix(vec3<f32>(0.1, 0.85, 0.2), vec3<f32>(0.95, 0.15, 0.1), -t);
+    }
+    return mix(vec3<f32>(0.1, 0.85, 0.2), vec3<f32>(0.15, 0.3, 1.0), t);
+}
+
+struct Outputs {
+    @location(0) visibility: vec4<f32>,
+    // Split colour, shaded by visibility.
+    @location(1) splits: vec4<f32>,
+    // Effective texel density in false colour.
+    @location(2) density: vec4<f32>,
+}
+
+@fragment
+fn fs_pssm(in: FullscreenOut) -> Outputs {
+    var out: Outputs;
+    out.visibility = vec4<f32>(1.0);
+    out.splits = vec4<f32>(0.0);
+    out.density = vec4<f32>(0.0);
+    let s = load_surface(vec2<i32>(in.position.xy));
+    if !s.valid {
+        return out;
+    }
+    let direction = lights[pssm.light].direction;
+    let depth = -(camera.view * vec4<f32>(s.position, 1.0)).z;
+    var split = 0u;
+    while split + 1u < pssm.splits && depth > distance_at(split + 1u) {
+        split += 1u;
+    }
+    let r = rotation(in.position.xy);
+    var visibility = split_visibility(s, split, direction, r);
+    var weight = 0.0;
+    if split + 1u < pssm.splits {
+        let end = distance_at(split + 1u);
+        let band = pssm.blend * (end - distance_at(split));
+        if band > 0.0 {
+            weight = clamp((depth - (end - band)) / band, 0.0, 1.0);
+        }
+        if weight > 0.0 {
+            visibility = mix(visibility, split_visibility(s, split + 1u, direction, r), weight);
+        }
+    }
+    out.visibility = vec4<f32>(visibility);
+    if pssm.diagnostics == 1u {
+        let next = min(split + 1u, 7u);
+        let colour = mix(SPLIT_COLOURS[split], SPLIT_COLOURS[next], weight);
+        out.splits = vec4<f32>(colour * (0.45 + 0.55 * visibility), 1.0);
+        // World size of one screen pixel at this depth against one texel of the split.
+        let pixel = 2.0 * depth / (camera.proj[1][1] * camera.size.y);
+        let texel = pssm.texel[split / 4u][split % 4u];
+        out.density = vec4<f32>(density_colour(pixel / texel), 1.0);
+    }
+    return out;
+}
