@@ -11,11 +11,18 @@ const SIZE: UVec2 = UVec2::new(256, 256);
 #[test]
 fn splits_halve_the_core_error_of_one_map_at_the_same_texel_budget() {
     // Four 1024² splits against one 2048² map: the same number of texels.
-    let pssm = judge("vista.ron", "pssm", &[("splits", "4"), ("map_size", "1024")], SIZE);
+    let pssm = judge(
+        "vista.ron",
+        "pssm",
+        &[("splits", "4"), ("map_size", "1024")],
+        SIZE,
+    );
     let single = judge("vista.ron", "sm-pcf", &[("map_size", "2048")], SIZE);
     let core = |m: zoo_host::judge::Metrics| m.false_shadow_core + m.false_lit_core;
     let (split, one) = (core(pssm.metrics(0)), core(single.metrics(0)));
-    eprintln!("vista core error (false shadow + false lit): pssm 4x1024 {split:.5}, sm-pcf 2048 {one:.5}");
+    eprintln!(
+        "vista core error (false shadow + false lit): pssm 4x1024 {split:.5}, sm-pcf 2048 {one:.5}"
+    );
     assert!(split <= 0.5 * one, "pssm {split} against one map {one}");
 }
 
@@ -48,6 +55,9 @@ fn stabilised_splits_flicker_less_along_the_vista_walk() {
     let stable = flicker["pssm [pssm.stabilise=true]"];
     let unstable = flicker["pssm [pssm.stabilise=false]"];
     let single = flicker["sm-pcf"];
-    assert!(stable < unstable, "stable {stable} against unstable {unstable}");
+    assert!(
+        stable < unstable,
+        "stable {stable} against unstable {unstable}"
+    );
     assert!(stable < single, "stable {stable} against one map {single}");
 }
