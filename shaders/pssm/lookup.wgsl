@@ -8,6 +8,7 @@
 #import "common/fullscreen.wgsl"
 #import "shadow-maps/filters.wgsl"
 #import "shadow-maps/depth_lookup.wgsl"
+#import "pssm/density.wgsl"
 
 // Filter modes, one per variant of the Rust `Filter` parameter (`FILTER_` and its name in
 // capitals); the plugin reads their values from here.
@@ -101,16 +102,6 @@ fn split_visibility(s: Surface, split: u32, direction: vec3<f32>, r: mat2x2<f32>
     }
 }
 
-// False colour for shadow-map texels per screen pixel (linear): red where one texel covers
-// several pixels (blocky), green at one to one, blue where texels are finer than pixels.
-fn density_colour(texels_per_pixel: f32) -> vec3<f32> {
-    let t = clamp(log2(max(texels_per_pixel, 1e-6)) / 3.0, -1.0, 1.0);
-    if t < 0.0 {
-        return mix(vec3<f32>(0.1, 0.85, 0.2), vec3<f32>(0.95, 0.15, 0.1), -t);
-    }
-    return mix(vec3<f32>(0.1, 0.85, 0.2), vec3<f32>(0.15, 0.3, 1.0), t);
-}
-
 struct Outputs {
     @location(0) visibility: vec4<f32>,
     // Split colour, shaded by visibility.
@@ -153,10 +144,8 @@ fn fs_pssm(in: FullscreenOut) -> Outputs {
         let next = min(split + 1u, 7u);
         let colour = mix(SPLIT_COLOURS[split], SPLIT_COLOURS[next], weight);
         out.splits = vec4<f32>(colour * (0.45 + 0.55 * visibility), 1.0);
-        // World size of one screen pixel at this depth against one texel of the split.
-        let pixel = 2.0 * depth / (camera.proj[1][1] * camera.size.y);
         let texel = pssm.texel[split / 4u][split % 4u];
-        out.density = vec4<f32>(density_colour(pixel / texel), 1.0);
+        out.density = vec4<f32>(density_colour(texels_per_pixel(depth, texel)), 1.0);
     }
     return out;
 }

@@ -10,13 +10,14 @@ struct LayerCamera {
 }
 
 // The light-space depth of `world` that moment maps store: distance to the light over far
-// (perspective layers, the same on every cube face) or the depth coordinate (orthographic
-// layers). 0 at the light, 1 at the far plane.
+// (perspective layers, the same on every cube face) or the depth coordinate (orthographic and
+// warped layers). 0 at the light, 1 at the far plane.
 fn light_depth(camera: LayerCamera, world: vec3<f32>) -> f32 {
     if camera.eye.w > 0.0 {
         return length(world - camera.eye.xyz) * camera.eye.w;
     }
-    return (camera.view_proj * vec4<f32>(world, 1.0)).z;
+    let clip = camera.view_proj * vec4<f32>(world, 1.0);
+    return clip.z / clip.w;
 }
 
 // The cube face (+x, -x, +y, -y, +z, -z) direction `d` from a point light falls in.

@@ -32,7 +32,7 @@ impl LayerCamera {
             Projection::Perspective { far, .. } => {
                 frustum.view.inverse().w_axis.truncate().extend(1.0 / far)
             }
-            Projection::Orthographic { .. } => Vec4::ZERO,
+            Projection::Orthographic { .. } | Projection::Warped => Vec4::ZERO,
         };
         LayerCamera {
             view_proj: frustum.view_proj.to_cols_array(),

@@ -15,6 +15,7 @@ pub mod lookup;
 pub mod maps;
 pub mod planning;
 pub mod set;
+pub mod warped;
 
 pub use blur::LayerBlur;
 pub use cascades::Cascades;

@@ -17,6 +17,9 @@ pub enum Projection {
     },
     /// Orthographic with the given world extent (width = height) and depth range.
     Orthographic { extent: f32, near: f32, far: f32 },
+    /// A general projective map (perspective or light-space perspective shadow maps): texel
+    /// sizes vary over the map, so lookups measure them where they are.
+    Warped,
 }
 
 /// One shadow-map layer's camera.
@@ -30,6 +33,8 @@ pub struct LightFrustum {
 impl LightFrustum {
     pub(crate) fn new(view: Mat4, projection: Projection) -> LightFrustum {
         let proj = match projection {
+            // Warped layers are built with their own matrix (`LightFrustum::warped`).
+            Projection::Warped => Mat4::IDENTITY,
             Projection::Perspective {
                 tan_half_fov,
                 near,
@@ -47,9 +52,29 @@ impl LightFrustum {
         }
     }
 
-    /// World size of one texel of a `resolution`-texel map at `point`.
+    /// A layer with any projective `view_proj` (its depth in [0, 1] front to back).
+    pub fn warped(view: Mat4, view_proj: Mat4) -> LightFrustum {
+        LightFrustum {
+            view,
+            view_proj,
+            projection: Projection::Warped,
+        }
+    }
+
+    /// World size of one texel of a `resolution`-texel map at `point` (for warped maps: the
+    /// larger of the two texel sides across the view ray direction `view`'s z axis).
     pub fn texel_world_size(&self, point: Vec3, resolution: u32) -> f32 {
         match self.projection {
+            Projection::Warped => {
+                let to_world = self.view.inverse();
+                let step = 1e-3 * point.length().max(1.0);
+                let uv = |p: Vec3| self.view_proj.project_point3(p).truncate() * 0.5;
+                let texels = |axis: Vec3| {
+                    let moved = uv(point + to_world.transform_vector3(axis) * step);
+                    (moved - uv(point)).length() * resolution as f32 / step
+                };
+                1.0 / texels(Vec3::X).min(texels(Vec3::Y)).max(1e-12)
+            }
             Projection::Perspective { tan_half_fov, .. } => {
                 let distance = -self.view.transform_point3(point).z;
                 2.0 * distance * tan_half_fov / resolution as f32

@@ -49,6 +49,13 @@ impl LightMaps {
                 near,
                 far,
             },
+            // Texel sizes vary over warped maps: lookups measure them per point.
+            Projection::Warped => MapScale {
+                texel_scale: 0.0,
+                perspective: false,
+                near: 0.0,
+                far: 1.0,
+            },
             Projection::Orthographic { extent, near, far } => MapScale {
                 texel_scale: extent / resolution as f32,
                 perspective: false,

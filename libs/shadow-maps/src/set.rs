@@ -185,6 +185,15 @@ impl ShadowMapSet {
         &self.lights
     }
 
+    /// The light debug views show: light `wanted` when it has layers, else the first light
+    /// that has.
+    pub fn debug_light(&self, wanted: u32) -> Option<&LightMaps> {
+        let shadowed = || self.lights.iter().filter(|l| !l.frustums.is_empty());
+        shadowed()
+            .find(|l| l.light as u32 == wanted)
+            .or_else(|| shadowed().next())
+    }
+
     /// The maps lookups read (the colour maps when there are any, else the depth maps).
     pub fn maps(&self) -> Option<&MapArray> {
         self.color.as_ref().or(self.depth.as_ref())

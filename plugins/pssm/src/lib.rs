@@ -8,6 +8,9 @@
 //! are declared unsupported).
 
 mod top_view;
+mod warped;
+
+pub use warped::{LispsmParams, PsmParams};
 
 use zoo_host::gpu::layout::ChoiceCodes;
 use zoo_host::kit::{UniformSlots, light_pass_name, slot_fullscreen_pipeline_with};
@@ -46,7 +49,7 @@ zoo_host::technique_params! {
         kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
         /// Largest PCSS blocker search and penumbra radius, in texels.
         pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
-        /// Light whose splits the debug views show.
+        /// Light whose splits the debug views show (the first shadowed light if it has none).
         debug_light: u32 = 0, range(0, 1023), step(1);
     }
 }
@@ -177,6 +180,7 @@ fn light_uniform(
     maps: &LightMaps,
     distances: &[f32],
     resolution: u32,
+    debug: bool,
 ) -> PssmLight {
     let mut light = PssmLight {
         light: maps.light as u32,
@@ -188,7 +192,7 @@ fn light_uniform(
         kernel_texels: p.kernel_radius,
         search_texels: p.pcss_max_texels,
         light_size: 0.0,
-        diagnostics: u32::from(maps.light as u32 == p.debug_light),
+        diagnostics: u32::from(debug),
         _pad: [0; 2],
         distances: [0.0; 12],
         texel: [0.0; 8],
@@ -276,12 +280,19 @@ impl ShadowTechnique for Pssm {
         let shadowed: Vec<&LightMaps> = (maps.lights().iter())
             .filter(|l| !l.frustums.is_empty())
             .collect();
+        let debug_light = maps.debug_light(p.debug_light).map(|l| l.light);
         let values: Vec<PssmLight> = shadowed
             .iter()
             .map(|l| PssmLight {
                 filter_mode,
                 light_size: ctx.lights[l.light].radius.tan(),
-                ..light_uniform(p, l, &distances, maps.resolution())
+                ..light_uniform(
+                    p,
+                    l,
+                    &distances,
+                    maps.resolution(),
+                    Some(l.light) == debug_light,
+                )
             })
             .collect();
         uniforms.write(ctx.gpu, &values);
@@ -300,9 +311,10 @@ impl ShadowTechnique for Pssm {
         }
         if ctx.debug_view == Some(TOP_VIEW) {
             let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
-            let debug: Vec<LightMaps> = (shadowed.iter())
-                .filter(|l| l.light as u32 == p.debug_light)
-                .map(|l| (*l).clone())
+            let debug: Vec<LightMaps> = maps
+                .debug_light(p.debug_light)
+                .cloned()
+                .into_iter()
                 .collect();
             let pixels = top_view::draw(ctx.camera, aspect, &debug, &distances);
             write_top_view(ctx.gpu, &d.top_view.0, &pixels);
@@ -335,9 +347,7 @@ impl ShadowTechnique for Pssm {
             DENSITY_VIEW => image(&gpu.diagnostics.density.1),
             TOP_VIEW => image(&gpu.diagnostics.top_view.1),
             "shadow maps" => {
-                let light = (gpu.maps.lights().iter()).find(|l| {
-                    l.light as u32 == self.params.debug_light && !l.frustums.is_empty()
-                })?;
+                let light = gpu.maps.debug_light(self.params.debug_light)?;
                 Some(DebugImage {
                     view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
                     mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
@@ -443,7 +453,7 @@ mod tests {
             layer_word: "split",
             scissor: [0; 4],
         };
-        let light = light_uniform(&p, &maps, &distances, 1024);
+        let light = light_uniform(&p, &maps, &distances, 1024, true);
         assert_eq!(light.distances[8], 8.0);
         assert_eq!(light.first_layer, 3);
     }

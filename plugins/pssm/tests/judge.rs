@@ -75,3 +75,67 @@ fn spot_and_point_lights_are_declared_unsupported() {
     assert_eq!(scored, [false, false, true]);
     assert_core_bounds(&run);
 }
+
+fn assert_bounds_for_scored_lights(run: &JudgeRun) {
+    for (light, score) in run.judged.scores.iter().enumerate() {
+        let Some(m) = score.metrics else { continue };
+        eprintln!(
+            "{} {} light {light} ({}): {m:?}",
+            run.scene,
+            run.judged.technique,
+            score.kind.name()
+        );
+        run.assert_bounds(
+            light,
+            &m,
+            &[
+                (Metric::FalseShadowCore, 0.005),
+                (Metric::FalseLitCore, 0.01),
+            ],
+        );
+    }
+}
+
+#[test]
+fn lispsm_within_bounds_on_vista_atrium_and_planar_room() {
+    for scene in ["vista.ron", "atrium.ron", "planar-room.ron"] {
+        assert_bounds_for_scored_lights(&judge(scene, "lispsm", &[("map_size", "2048")], SIZE));
+    }
+}
+
+#[test]
+fn psm_within_bounds_on_atrium_and_planar_room_spot_included() {
+    for scene in ["atrium.ron", "planar-room.ron"] {
+        let run = judge(scene, "psm", &[("map_size", "2048")], SIZE);
+        assert_bounds_for_scored_lights(&run);
+    }
+    let registration = zoo_host::find_technique("psm").unwrap();
+    assert!(registration.supports(zoo_host::LightKind::Spot));
+    assert!(!registration.supports(zoo_host::LightKind::Point));
+}
+
+#[test]
+fn warped_maps_beat_one_uniform_map_on_vista() {
+    let core = |id: &str| {
+        let run = judge("vista.ron", id, &[("map_size", "2048")], SIZE);
+        let m = run.metrics(0);
+        m.false_shadow_core + m.false_lit_core
+    };
+    let uniform = {
+        // The uniform map of a warped technique: LiSPSM with its warp off.
+        let run = judge(
+            "vista.ron",
+            "lispsm",
+            &[("map_size", "2048"), ("strength", "0")],
+            SIZE,
+        );
+        let m = run.metrics(0);
+        m.false_shadow_core + m.false_lit_core
+    };
+    let (lispsm, psm) = (core("lispsm"), core("psm"));
+    eprintln!("vista core error at 2048: lispsm {lispsm:.5}, psm {psm:.5}, uniform {uniform:.5}");
+    assert!(
+        lispsm < 0.5 * uniform && psm < uniform,
+        "lispsm {lispsm}, psm {psm}, uniform {uniform}"
+    );
+}

@@ -1,0 +1,505 @@
+//! Warped single maps: light-space perspective shadow maps (`lispsm`, directional lights) and
+//! perspective shadow maps (`psm`, directional and spot lights), fitted by the shadow-map
+//! library (`zoo_shadow_maps::warped`). One layer per light; the lookup measures texel sizes
+//! where it filters. Where PSM cannot hold the view in one map (the light inside the view's
+//! post-perspective box) the light falls back to the ordinary fitted map, and the counters
+//! say how often.
+
+use std::cell::Cell;
+
+use zoo_host::glam::UVec2;
+use zoo_host::gpu::layout::ChoiceCodes;
+use zoo_host::kit::{UniformSlots, light_pass_name, slot_fullscreen_pipeline_with};
+use zoo_host::prelude::*;
+use zoo_host::scene::Light;
+use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+use zoo_shadow_maps::cascades::visible_depth_range;
+use zoo_shadow_maps::light_space::LightFrustum;
+use zoo_shadow_maps::warped::{lispsm_frustum, psm_frustum};
+use zoo_shadow_maps::{DepthState, LayerPlan, PlanInputs, ShadowMapSet, StandardLayers};
+
+use crate::Filter;
+
+zoo_host::technique_params! {
+    /// Parameters of light-space perspective shadow maps.
+    pub struct LispsmParams {
+        /// Map resolution in texels per side.
+        map_size: u32 = 2048, range(256, 8192), step(256);
+        /// Warp strength: 1 puts the warp's centre at the optimal n, larger values nearer
+        /// (stronger warp), 0 gives a uniform map.
+        strength: f32 = 1.0, range(0.0, 4.0), step(0.05);
+        /// Filter: none, hardware 2x2, 3x3 or 5x5 grid PCF, rotated Poisson disc, or PCSS.
+        filter: Filter = Filter::Pcf3x3;
+        /// Slope-scaled depth bias of the depth pass.
+        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
+        /// Normal offset: lookups move off the surface by this many texels (measured there).
+        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
+        /// Poisson disc radius in texels.
+        kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
+        /// Largest PCSS blocker search and penumbra radius, in texels.
+        pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
+        /// Light whose diagnostics the debug views show (the first shadowed light if it has none).
+        debug_light: u32 = 0, range(0, 1023), step(1);
+    }
+}
+
+zoo_host::technique_params! {
+    /// Parameters of perspective shadow maps.
+    pub struct PsmParams {
+        /// Map resolution in texels per side.
+        map_size: u32 = 2048, range(256, 8192), step(256);
+        /// Smallest near plane of the virtual camera, as a fraction of the view's far depth
+        /// (a nearer plane warps harder and loses depth precision).
+        near_fraction: f32 = 0.002, range(0.0001, 0.1), step(0.0001);
+        /// Filter: none, hardware 2x2, 3x3 or 5x5 grid PCF, rotated Poisson disc, or PCSS.
+        filter: Filter = Filter::Pcf3x3;
+        /// Slope-scaled depth bias of the depth pass.
+        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
+        /// Normal offset: lookups move off the surface by this many texels (measured there).
+        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
+        /// Poisson disc radius in texels.
+        kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
+        /// Largest PCSS blocker search and penumbra radius, in texels.
+        pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
+        /// Light whose diagnostics the debug views show (the first shadowed light if it has none).
+        debug_light: u32 = 0, range(0, 1023), step(1);
+    }
+}
+
+/// Which warp.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Warp {
+    /// LiSPSM with this strength.
+    Lispsm(f32),
+    /// PSM with this smallest virtual near plane (fraction of far).
+    Psm(f32),
+}
+
+/// What both techniques need of their parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Settings {
+    warp: Warp,
+    map_size: u32,
+    filter: Filter,
+    slope_bias: f32,
+    normal_offset: f32,
+    kernel_radius: f32,
+    pcss_max_texels: f32,
+    debug_light: u32,
+}
+
+impl From<&LispsmParams> for Settings {
+    fn from(p: &LispsmParams) -> Settings {
+        Settings {
+            warp: Warp::Lispsm(p.strength),
+            map_size: p.map_size,
+            filter: p.filter,
+            slope_bias: p.slope_bias,
+            normal_offset: p.normal_offset,
+            kernel_radius: p.kernel_radius,
+            pcss_max_texels: p.pcss_max_texels,
+            debug_light: p.debug_light,
+        }
+    }
+}
+
+impl From<&PsmParams> for Settings {
+    fn from(p: &PsmParams) -> Settings {
+        Settings {
+            warp: Warp::Psm(p.near_fraction),
+            map_size: p.map_size,
+            filter: p.filter,
+            slope_bias: p.slope_bias,
+            normal_offset: p.normal_offset,
+            kernel_radius: p.kernel_radius,
+            pcss_max_texels: p.pcss_max_texels,
+            debug_light: p.debug_light,
+        }
+    }
+}
+
+/// One warped layer per supported light; the standard fit where PSM cannot warp.
+struct WarpedLayers {
+    warp: Warp,
+    /// Lights fitted, and of those, PSM fits that fell back to the standard map.
+    fitted: Cell<u32>,
+    fallbacks: Cell<u32>,
+}
+
+impl LayerPlan for WarpedLayers {
+    fn layers(&self, light: &Light) -> u32 {
+        match (self.warp, light.kind) {
+            (_, LightKind::Directional) | (Warp::Psm(_), LightKind::Spot) => 1,
+            _ => 0,
+        }
+    }
+
+    fn frustums(&self, light: &Light, inputs: &PlanInputs<'_>) -> Vec<LightFrustum> {
+        if self.layers(light) == 0 {
+            return Vec::new();
+        }
+        self.fitted.set(self.fitted.get() + 1);
+        let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
+        let range = visible_depth_range(inputs.camera, inputs.objects);
+        let fit = match self.warp {
+            Warp::Lispsm(strength) => Some(
+                lispsm_frustum(
+                    light.direction,
+                    inputs.camera,
+                    aspect,
+                    range,
+                    inputs.casters,
+                    strength,
+                )
+                .frustum,
+            ),
+            Warp::Psm(near_fraction) => psm_frustum(
+                light,
+                inputs.camera,
+                aspect,
+                range,
+                inputs.objects,
+                inputs.casters,
+                near_fraction,
+            )
+            .map(|fit| fit.frustum),
+        };
+        fit.map(|f| vec![f]).unwrap_or_else(|| {
+            self.fallbacks.set(self.fallbacks.get() + 1);
+            StandardLayers.frustums(light, inputs)
+        })
+    }
+}
+
+/// `WarpedLight` in `pssm/warped.wgsl`.
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+struct WarpedLight {
+    inv_view_proj: [f32; 16],
+    light: u32,
+    layer: u32,
+    filter_mode: u32,
+    diagnostics: u32,
+    resolution: f32,
+    normal_offset: f32,
+    kernel_texels: f32,
+    search_texels: f32,
+    light_size: f32,
+    _pad: [f32; 3],
+}
+
+const SHADER: &str = "pssm/warped.wgsl";
+const DIAGNOSTICS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+const DENSITY_VIEW: &str = "texel density";
+
+/// Pipelines, maps and uniforms, built at the first `prepare`.
+struct Gpu {
+    maps: ShadowMapSet,
+    uniforms: UniformSlots<WarpedLight>,
+    /// Without and with diagnostics written.
+    lookup: [wgpu::RenderPipeline; 2],
+    filter_codes: ChoiceCodes,
+    density: (wgpu::Texture, wgpu::TextureView),
+    fallbacks: u32,
+}
+
+/// A warped-map technique (LiSPSM or PSM).
+struct WarpedMaps {
+    /// `lispsm` or `psm`: names its passes and resources.
+    id: &'static str,
+    settings: Settings,
+    gpu: Option<Gpu>,
+}
+
+fn density_target(device: &wgpu::Device, size: UVec2) -> (wgpu::Texture, wgpu::TextureView) {
+    let usage = wgpu::TextureUsages::empty();
+    zoo_host::gpu::render_target(
+        device,
+        "warped texel density",
+        size,
+        DIAGNOSTICS_FORMAT,
+        usage,
+    )
+}
+
+impl WarpedMaps {
+    fn map_pass(&self) -> String {
+        format!("{} map", self.id.to_uppercase())
+    }
+
+    fn lookup_pass(&self) -> String {
+        format!("{} lookup", self.id.to_uppercase())
+    }
+
+    fn create_gpu(&self, ctx: &RenderContext<'_>) -> TechniqueResult<Gpu> {
+        let state = DepthState {
+            constant_bias: 0,
+            slope_bias: self.settings.slope_bias,
+            cull_front: false,
+        };
+        let label = format!("{} maps", self.id);
+        let maps = ShadowMapSet::new(ctx, &label, state, None)?;
+        let stage = wgpu::ShaderStages::FRAGMENT;
+        let uniforms = UniformSlots::new(ctx.gpu, &format!("{} lights", self.id), 1, stage);
+        let module = ctx.shaders.create_module(&ctx.gpu.device, SHADER)?;
+        let source = ctx.shaders.compose(SHADER)?.source;
+        let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
+            .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
+        let groups = [uniforms.layout(), maps.lookup_layout()];
+        let lookup = [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|mask| {
+            let density = Some(wgpu::ColorTargetState {
+                format: DIAGNOSTICS_FORMAT,
+                blend: None,
+                write_mask: mask,
+            });
+            let label = format!("{} lookup (diagnostics {})", self.id, !mask.is_empty());
+            slot_fullscreen_pipeline_with(ctx, &label, &module, "fs_warped", &groups, &[density])
+        });
+        Ok(Gpu {
+            maps,
+            uniforms,
+            lookup,
+            filter_codes,
+            density: density_target(&ctx.gpu.device, ctx.size),
+            fallbacks: 0,
+        })
+    }
+}
+
+impl ShadowTechnique for WarpedMaps {
+    fn passes(&self) -> Vec<PassInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let lookup = self.lookup_pass();
+        let shadowed = gpu.maps.lights().iter().filter(|l| !l.frustums.is_empty());
+        let lookups = shadowed.map(|l| light_pass_name(&lookup, l.light));
+        let names = gpu
+            .maps
+            .pass_names(&self.map_pass())
+            .into_iter()
+            .chain(lookups);
+        names.map(PassInfo::render).collect()
+    }
+
+    fn resources(&self) -> Vec<ResourceInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut out = vec![ResourceInfo::texture(DENSITY_VIEW, &gpu.density.0, true)];
+        if let Some(maps) = gpu.maps.maps() {
+            out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
+        }
+        if let Some(cameras) = gpu.maps.cameras() {
+            out.push(ResourceInfo::buffer(
+                "layer cameras",
+                cameras,
+                "LayerCamera",
+            ));
+        }
+        out
+    }
+
+    fn packs_visibility_slots(&self) -> bool {
+        // Spot lookups write only inside the light's range and cone; directional lights
+        // cover the screen and are never packed with others.
+        true
+    }
+
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
+        if self.gpu.is_none() {
+            self.gpu = Some(self.create_gpu(ctx)?);
+        }
+        let layout = WarpedLayers {
+            warp: self.settings.warp,
+            fitted: Cell::new(0),
+            fallbacks: Cell::new(0),
+        };
+        let gpu = self.gpu.as_mut().expect("built above");
+        if changes.resolution {
+            gpu.density = density_target(&ctx.gpu.device, ctx.size);
+        }
+        // Warped maps follow the camera: the set refits them on every change.
+        (gpu.maps).prepare_with(ctx, changes, self.settings.map_size, false, &layout);
+        if layout.fitted.get() > 0 {
+            gpu.fallbacks = layout.fallbacks.get();
+        }
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> TechniqueResult {
+        let (map_pass, lookup_pass) = (self.map_pass(), self.lookup_pass());
+        let s = self.settings;
+        let Gpu {
+            maps,
+            uniforms,
+            lookup,
+            filter_codes,
+            density,
+            ..
+        } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        let group = maps
+            .lookup_group()
+            .ok_or_else(TechniqueError::not_prepared)?;
+        maps.record(ctx, recorder, &map_pass)?;
+        let filter_mode = filter_codes.code(s.filter.index());
+        let debug_light = maps.debug_light(s.debug_light).map(|l| l.light);
+        let shadowed: Vec<_> = (maps.lights().iter())
+            .filter(|l| !l.frustums.is_empty())
+            .collect();
+        let values: Vec<WarpedLight> = shadowed
+            .iter()
+            .map(|l| {
+                let light = &ctx.lights[l.light];
+                let size = match light.kind {
+                    LightKind::Directional => light.radius.tan(),
+                    _ => light.radius,
+                };
+                WarpedLight {
+                    inv_view_proj: l.frustums[0].view_proj.inverse().to_cols_array(),
+                    light: l.light as u32,
+                    layer: l.first_layer,
+                    filter_mode,
+                    diagnostics: u32::from(Some(l.light) == debug_light),
+                    resolution: maps.resolution() as f32,
+                    normal_offset: s.normal_offset,
+                    kernel_texels: s.kernel_radius,
+                    search_texels: s.pcss_max_texels,
+                    light_size: size,
+                    _pad: [0.0; 3],
+                }
+            })
+            .collect();
+        uniforms.write(ctx.gpu, &values);
+        for (k, light_maps) in shadowed.iter().enumerate() {
+            let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
+            let targets = [zoo_host::gpu::color_attachment(&density.1, clear)];
+            let name = light_pass_name(&lookup_pass, light_maps.light);
+            let mut pass = ctx.light_pass_with(recorder, &name, light_maps.light, &targets, None);
+            pass.set_pipeline(&lookup[values[k].diagnostics as usize]);
+            pass.set_bind_group(2, uniforms.bind_group(), &[uniforms.offset(k)]);
+            pass.set_bind_group(3, group, &[]);
+            let [x, y, width, height] = light_maps.scissor;
+            if width > 0 && height > 0 {
+                pass.set_scissor_rect(x, y, width, height);
+                pass.draw(0..3, 0..1);
+            }
+        }
+        Ok(())
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+        let next = match self.id {
+            "lispsm" => Settings::from(&LispsmParams::from_values(values)?),
+            _ => Settings::from(&PsmParams::from_values(values)?),
+        };
+        // The slope bias lives in the depth pipeline; everything else applies at `prepare`.
+        if next.slope_bias != self.settings.slope_bias {
+            return Ok(ParamUpdate::Rebuild);
+        }
+        self.settings = next;
+        Ok(ParamUpdate::Applied)
+    }
+
+    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let gpu = self.gpu.as_ref()?;
+        match resource {
+            DENSITY_VIEW => Some(DebugImage {
+                view: &gpu.density.1,
+                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
+            }),
+            "shadow maps" => {
+                let light = gpu.maps.debug_light(self.settings.debug_light)?;
+                Some(DebugImage {
+                    view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
+                    mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
+                })
+            }
+            _ => None,
+        }
+    }
+
+    fn counters(&self) -> Vec<(String, f64)> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        vec![
+            ("map resolution".into(), gpu.maps.resolution() as f64),
+            ("standard-fit fallbacks".into(), gpu.fallbacks as f64),
+        ]
+    }
+}
+
+fn create_lispsm(
+    _: &GpuContext,
+    values: &ParamValues,
+) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    let settings = Settings::from(&LispsmParams::from_values(values)?);
+    Ok(Box::new(WarpedMaps {
+        id: "lispsm",
+        settings,
+        gpu: None,
+    }))
+}
+
+fn create_psm(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    let settings = Settings::from(&PsmParams::from_values(values)?);
+    Ok(Box::new(WarpedMaps {
+        id: "psm",
+        settings,
+        gpu: None,
+    }))
+}
+
+zoo_host::register_technique! {
+    id: "lispsm",
+    name: "Light-space perspective shadow maps",
+    description: "Directional lights: one map warped by a perspective in light space along the view direction (n_opt), uniform as light and view align",
+    source: "seed 000 section 13.2 (Wimmer, Scherzer and Purgathofer 2004)",
+    light_kinds: &[LightKind::Directional],
+    params: LispsmParams::schema,
+    create: create_lispsm,
+}
+
+zoo_host::register_technique! {
+    id: "psm",
+    name: "Perspective shadow maps",
+    description: "Directional and spot lights: one map in the camera's post-perspective space, virtual camera slid back for casters behind the viewer, inverted lights handled",
+    source: "seed 000 section 7.9 (Stamminger and Drettakis 2002)",
+    light_kinds: &[LightKind::Directional, LightKind::Spot],
+    params: PsmParams::schema,
+    create: create_psm,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    #[test]
+    fn warped_light_mirrors_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose(SHADER)
+            .unwrap()
+            .source;
+        let (size, fields) = zoo_host::mirror_fields!(WarpedLight {
+            inv_view_proj,
+            light,
+            layer,
+            filter_mode,
+            diagnostics,
+            resolution,
+            normal_offset,
+            kernel_texels,
+            search_texels,
+            light_size
+        });
+        check_mirror(&source, "WarpedLight", size, &fields, SizeRule::Equal).unwrap();
+        ChoiceCodes::read(&source, "FILTER", Filter::NAMES).unwrap();
+    }
+}

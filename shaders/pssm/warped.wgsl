@@ -1,0 +1,142 @@
+// Warped single maps (LiSPSM, PSM): the lookup. Texel sizes vary over a warped map, so the
+// lookup measures the texel's world size where it filters (finite differences of the map
+// projection across the light's rays), and PCSS measures blocker distances in world space by
+// unprojecting the stored depth.
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "common/fullscreen.wgsl"
+#import "shadow-maps/filters.wgsl"
+#import "shadow-maps/depth_lookup.wgsl"
+#import "pssm/density.wgsl"
+
+// Filter modes, one per variant of the Rust `Filter` parameter; the plugin reads them here.
+const FILTER_NONE: u32 = 0u;
+const FILTER_HARDWARE2X2: u32 = 1u;
+const FILTER_PCF3X3: u32 = 2u;
+const FILTER_PCF5X5: u32 = 3u;
+const FILTER_POISSON: u32 = 4u;
+const FILTER_PCSS: u32 = 5u;
+
+struct WarpedLight {
+    // The layer's clip space back to world space (for PCSS blocker positions).
+    inv_view_proj: mat4x4<f32>,
+    // Index of the scene light.
+    light: u32,
+    layer: u32,
+    filter_mode: u32,
+    // 1 when this light's diagnostics are written.
+    diagnostics: u32,
+    // Map resolution in texels.
+    resolution: f32,
+    normal_offset: f32,
+    kernel_texels: f32,
+    search_texels: f32,
+    // Light radius (spot) or tangent of the angular radius (directional).
+    light_size: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+@group(2) @binding(0) var<uniform> warped: WarpedLight;
+
+// Unit direction light rays travel at p.
+fn ray_direction(light: Light, p: vec3<f32>) -> vec3<f32> {
+    if light.kind == LIGHT_DIRECTIONAL {
+        return light.direction;
+    }
+    return normalize(p - light.position);
+}
+
+// World size of one map texel at p across the rays (the larger side).
+fn texel_world(p: vec3<f32>, frame: mat2x3<f32>) -> f32 {
+    let step = 1e-3 * max(distance(p, camera.position), 1e-2);
+    let at = map_point(warped.layer, p).uv;
+    let across = map_point(warped.layer, p + frame[0] * step).uv - at;
+    let along = map_point(warped.layer, p + frame[1] * step).uv - at;
+    let texels = min(length(across), length(along)) * warped.resolution / step;
+    return 1.0 / max(texels, 1e-9);
+}
+
+// The world-space distance along the light to p: from the light (spot) or along its
+// direction (directional).
+fn light_distance(light: Light, p: vec3<f32>) -> f32 {
+    if light.kind == LIGHT_DIRECTIONAL {
+        return dot(p, light.direction);
+    }
+    return distance(p, light.position);
+}
+
+var<private> looked_up: Light;
+
+// One comparison tap (the filters' map access).
+fn shadow_tap(p: vec3<f32>, linear: bool) -> f32 {
+    return compare_map(map_point(warped.layer, p), linear);
+}
+
+// (inside, receiver distance, blocker distance) at p, along the light in world units; the
+// blocker's position comes from unprojecting the stored depth.
+fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
+    let m = map_point(warped.layer, p);
+    if !m.inside {
+        return vec3<f32>(0.0);
+    }
+    let ndc = vec2<f32>(m.uv.x * 2.0 - 1.0, 1.0 - m.uv.y * 2.0);
+    let stored = warped.inv_view_proj * vec4<f32>(ndc, stored_map_depth(m), 1.0);
+    let blocker = stored.xyz / stored.w;
+    return vec3<f32>(1.0, light_distance(looked_up, p), light_distance(looked_up, blocker));
+}
+
+struct Outputs {
+    @location(0) visibility: vec4<f32>,
+    // Effective texel density in false colour.
+    @location(1) density: vec4<f32>,
+}
+
+@fragment
+fn fs_warped(in: FullscreenOut) -> Outputs {
+    var out: Outputs;
+    out.visibility = vec4<f32>(1.0);
+    out.density = vec4<f32>(0.0);
+    let s = load_surface(vec2<i32>(in.position.xy));
+    if !s.valid {
+        return out;
+    }
+    let light = lights[warped.light];
+    looked_up = light;
+    if light.kind != LIGHT_DIRECTIONAL {
+        let to_surface = s.position - light.position;
+        let d = length(to_surface);
+        if d >= light.range || dot(to_surface, light.direction) <= light.cos_outer * d {
+            return out;
+        }
+    }
+    let frame = tangent_frame(ray_direction(light, s.position));
+    let texel = texel_world(s.position, frame);
+    let p = s.position + s.normal * (warped.normal_offset * texel);
+    let r = rotation(in.position.xy);
+    var visibility = 1.0;
+    switch warped.filter_mode {
+        case FILTER_NONE: { visibility = shadow_tap(p, false); }
+        case FILTER_HARDWARE2X2: { visibility = shadow_tap(p, true); }
+        case FILTER_PCF3X3: { visibility = grid_pcf(p, frame, texel, 3); }
+        case FILTER_PCF5X5: { visibility = grid_pcf(p, frame, texel, 5); }
+        case FILTER_POISSON: { visibility = poisson_pcf(p, frame, warped.kernel_texels * texel, r); }
+        default: {
+            // A warped map has no single near plane to size the blocker search by: the
+            // search takes the largest radius (`search_texels`). Distances are measured from
+            // the light (spot) or along it (directional, where only differences matter).
+            let spot = light.kind != LIGHT_DIRECTIONAL;
+            let near = select(-1e30, 0.0, spot);
+            let pcss_light = PcssLight(warped.light_size, near, spot, warped.search_texels);
+            visibility = pcss(p, frame, texel, r, pcss_light);
+        }
+    }
+    out.visibility = vec4<f32>(visibility);
+    if warped.diagnostics == 1u {
+        let depth = -(camera.view * vec4<f32>(s.position, 1.0)).z;
+        out.density = vec4<f32>(density_colour(texels_per_pixel(depth, texel)), 1.0);
+    }
+    return out;
+}
