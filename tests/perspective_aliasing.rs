@@ -94,7 +94,7 @@ fn warped_and_split_maps_put_more_texels_near_the_viewer() {
     let light = &scene.lights[0];
     let forward = ((camera.target - camera.position) * Vec3::new(1.0, 0.0, 1.0)).normalize();
     let ground = |d: f32| Vec3::new(camera.position.x, 0.0, camera.position.z) + forward * d;
-    let range = visible_depth_range(&camera, &objects);
+    let range = visible_depth_range(&camera, 1.0, &objects);
     let texel_at = |name: &str, d: f32| -> f32 {
         let p = ground(d);
         match name {
@@ -107,7 +107,7 @@ fn warped_and_split_maps_put_more_texels_near_the_viewer() {
                     lambda: 0.5,
                     blend: 0.1,
                 };
-                let c = cascades.distances(&camera, &objects);
+                let c = cascades.distances(&camera, 1.0, &objects, true);
                 let depth =
                     (p - camera.position).dot((camera.target - camera.position).normalize());
                 let split = (0..4).find(|&i| depth <= c[i + 1]).unwrap_or(3);

@@ -23,8 +23,14 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     }
     let view_dir = normalize(camera.position - s.position);
     var color = camera.ambient * s.albedo;
-    for (var i = 0u; i < camera.light_count; i++) {
+    // The light buffer holds the scene's lights (one dark placeholder when there are none).
+    // Bounding the loop by the uniform light count would let lavapipe inline the camera
+    // uniform and recompile this shader every time the camera moves.
+    for (var i = 0u; i < arrayLength(&lights); i++) {
         let light = lights[i];
+        if all(light.radiance == vec3<f32>(0.0)) {
+            continue;
+        }
         let v = textureLoad(visibility, pixel, light.slot_layer, 0)[light.slot_channel];
         if v > 0.0 {
             color += v * direct_light(light, s.position, s.normal, view_dir,

@@ -105,11 +105,12 @@ fn fs_warped(in: FullscreenOut) -> Outputs {
     }
     let light = lights[warped.light];
     looked_up = light;
+    // Write only where the light reaches, so lights with disjoint influence can share a slot.
     if light.kind != LIGHT_DIRECTIONAL {
         let to_surface = s.position - light.position;
         let d = length(to_surface);
         if d >= light.range || dot(to_surface, light.direction) <= light.cos_outer * d {
-            return out;
+            discard;
         }
     }
     let frame = tangent_frame(ray_direction(light, s.position));

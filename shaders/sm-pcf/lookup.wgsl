@@ -1,13 +1,14 @@
 // Shadow-map lookup: one full-screen pass per light writes that light's visibility, filtered by
 // the shadow-map library's filters (`shadow-maps/filters.wgsl`) through `shadow_tap` and
 // `shadow_depths` below, which project each tap by itself (for point lights into whichever
-// cube face it falls in), so filtering is seamless across cube faces.
+// cube face it falls in), so filtering is seamless across cube faces. The maps are read
+// through the library's depth lookup group (`shadow-maps/depth_lookup.wgsl`).
 
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
 #import "common/fullscreen.wgsl"
 #import "shadow-maps/filters.wgsl"
-#import "shadow-maps/layers.wgsl"
+#import "shadow-maps/depth_lookup.wgsl"
 
 // Filter modes, one per variant of the Rust `Filter` parameter (`FILTER_` and its name in
 // capitals). The plugin reads their values from this module, so no number is kept twice.
@@ -19,12 +20,6 @@ const FILTER_PCF7X7: u32 = 4u;
 const FILTER_PCF9X9: u32 = 5u;
 const FILTER_POISSON: u32 = 6u;
 const FILTER_PCSS: u32 = 7u;
-
-// One layer's camera, in a 256-byte slot (shared with the depth pass's dynamic uniform).
-struct Slot {
-    camera: LayerCamera,
-    _pad: array<vec4<f32>, 11>,
-}
 
 struct ShadowLight {
     first_layer: u32,
@@ -45,46 +40,17 @@ struct ShadowLight {
     light_size: f32,
     search_texels: f32,
     position: vec3<f32>,
-    _pad0: f32,
-    direction: vec3<f32>,
-    _pad1: f32,
-}
-
-struct Current {
-    index: u32,
     // 1 when this light's diagnostics are written.
     debug: u32,
-    _pad: vec2<u32>,
+    direction: vec3<f32>,
+    _pad: f32,
 }
 
-@group(2) @binding(0) var shadow_maps: texture_depth_2d_array;
-@group(2) @binding(1) var compare_linear: sampler_comparison;
-@group(2) @binding(2) var compare_nearest: sampler_comparison;
-@group(2) @binding(3) var<storage, read> slots: array<Slot>;
-@group(2) @binding(4) var<storage, read> shadow_lights: array<ShadowLight>;
-@group(2) @binding(5) var<uniform> current: Current;
-// The maps again as plain floats: GLSL cannot fetch texels of depth textures.
-@group(2) @binding(6) var shadow_map_depths: texture_2d_array<f32>;
-// And once more for the nearest comparison sampler: GLSL pairs each texture with one sampler.
-@group(2) @binding(7) var shadow_maps_nearest: texture_depth_2d_array;
-
-struct MapPoint {
-    uv: vec2<f32>,
-    depth: f32,
-    layer: u32,
-    inside: bool,
-}
+// The light being looked up; the maps come from `shadow-maps/depth_lookup.wgsl` (group 3).
+@group(2) @binding(0) var<uniform> shadow_light: ShadowLight;
 
 fn project(sl: ShadowLight, p: vec3<f32>) -> MapPoint {
-    let layer = light_layer(sl.first_layer, sl.layer_count, sl.position, p);
-    let clip = slots[layer].camera.view_proj * vec4<f32>(p, 1.0);
-    let ndc = clip.xyz / clip.w;
-    var m: MapPoint;
-    m.uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
-    m.depth = ndc.z;
-    m.layer = layer;
-    m.inside = clip.w > 0.0 && abs(ndc.x) <= 1.0 && abs(ndc.y) <= 1.0 && ndc.z >= 0.0 && ndc.z <= 1.0;
-    return m;
+    return map_point(light_layer(sl.first_layer, sl.layer_count, sl.position, p), p);
 }
 
 // Distance along the map's axis for a [0, 1] depth value.
@@ -95,11 +61,6 @@ fn linear_depth(sl: ShadowLight, d: f32) -> f32 {
     return sl.near + d * (sl.far - sl.near);
 }
 
-fn stored_depth(m: MapPoint) -> f32 {
-    let size = vec2<i32>(textureDimensions(shadow_maps));
-    let texel = clamp(vec2<i32>(m.uv * vec2<f32>(size)), vec2<i32>(0), size - vec2<i32>(1));
-    return textureLoad(shadow_map_depths, texel, m.layer, 0).r;
-}
 
 // Unit direction light rays travel at p.
 fn ray_direction(sl: ShadowLight, p: vec3<f32>) -> vec3<f32> {
@@ -127,14 +88,7 @@ var<private> looked_up: ShadowLight;
 
 // One comparison tap (the filters' map access): 1 = lit; outside the map = lit.
 fn shadow_tap(p: vec3<f32>, linear: bool) -> f32 {
-    let m = project(looked_up, p);
-    if !m.inside {
-        return 1.0;
-    }
-    if linear {
-        return textureSampleCompareLevel(shadow_maps, compare_linear, m.uv, m.layer, m.depth);
-    }
-    return textureSampleCompareLevel(shadow_maps_nearest, compare_nearest, m.uv, m.layer, m.depth);
+    return compare_map(project(looked_up, p), linear);
 }
 
 // (inside, receiver depth, stored depth) at p, depths along the map's axis.
@@ -143,7 +97,7 @@ fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
     if !m.inside {
         return vec3<f32>(0.0);
     }
-    return vec3<f32>(1.0, linear_depth(looked_up, m.depth), linear_depth(looked_up, stored_depth(m)));
+    return vec3<f32>(1.0, linear_depth(looked_up, m.depth), linear_depth(looked_up, stored_map_depth(m)));
 }
 
 struct Outputs {
@@ -161,7 +115,7 @@ fn fs_lookup(in: FullscreenOut) -> Outputs {
     if !s.valid {
         return out;
     }
-    let sl = shadow_lights[current.index];
+    let sl = shadow_light;
     looked_up = sl;
     // Write only where the light reaches, so lights with disjoint influence can share a slot.
     let light = lights[sl.light];
@@ -193,10 +147,10 @@ fn fs_lookup(in: FullscreenOut) -> Outputs {
         }
     }
     out.visibility = vec4<f32>(visibility);
-    if current.debug == 1u {
+    if sl.debug == 1u {
         let m = project(sl, s.position);
         if m.inside {
-            let difference = linear_depth(sl, m.depth) - linear_depth(sl, stored_depth(m));
+            let difference = linear_depth(sl, m.depth) - linear_depth(sl, stored_map_depth(m));
             out.diagnostics = vec4<f32>(1.0, difference / texel, 0.0, 1.0);
         }
     }

@@ -252,12 +252,12 @@ pub fn directional_frustum(
     let mut extent = (hi.x - lo.x).max(hi.y - lo.y).max(1e-3) * 1.02;
     let mut center = (lo + hi) * 0.5;
     if let Some(resolution) = stable_texels {
-        extent = 1.25f32.powf(extent.ln().div_euclid(1.25f32.ln()) + 1.0);
+        // Two texels of margin: rounding the centre moves the receivers by up to half a texel.
+        extent = 1.25f32.powf(extent.ln().div_euclid(1.25f32.ln()) + 1.0)
+            * (1.0 + 2.0 / resolution as f32);
         let texel = extent / resolution as f32;
         center.x = (center.x / texel).round() * texel;
         center.y = (center.y / texel).round() * texel;
-        // Rounding the centre moves the receivers by up to half a texel: keep them inside.
-        extent += 2.0 * texel;
     }
     let margin = (nearest - lo.z).max(1e-3) * 0.01;
     let (mut near, mut far) = (-nearest - margin, -lo.z + margin);

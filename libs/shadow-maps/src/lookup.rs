@@ -104,3 +104,21 @@ impl LookupGroup {
         self.group = Some(bind_group(device, &label, &self.layout, &resources));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use zoo_host::gpu::layout::wgsl_struct;
+
+    #[test]
+    fn lookup_camera_slots_are_the_depth_pass_stride() {
+        let library = zoo_host::ShaderLibrary::embedded();
+        // Shared modules are checked through a shader that imports them.
+        let source = library
+            .compose_source("test.wgsl", "#import \"shadow-maps/depth_lookup.wgsl\"\n")
+            .unwrap()
+            .source;
+        let slot = wgsl_struct(&source, "CameraSlot").unwrap();
+        assert_eq!(slot.size as u64, crate::CAMERA_STRIDE);
+        assert_eq!(slot.members[0], ("camera".to_string(), 0));
+    }
+}

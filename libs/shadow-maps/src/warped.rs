@@ -51,7 +51,7 @@ fn light_space_body(light_view: Mat4, slice: &[Vec3; 8], casters: &[Aabb]) -> Ve
     let mut top = hi.z;
     for caster in casters {
         let (clo, chi) = bounds_in(light_view, &corners(*caster));
-        if clo.x <= hi.x && chi.x >= lo.x && clo.y <= hi.y && chi.y >= lo.y && clo.z <= hi.z {
+        if clo.x <= hi.x && chi.x >= lo.x && clo.y <= hi.y && chi.y >= lo.y && chi.z >= lo.z {
             top = top.max(chi.z);
         }
     }
@@ -101,7 +101,9 @@ pub fn lispsm_frustum(
     let view_dir = (camera.target - camera.position).normalize_or(Vec3::NEG_Z);
     let sin_gamma = view_dir.cross(direction).length();
     let along_view = view_dir - direction * view_dir.dot(direction);
-    let up = if sin_gamma >= MIN_SIN_GAMMA {
+    // The map's y axis follows the view until light and view are parallel, so the map does
+    // not turn when the warp is dropped below MIN_SIN_GAMMA.
+    let up = if sin_gamma >= 1e-4 {
         along_view.normalize()
     } else {
         up_for(direction)
@@ -207,7 +209,9 @@ pub fn psm_frustum(
     // World axes across the light, for measuring texel sizes.
     let world_view = look_to_mat4(Vec3::ZERO, light.direction, up_for(light.direction));
     let scale = l.xyz().length().max(1e-12);
-    if l.w.abs() < 1e-6 * scale {
+    // Nearly parallel to the view plane the light's post-perspective position runs off to
+    // infinity (and with it the precision of a perspective fit): treat it as directional.
+    if l.w.abs() < 1e-3 * scale {
         // Directional in post-perspective space: an orthographic fit along -l.
         let travel = -l.xyz() / scale;
         let pp_view = look_to_mat4(Vec3::ZERO, travel, up_for(travel));

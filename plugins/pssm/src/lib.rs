@@ -275,7 +275,8 @@ impl ShadowTechnique for Pssm {
             .lookup_group()
             .ok_or_else(TechniqueError::not_prepared)?;
         maps.record(ctx, recorder, MAP_PASS)?;
-        let distances = cascades.distances(ctx.camera, maps.bounds().0);
+        let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
+        let distances = cascades.distances(ctx.camera, aspect, maps.bounds().0, p.stabilise);
         let filter_mode = filter_codes.code(p.filter.index());
         let shadowed: Vec<&LightMaps> = (maps.lights().iter())
             .filter(|l| !l.frustums.is_empty())

@@ -140,7 +140,7 @@ impl LayerPlan for WarpedLayers {
         }
         self.fitted.set(self.fitted.get() + 1);
         let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
-        let range = visible_depth_range(inputs.camera, inputs.objects);
+        let range = visible_depth_range(inputs.camera, aspect, inputs.objects);
         let fit = match self.warp {
             Warp::Lispsm(strength) => Some(
                 lispsm_frustum(

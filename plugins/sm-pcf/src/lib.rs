@@ -7,20 +7,15 @@
 //! cube faces widened by a guard band. A full-screen pass per light then compares each pixel's
 //! light-space depth with the map and writes the light's visibility. Points outside a map are
 //! lit. Bias: constant and slope-scaled pipeline depth bias, normal offset in texels, and
-//! optional front-face culling in the depth pass.
+//! optional front-face culling in the depth pass. Maps, fitting and the lookup's map access
+//! come from the shadow-map library.
 
-use bytemuck::{Pod, Zeroable};
 use zoo_host::glam::UVec2;
 use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::params::TechniqueParams;
-use zoo_host::scene::LightKind;
+use zoo_host::kit::{UniformSlots, light_pass_name, slot_fullscreen_pipeline_with};
+use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
-use zoo_host::{
-    Changes, GpuContext, ParamUpdate, ParamValues, PassInfo, PassRecorder, RenderContext,
-    ShadowTechnique, TechniqueError, wgpu,
-};
-
-use zoo_shadow_maps::{DepthState, ShadowMapSet, light_size};
+use zoo_shadow_maps::{DepthState, LightMaps, ShadowMapSet, light_size};
 
 zoo_host::param_choice! {
     /// How shadow-map comparisons are filtered.
@@ -54,8 +49,9 @@ zoo_host::technique_params! {
     }
 }
 
-/// `ShadowLight` in `sm-pcf/lookup.wgsl`.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+/// `ShadowLight` in `sm-pcf/lookup.wgsl`: one light's lookup, at a dynamic offset.
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
 #[repr(C)]
 struct ShadowLight {
     first_layer: u32,
@@ -71,397 +67,158 @@ struct ShadowLight {
     light_size: f32,
     search_texels: f32,
     position: [f32; 3],
-    _pad0: f32,
-    direction: [f32; 3],
-    _pad1: f32,
-}
-
-/// `Current` in `sm-pcf/lookup.wgsl`, in a 256-byte slot.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-#[repr(C)]
-struct Current {
-    index: u32,
     debug: u32,
-    _pad: [u32; 62],
+    direction: [f32; 3],
+    _pad: f32,
 }
 
-const SLOT: u64 = 256;
-const LOOKUP_SHADER: &str = "sm-pcf/lookup.wgsl";
+const SHADER: &str = "sm-pcf/lookup.wgsl";
+/// Base name of the depth passes (see `zoo_shadow_maps::layer_pass_name`).
+const DEPTH_PASS: &str = "Shadow map";
+const LOOKUP_PASS: &str = "Shadow lookup";
 const DIAGNOSTICS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-struct Pipelines {
-    /// Without and with diagnostics output; each writes the light's slot (`kit::slot_target`).
-    lookup: Vec<wgpu::RenderPipeline>,
-    lookup_layout: wgpu::BindGroupLayout,
+
+/// Maps, pipelines and per-light uniforms, built at the first `prepare`.
+struct Gpu {
+    maps: ShadowMapSet,
+    uniforms: UniformSlots<ShadowLight>,
+    /// Without and with diagnostics written.
+    lookup: [wgpu::RenderPipeline; 2],
     /// The lookup's value of each `Filter` (its `FILTER_*` constants).
     filter_codes: ChoiceCodes,
+    /// Coverage (r) and receiver minus stored depth in texels (g), for the debug light.
+    diagnostics: (wgpu::Texture, wgpu::TextureView),
 }
 
-struct Buffers {
-    lights: wgpu::Buffer,
-    current: wgpu::Buffer,
-    lookup_bind_group: wgpu::BindGroup,
+fn diagnostics_target(device: &wgpu::Device, size: UVec2) -> (wgpu::Texture, wgpu::TextureView) {
+    let usage = wgpu::TextureUsages::empty();
+    zoo_host::gpu::render_target(
+        device,
+        "sm-pcf diagnostics",
+        size,
+        DIAGNOSTICS_FORMAT,
+        usage,
+    )
+}
+
+impl Gpu {
+    fn new(ctx: &RenderContext<'_>, params: &SmParams) -> TechniqueResult<Gpu> {
+        let state = DepthState {
+            constant_bias: params.constant_bias as i32,
+            slope_bias: params.slope_bias,
+            cull_front: params.cull_front,
+        };
+        let maps = ShadowMapSet::new(ctx, "sm-pcf shadow maps", state, None)?;
+        let stage = wgpu::ShaderStages::FRAGMENT;
+        let uniforms = UniformSlots::new(ctx.gpu, "sm-pcf lights", ctx.lights.len(), stage);
+        let module = ctx.shaders.create_module(&ctx.gpu.device, SHADER)?;
+        let source = ctx.shaders.compose(SHADER)?.source;
+        let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
+            .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
+        let groups = [uniforms.layout(), maps.lookup_layout()];
+        let lookup = [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|mask| {
+            let diagnostics = Some(wgpu::ColorTargetState {
+                format: DIAGNOSTICS_FORMAT,
+                blend: None,
+                write_mask: mask,
+            });
+            let label = format!("sm-pcf lookup (diagnostics {})", !mask.is_empty());
+            slot_fullscreen_pipeline_with(
+                ctx,
+                &label,
+                &module,
+                "fs_lookup",
+                &groups,
+                &[diagnostics],
+            )
+        });
+        Ok(Gpu {
+            maps,
+            uniforms,
+            lookup,
+            filter_codes,
+            diagnostics: diagnostics_target(&ctx.gpu.device, ctx.size),
+        })
+    }
+}
+
+/// The lookup's uniform for one light's maps.
+fn shadow_light(
+    p: &SmParams,
+    maps: &LightMaps,
+    light: &zoo_host::Light,
+    resolution: u32,
+) -> ShadowLight {
+    let scale = maps.scale(resolution);
+    ShadowLight {
+        first_layer: maps.first_layer,
+        layer_count: maps.frustums.len() as u32,
+        filter_mode: 0,
+        light: maps.light as u32,
+        texel_scale: scale.texel_scale,
+        perspective: u32::from(scale.perspective),
+        near: scale.near,
+        far: scale.far,
+        normal_offset: p.normal_offset,
+        kernel_texels: p.kernel_radius,
+        light_size: light_size(light),
+        search_texels: p.pcss_max_texels,
+        position: light.position.to_array(),
+        debug: u32::from(maps.light as u32 == p.debug_light),
+        direction: light.direction.to_array(),
+        _pad: 0.0,
+    }
 }
 
 /// Shadow maps with PCF.
 pub struct ShadowMaps {
     params: SmParams,
-    pipelines: Option<Pipelines>,
-    /// The lights' depth maps, their frusta and the depth pass.
-    maps: Option<ShadowMapSet>,
-    buffers: Option<Buffers>,
-    diagnostics: Option<(wgpu::Texture, wgpu::TextureView)>,
-    samplers: Option<(wgpu::Sampler, wgpu::Sampler)>,
-}
-
-impl ShadowMaps {
-    fn create_pipelines(&self, ctx: &RenderContext<'_>) -> Result<Pipelines, TechniqueError> {
-        let device = &ctx.gpu.device;
-        let lookup_module = ctx.shaders.create_module(device, LOOKUP_SHADER)?;
-        let lookup_source = ctx.shaders.compose(LOOKUP_SHADER)?.source;
-        let filter_codes = ChoiceCodes::read(&lookup_source, "FILTER", Filter::NAMES)
-            .map_err(|e| TechniqueError::Other(format!("{LOOKUP_SHADER}: {e}")))?;
-
-        let texture_entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty,
-            count: None,
-        };
-        let storage = wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        };
-        let lookup_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sm-pcf lookup layout"),
-            entries: &[
-                texture_entry(
-                    0,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                ),
-                texture_entry(
-                    1,
-                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                ),
-                texture_entry(
-                    2,
-                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                ),
-                texture_entry(3, storage),
-                texture_entry(4, storage),
-                texture_entry(
-                    5,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(16),
-                    },
-                ),
-                // The same maps as plain floats, for reading stored depths (GLSL cannot fetch
-                // texels of depth textures).
-                texture_entry(
-                    6,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                ),
-                // And once more for the nearest comparison sampler (GLSL pairs each texture
-                // with one sampler).
-                texture_entry(
-                    7,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                ),
-            ],
-        });
-        let lookup_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("sm-pcf lookup pipeline layout"),
-                bind_group_layouts: &[
-                    Some(&ctx.frame.layout),
-                    Some(&ctx.gbuffer.layout),
-                    Some(&lookup_layout),
-                ],
-                immediate_size: 0,
-            });
-        let lookup = [false, true]
-            .into_iter()
-            .map(|diagnostics| {
-                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(if diagnostics {
-                        "sm-pcf lookup pipeline (diagnostics)"
-                    } else {
-                        "sm-pcf lookup pipeline"
-                    }),
-                    layout: Some(&lookup_pipeline_layout),
-                    vertex: wgpu::VertexState {
-                        module: &lookup_module,
-                        entry_point: Some("fullscreen_vs"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: Default::default(),
-                    depth_stencil: None,
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &lookup_module,
-                        entry_point: Some("fs_lookup"),
-                        compilation_options: Default::default(),
-                        targets: &[
-                            Some(zoo_host::kit::slot_target()),
-                            Some(wgpu::ColorTargetState {
-                                format: DIAGNOSTICS_FORMAT,
-                                blend: None,
-                                write_mask: if diagnostics {
-                                    wgpu::ColorWrites::ALL
-                                } else {
-                                    wgpu::ColorWrites::empty()
-                                },
-                            }),
-                        ],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
-            })
-            .collect();
-        Ok(Pipelines {
-            lookup,
-            lookup_layout,
-            filter_codes,
-        })
-    }
-
-    /// Uploads every light's lookup parameters (after the maps were refitted or a parameter
-    /// changed).
-    fn upload(&mut self, ctx: &RenderContext<'_>) {
-        let pipelines = self.pipelines.as_ref().expect("pipelines exist");
-        let maps = self.maps.as_ref().expect("maps exist");
-        let resolution = maps.resolution();
-        let filter_mode = pipelines.filter_codes.code(self.params.filter.index());
-        let shadow_lights: Vec<ShadowLight> = maps
-            .lights()
-            .iter()
-            .map(|maps| {
-                let light = &ctx.lights[maps.light];
-                let scale = maps.scale(resolution);
-                ShadowLight {
-                    first_layer: maps.first_layer,
-                    layer_count: maps.frustums.len() as u32,
-                    filter_mode,
-                    light: maps.light as u32,
-                    texel_scale: scale.texel_scale,
-                    perspective: u32::from(scale.perspective),
-                    near: scale.near,
-                    far: scale.far,
-                    normal_offset: self.params.normal_offset,
-                    kernel_texels: self.params.kernel_radius,
-                    light_size: light_size(light),
-                    search_texels: self.params.pcss_max_texels,
-                    position: light.position.to_array(),
-                    _pad0: 0.0,
-                    direction: light.direction.to_array(),
-                    _pad1: 0.0,
-                }
-            })
-            .collect();
-        let currents: Vec<Current> = (0..maps.lights().len())
-            .map(|i| Current {
-                index: i as u32,
-                debug: u32::from(i as u32 == self.params.debug_light),
-                _pad: [0; 62],
-            })
-            .collect();
-
-        let queue = &ctx.gpu.queue;
-        let fits = |buffer: &wgpu::Buffer, bytes: usize| buffer.size() >= bytes.max(16) as u64;
-        let light_bytes = size_of_val(shadow_lights.as_slice());
-        let current_bytes = size_of_val(currents.as_slice());
-        if !self
-            .buffers
-            .as_ref()
-            .is_some_and(|b| fits(&b.lights, light_bytes) && fits(&b.current, current_bytes))
-        {
-            self.buffers = Some(self.create_buffers(ctx, light_bytes, current_bytes));
-        }
-        let buffers = self.buffers.as_ref().expect("created above");
-        if !shadow_lights.is_empty() {
-            queue.write_buffer(&buffers.lights, 0, bytemuck::cast_slice(&shadow_lights));
-            queue.write_buffer(&buffers.current, 0, bytemuck::cast_slice(&currents));
-        }
-    }
-
-    fn create_buffers(
-        &self,
-        ctx: &RenderContext<'_>,
-        light_bytes: usize,
-        current_bytes: usize,
-    ) -> Buffers {
-        let device = &ctx.gpu.device;
-        let pipelines = self.pipelines.as_ref().expect("pipelines exist");
-        let set = self.maps.as_ref().expect("maps exist");
-        let maps = set.maps().expect("maps prepared");
-        let (linear, nearest) = self.samplers.as_ref().expect("samplers exist");
-        let buffer = |label: &str, bytes: usize, usage: wgpu::BufferUsages| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: (bytes.max(SLOT as usize) as u64).next_multiple_of(SLOT),
-                usage: usage | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
-        let cameras = set.cameras().expect("cameras written");
-        let lights = buffer(
-            "sm-pcf shadow lights",
-            light_bytes,
-            wgpu::BufferUsages::STORAGE,
-        );
-        let current = buffer(
-            "sm-pcf current light",
-            current_bytes,
-            wgpu::BufferUsages::UNIFORM,
-        );
-        let lookup_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sm-pcf lookup bind group"),
-            layout: &pipelines.lookup_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&maps.array_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(linear),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Sampler(nearest),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: cameras.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: lights.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &current,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(16),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::TextureView(&maps.array_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: wgpu::BindingResource::TextureView(&maps.array_view),
-                },
-            ],
-        });
-        Buffers {
-            lights,
-            current,
-            lookup_bind_group,
-        }
-    }
-
-    fn create_samplers(device: &wgpu::Device) -> (wgpu::Sampler, wgpu::Sampler) {
-        let sampler = |label, filter| {
-            device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some(label),
-                address_mode_u: wgpu::AddressMode::ClampToEdge,
-                address_mode_v: wgpu::AddressMode::ClampToEdge,
-                mag_filter: filter,
-                min_filter: filter,
-                compare: Some(wgpu::CompareFunction::LessEqual),
-                ..Default::default()
-            })
-        };
-        (
-            sampler("sm-pcf compare sampler (linear)", wgpu::FilterMode::Linear),
-            sampler(
-                "sm-pcf compare sampler (nearest)",
-                wgpu::FilterMode::Nearest,
-            ),
-        )
-    }
-
-    fn diagnostics_texture(
-        device: &wgpu::Device,
-        size: UVec2,
-    ) -> (wgpu::Texture, wgpu::TextureView) {
-        zoo_host::gpu::render_target(
-            device,
-            "sm-pcf diagnostics",
-            size,
-            DIAGNOSTICS_FORMAT,
-            wgpu::TextureUsages::empty(),
-        )
-    }
-}
-
-/// Base name of the depth passes (see `zoo_shadow_maps::layer_pass_name`).
-const DEPTH_PASS: &str = "Shadow map";
-
-fn lookup_pass_name(light: usize) -> String {
-    format!("Shadow lookup: light {light}")
+    gpu: Option<Gpu>,
 }
 
 impl ShadowTechnique for ShadowMaps {
     fn passes(&self) -> Vec<PassInfo> {
-        let Some(maps) = &self.maps else {
+        let Some(gpu) = &self.gpu else {
             return Vec::new();
         };
-        let lookups = maps.lights().iter().map(|l| lookup_pass_name(l.light));
-        (maps.pass_names(DEPTH_PASS).into_iter())
-            .chain(lookups)
-            .map(PassInfo::render)
-            .collect()
+        let lookups = gpu
+            .maps
+            .lights()
+            .iter()
+            .map(|l| light_pass_name(LOOKUP_PASS, l.light));
+        let names = gpu.maps.pass_names(DEPTH_PASS).into_iter().chain(lookups);
+        names.map(PassInfo::render).collect()
     }
 
     fn resources(&self) -> Vec<ResourceInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
         let mut out = Vec::new();
-        if let Some(maps) = self.maps.as_ref().and_then(|m| m.maps()) {
+        if let Some(maps) = gpu.maps.maps() {
             out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
         }
-        if let Some((texture, _)) = &self.diagnostics {
-            out.push(ResourceInfo::texture("diagnostics", texture, false));
-            // Two views of the diagnostics texture (no memory of their own).
-            for view in ["coverage", "depth difference"] {
-                out.push(ResourceInfo {
-                    bytes: 0,
-                    ..ResourceInfo::texture(view, texture, true)
-                });
-            }
+        let texture = &gpu.diagnostics.0;
+        out.push(ResourceInfo::texture("diagnostics", texture, false));
+        // Two views of the diagnostics texture (no memory of their own).
+        for view in ["coverage", "depth difference"] {
+            out.push(ResourceInfo {
+                bytes: 0,
+                ..ResourceInfo::texture(view, texture, true)
+            });
         }
-        if let Some(cameras) = self.maps.as_ref().and_then(|m| m.cameras()) {
+        if let Some(cameras) = gpu.maps.cameras() {
             out.push(ResourceInfo::buffer(
                 "layer cameras",
                 cameras,
-                "LayerCamera in 256-byte slots",
+                "LayerCamera",
             ));
         }
-        if let Some(b) = &self.buffers {
-            out.push(ResourceInfo::buffer(
-                "shadow lights",
-                &b.lights,
-                "ShadowLight",
-            ));
-        }
+        out.push(ResourceInfo::buffer(
+            "shadow lights",
+            gpu.uniforms.buffer(),
+            "ShadowLight",
+        ));
         out
     }
 
@@ -470,29 +227,17 @@ impl ShadowTechnique for ShadowMaps {
         true
     }
 
-    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError> {
-        if self.pipelines.is_none() {
-            self.pipelines = Some(self.create_pipelines(ctx)?);
-            self.samplers = Some(Self::create_samplers(&ctx.gpu.device));
-            let state = DepthState {
-                constant_bias: self.params.constant_bias as i32,
-                slope_bias: self.params.slope_bias,
-                cull_front: self.params.cull_front,
-            };
-            self.maps = Some(ShadowMapSet::new(ctx, "sm-pcf shadow maps", state, None)?);
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
+        if self.gpu.is_none() {
+            self.gpu = Some(Gpu::new(ctx, &self.params)?);
         }
-        if changes.resolution || self.diagnostics.is_none() {
-            self.diagnostics = Some(Self::diagnostics_texture(&ctx.gpu.device, ctx.size));
+        let gpu = self.gpu.as_mut().expect("built above");
+        if changes.resolution {
+            gpu.diagnostics = diagnostics_target(&ctx.gpu.device, ctx.size);
         }
         // Directional maps follow the camera; spot and point maps follow their lights.
-        let maps = self.maps.as_mut().expect("created above");
         let p = &self.params;
-        if maps.prepare(ctx, changes, p.map_size, p.stable_fit) {
-            self.buffers = None;
-        }
-        if changes != Changes::default() || self.buffers.is_none() {
-            self.upload(ctx);
-        }
+        gpu.maps.prepare(ctx, changes, p.map_size, p.stable_fit);
         Ok(())
     }
 
@@ -500,27 +245,35 @@ impl ShadowTechnique for ShadowMaps {
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-    ) -> Result<(), TechniqueError> {
-        let (Some(pipelines), Some(maps), Some(buffers), Some((_, diagnostics))) = (
-            &self.pipelines,
-            &self.maps,
-            &self.buffers,
-            &self.diagnostics,
-        ) else {
-            return Err(TechniqueError::not_prepared());
-        };
+    ) -> TechniqueResult {
+        let p = &self.params;
+        let Gpu {
+            maps,
+            uniforms,
+            lookup,
+            filter_codes,
+            diagnostics,
+        } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        let group = maps
+            .lookup_group()
+            .ok_or_else(TechniqueError::not_prepared)?;
         maps.record(ctx, recorder, DEPTH_PASS)?;
+        let filter_mode = filter_codes.code(p.filter.index());
+        let values: Vec<ShadowLight> = (maps.lights().iter())
+            .map(|l| ShadowLight {
+                filter_mode,
+                ..shadow_light(p, l, &ctx.lights[l.light], maps.resolution())
+            })
+            .collect();
+        uniforms.write(ctx.gpu, &values);
         for (k, light_maps) in maps.lights().iter().enumerate() {
-            let debug = light_maps.light as u32 == self.params.debug_light;
-            let name = lookup_pass_name(light_maps.light);
-            let diagnostics = zoo_host::gpu::color_attachment(
-                diagnostics,
-                zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT),
-            );
-            let mut pass =
-                ctx.light_pass_with(recorder, &name, light_maps.light, &[diagnostics], None);
-            pass.set_pipeline(&pipelines.lookup[usize::from(debug)]);
-            pass.set_bind_group(2, &buffers.lookup_bind_group, &[(k as u64 * SLOT) as u32]);
+            let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
+            let targets = [zoo_host::gpu::color_attachment(&diagnostics.1, clear)];
+            let name = light_pass_name(LOOKUP_PASS, light_maps.light);
+            let mut pass = ctx.light_pass_with(recorder, &name, light_maps.light, &targets, None);
+            pass.set_pipeline(&lookup[values[k].debug as usize]);
+            pass.set_bind_group(2, uniforms.bind_group(), &[uniforms.offset(k)]);
+            pass.set_bind_group(3, group, &[]);
             let [x, y, width, height] = light_maps.scissor;
             if width > 0 && height > 0 {
                 pass.set_scissor_rect(x, y, width, height);
@@ -530,11 +283,11 @@ impl ShadowTechnique for ShadowMaps {
         Ok(())
     }
 
-    fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
+    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
         let next = SmParams::from_values(values)?;
         // Depth biases and culling live in the depth pipeline; the map size is applied by
         // the map set at the next `prepare`, the rest reaches the shader through the per-light
-        // buffers `upload` rewrites.
+        // uniforms written every frame.
         let built = |p: &SmParams| (p.constant_bias, p.slope_bias.to_bits(), p.cull_front);
         if built(&next) != built(&self.params) {
             return Ok(ParamUpdate::Rebuild);
@@ -544,61 +297,42 @@ impl ShadowTechnique for ShadowMaps {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let gpu = self.gpu.as_ref()?;
+        let channel = |channel, min, max| {
+            Some(DebugImage {
+                view: &gpu.diagnostics.1,
+                mapping: ViewMapping::Channel { channel, min, max },
+            })
+        };
         match resource {
             "shadow maps" => {
-                let set = self.maps.as_ref()?;
-                let light =
-                    (set.lights().iter()).find(|l| l.light as u32 == self.params.debug_light)?;
+                let light = gpu.maps.debug_light(self.params.debug_light)?;
                 Some(DebugImage {
-                    view: &set.maps()?.layer_views[light.first_layer as usize],
+                    view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
                     mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
                 })
             }
-            "coverage" => Some(DebugImage {
-                view: &self.diagnostics.as_ref()?.1,
-                mapping: ViewMapping::Channel {
-                    channel: 0,
-                    min: 0.0,
-                    max: 1.0,
-                },
-            }),
-            "depth difference" => Some(DebugImage {
-                view: &self.diagnostics.as_ref()?.1,
-                mapping: ViewMapping::Channel {
-                    channel: 1,
-                    min: -2.0,
-                    max: 2.0,
-                },
-            }),
+            "coverage" => channel(0, 0.0, 1.0),
+            "depth difference" => channel(1, -2.0, 2.0),
             _ => None,
         }
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        let Some(maps) = &self.maps else {
+        let Some(gpu) = &self.gpu else {
             return Vec::new();
         };
-        let layers: usize = maps.lights().iter().map(|l| l.frustums.len()).sum();
-        let resolution = maps.resolution();
+        let layers: usize = gpu.maps.lights().iter().map(|l| l.frustums.len()).sum();
         vec![
             ("map layers".into(), layers as f64),
-            ("map resolution".into(), resolution as f64),
+            ("map resolution".into(), gpu.maps.resolution() as f64),
         ]
     }
 }
 
-fn create(
-    _: &GpuContext,
-    values: &ParamValues,
-) -> Result<Box<dyn ShadowTechnique>, TechniqueError> {
-    Ok(Box::new(ShadowMaps {
-        params: SmParams::from_values(values)?,
-        pipelines: None,
-        maps: None,
-        buffers: None,
-        diagnostics: None,
-        samplers: None,
-    }))
+fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    let params = SmParams::from_values(values)?;
+    Ok(Box::new(ShadowMaps { params, gpu: None }))
 }
 
 zoo_host::register_technique! {
@@ -607,9 +341,6 @@ zoo_host::register_technique! {
     description: "Depth maps from each light (spot frustum, fitted directional box, point cube) with PCF or PCSS",
     source: "seed 000 section 7; seed 004 sections 3.4 and 9.1 (Williams 1978; Reeves 1987; Fernando 2005)",
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
-    required_features: wgpu::Features::empty,
-    optional_features: wgpu::Features::empty,
-    required_limits: wgpu::Limits::downlevel_defaults,
     params: SmParams::schema,
     create: create,
 }
@@ -617,27 +348,26 @@ zoo_host::register_technique! {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_struct};
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    fn shader() -> String {
+        zoo_host::ShaderLibrary::embedded()
+            .compose(SHADER)
+            .unwrap()
+            .source
+    }
 
     #[test]
     fn every_filter_has_a_distinct_shader_constant() {
-        let codes = ChoiceCodes::read(&shader(LOOKUP_SHADER), "FILTER", Filter::NAMES).unwrap();
+        let codes = ChoiceCodes::read(&shader(), "FILTER", Filter::NAMES).unwrap();
         let mut values: Vec<u32> = (0..Filter::NAMES.len()).map(|i| codes.code(i)).collect();
         values.sort();
         values.dedup();
         assert_eq!(values.len(), Filter::NAMES.len());
     }
 
-    fn shader(name: &str) -> String {
-        zoo_host::ShaderLibrary::embedded()
-            .compose(name)
-            .unwrap()
-            .source
-    }
-
     #[test]
-    fn gpu_structs_mirror_the_shaders() {
-        let lookup = shader("sm-pcf/lookup.wgsl");
+    fn shadow_light_mirrors_the_shader() {
         let (size, fields) = zoo_host::mirror_fields!(ShadowLight {
             first_layer,
             layer_count,
@@ -652,15 +382,9 @@ mod tests {
             light_size,
             search_texels,
             position,
+            debug,
             direction
         });
-        check_mirror(&lookup, "ShadowLight", size, &fields, SizeRule::Equal).unwrap();
-        // The layer cameras come from the shadow-map library's depth pass, 256 bytes apart.
-        let slot = wgsl_struct(&lookup, "Slot").unwrap();
-        assert_eq!(slot.size as u64, zoo_shadow_maps::CAMERA_STRIDE);
-        assert_eq!(slot.members[0], ("camera".to_string(), 0));
-        // Uniforms at 256-byte dynamic offsets: the Rust struct fills the slot.
-        let (size, fields) = zoo_host::mirror_fields!(Current { index, debug });
-        check_mirror(&lookup, "Current", size, &fields, SizeRule::AtLeast).unwrap();
+        check_mirror(&shader(), "ShadowLight", size, &fields, SizeRule::Equal).unwrap();
     }
 }
