@@ -10,9 +10,7 @@
 //! the depth test fails, with wrap); a full-screen pass then writes visibility 0 where the count
 //! is not zero.
 
-use zoo_host::gpu::readback::ReadbackRing;
 use zoo_host::params::TechniqueParams;
-use zoo_host::render::visibility::VISIBILITY_FORMAT;
 use zoo_host::scene::LightKind;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
@@ -20,10 +18,10 @@ use zoo_host::{
     ShadowTechnique, TechniqueError, wgpu,
 };
 
-use zoo_shadow_volumes::{
-    ARGS_BYTES, VOLUME_VERTEX_LAYOUT, VolumeGenerator, stencil_state, volume_depth_stencil,
-    volume_primitive,
-};
+mod pipelines;
+
+use pipelines::{Buffers, COUNT_LEVELS, DebugTargets, Pipelines, SLOT};
+use zoo_shadow_volumes::ARGS_BYTES;
 pub use zoo_shadow_volumes::{Counting, Volumes, silhouette};
 
 zoo_host::technique_params! {
@@ -46,34 +44,6 @@ zoo_host::technique_params! {
     }
 }
 
-const SLOT: u64 = 256;
-const COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
-const OVERLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-/// Stencil levels the count view distinguishes, shown as ids 1..=10: counts 1..=8, then 255 and
-/// 254 (-1 and -2 wrapped); any other non-zero count is id 11.
-const COUNT_LEVELS: [u32; 10] = [1, 2, 3, 4, 5, 6, 7, 8, 255, 254];
-
-struct Pipelines {
-    generator: VolumeGenerator,
-    volume: wgpu::RenderPipeline,
-    resolve: wgpu::RenderPipeline,
-    overlay: wgpu::RenderPipeline,
-    count_equal: wgpu::RenderPipeline,
-    count_any: wgpu::RenderPipeline,
-    count_layout: wgpu::BindGroupLayout,
-}
-
-struct Buffers {
-    /// Draw arguments and silhouette counters per light, read back a frame or two late.
-    stats: std::sync::Mutex<ReadbackRing>,
-    levels_bind_group: wgpu::BindGroup,
-}
-
-struct DebugTargets {
-    counts: (wgpu::Texture, wgpu::TextureView),
-    overlay: (wgpu::Texture, wgpu::TextureView),
-}
-
 /// Stencil shadow volumes.
 pub struct ShadowVolumes {
     params: SvParams,
@@ -85,236 +55,6 @@ pub struct ShadowVolumes {
 }
 
 impl ShadowVolumes {
-    fn create_pipelines(&self, ctx: &RenderContext<'_>) -> Result<Pipelines, TechniqueError> {
-        let device = &ctx.gpu.device;
-        let stencil_module = ctx.shaders.create_module(device, "sv-zfail/stencil.wgsl")?;
-        let generator = VolumeGenerator::new(ctx, "sv-zfail")?;
-
-        let count_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sv-zfail count level layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(4),
-                },
-                count: None,
-            }],
-        });
-        let frame_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sv-zfail render pipeline layout"),
-            bind_group_layouts: &[Some(&ctx.frame.layout)],
-            immediate_size: 0,
-        });
-        let count_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("sv-zfail count pipeline layout"),
-                bind_group_layouts: &[Some(&ctx.frame.layout), Some(&count_layout)],
-                immediate_size: 0,
-            });
-
-        let keep = wgpu::StencilOperation::Keep;
-        let face = |compare, pass_op, depth_fail_op| wgpu::StencilFaceState {
-            compare,
-            fail_op: keep,
-            depth_fail_op,
-            pass_op,
-        };
-        let target = |format, write_mask, blend| {
-            Some(wgpu::ColorTargetState {
-                format,
-                blend,
-                write_mask,
-            })
-        };
-        let volume_primitive = volume_primitive();
-        let bias = wgpu::DepthBiasState {
-            constant: self.params.depth_bias as i32,
-            slope_scale: self.params.slope_bias,
-            clamp: 0.0,
-        };
-        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("sv-zfail volume stencil pipeline"),
-            layout: Some(&frame_layout),
-            vertex: wgpu::VertexState {
-                module: &stencil_module,
-                entry_point: Some("vs_volume"),
-                compilation_options: Default::default(),
-                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
-            },
-            primitive: volume_primitive,
-            depth_stencil: Some(volume_depth_stencil(self.params.counting, bias)),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &stencil_module,
-                entry_point: Some("fs_volume"),
-                compilation_options: Default::default(),
-                targets: &[target(VISIBILITY_FORMAT, wgpu::ColorWrites::empty(), None)],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let test = |compare| face(compare, keep, keep);
-        let fullscreen = |label: &str,
-                          layout: &wgpu::PipelineLayout,
-                          entry: &str,
-                          compare,
-                          targets: &[Option<wgpu::ColorTargetState>]| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(layout),
-                vertex: wgpu::VertexState {
-                    module: &stencil_module,
-                    entry_point: Some("fullscreen_vs"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: Some(stencil_state(
-                    wgpu::CompareFunction::Always,
-                    test(compare),
-                    test(compare),
-                    Default::default(),
-                )),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &stencil_module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    targets,
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let resolve = fullscreen(
-            "sv-zfail resolve pipeline",
-            &frame_layout,
-            "fs_shadowed",
-            wgpu::CompareFunction::NotEqual,
-            &[Some(zoo_host::kit::slot_target())],
-        );
-        let debug_targets = |count_writes, overlay_writes, blend| {
-            [
-                target(COUNTS_FORMAT, count_writes, None),
-                target(OVERLAY_FORMAT, overlay_writes, blend),
-            ]
-        };
-        let count_targets = debug_targets(wgpu::ColorWrites::ALL, wgpu::ColorWrites::empty(), None);
-        let count_equal = fullscreen(
-            "sv-zfail stencil count pipeline (equal)",
-            &count_pipeline_layout,
-            "fs_count",
-            wgpu::CompareFunction::Equal,
-            &count_targets,
-        );
-        let count_any = fullscreen(
-            "sv-zfail stencil count pipeline (any)",
-            &count_pipeline_layout,
-            "fs_count",
-            wgpu::CompareFunction::NotEqual,
-            &count_targets,
-        );
-        let additive = wgpu::BlendState {
-            color: wgpu::BlendComponent {
-                src_factor: wgpu::BlendFactor::One,
-                dst_factor: wgpu::BlendFactor::One,
-                operation: wgpu::BlendOperation::Add,
-            },
-            alpha: wgpu::BlendComponent::REPLACE,
-        };
-        let overlay = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("sv-zfail volume overlay pipeline"),
-            layout: Some(&frame_layout),
-            vertex: wgpu::VertexState {
-                module: &stencil_module,
-                entry_point: Some("vs_volume"),
-                compilation_options: Default::default(),
-                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
-            },
-            primitive: volume_primitive,
-            depth_stencil: Some(stencil_state(
-                wgpu::CompareFunction::Always,
-                test(wgpu::CompareFunction::Always),
-                test(wgpu::CompareFunction::Always),
-                Default::default(),
-            )),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &stencil_module,
-                entry_point: Some("fs_volume_debug"),
-                compilation_options: Default::default(),
-                targets: &debug_targets(
-                    wgpu::ColorWrites::empty(),
-                    wgpu::ColorWrites::ALL,
-                    Some(additive),
-                ),
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        Ok(Pipelines {
-            generator,
-            volume,
-            resolve,
-            overlay,
-            count_equal,
-            count_any,
-            count_layout,
-        })
-    }
-
-    fn create_buffers(&self, ctx: &RenderContext<'_>) -> Buffers {
-        let device = &ctx.gpu.device;
-        let pipelines = self.pipelines.as_ref().expect("pipelines exist");
-        let stats = std::sync::Mutex::new(ReadbackRing::new(
-            device,
-            "sv-zfail workload counters",
-            ctx.lights.len() as u64 * ARGS_BYTES,
-            3,
-        ));
-        let level_data: Vec<u32> = std::iter::once(11)
-            .chain(COUNT_LEVELS.iter().enumerate().map(|(i, _)| i as u32 + 1))
-            .flat_map(|value| std::iter::once(value).chain(std::iter::repeat_n(0, 63)))
-            .collect();
-        let levels = wgpu::util::DeviceExt::create_buffer_init(
-            device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("sv-zfail count levels"),
-                contents: bytemuck::cast_slice(&level_data),
-                usage: wgpu::BufferUsages::UNIFORM,
-            },
-        );
-        let levels_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sv-zfail count levels bind group"),
-            layout: &pipelines.count_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &levels,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(4),
-                }),
-            }],
-        });
-        Buffers {
-            stats,
-            levels_bind_group,
-        }
-    }
-
-    fn create_debug_targets(device: &wgpu::Device, size: zoo_host::glam::UVec2) -> DebugTargets {
-        let make = |label: &str, format| {
-            zoo_host::gpu::render_target(device, label, size, format, wgpu::TextureUsages::empty())
-        };
-        DebugTargets {
-            counts: make("sv-zfail stencil counts", COUNTS_FORMAT),
-            overlay: make("sv-zfail volumes overlay", OVERLAY_FORMAT),
-        }
-    }
-
     /// Silhouette edges and volume triangles per light from the newest frame whose counters
     /// have arrived (empty until one has; never waits for the GPU).
     pub fn workload(&self) -> Vec<(u32, u32)> {
@@ -383,7 +123,7 @@ impl ShadowTechnique for ShadowVolumes {
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError> {
         if self.pipelines.is_none() {
-            self.pipelines = Some(self.create_pipelines(ctx)?);
+            self.pipelines = Some(Pipelines::new(ctx, &self.params)?);
         }
         // Volume buffers and the counter ring depend on the scene and the number of lights,
         // not on where the lights are (moving one keeps its counters coming).
@@ -392,10 +132,13 @@ impl ShadowTechnique for ShadowVolumes {
             self.lights = ctx.lights.len();
             let generator = &mut self.pipelines.as_mut().expect("created above").generator;
             generator.prepare(ctx, self.params.volumes);
-            self.buffers = Some(self.create_buffers(ctx));
+            self.buffers = Some(Buffers::new(
+                ctx,
+                self.pipelines.as_ref().expect("built above"),
+            ));
         }
         if changes.resolution || self.debug.is_none() {
-            self.debug = Some(Self::create_debug_targets(&ctx.gpu.device, ctx.size));
+            self.debug = Some(DebugTargets::new(&ctx.gpu.device, ctx.size));
         }
         Ok(())
     }
