@@ -18,9 +18,10 @@ const FILTER_PCF5X5: u32 = 3u;
 const FILTER_POISSON: u32 = 4u;
 const FILTER_PCSS: u32 = 5u;
 
+// Per-light settings; everything that changes from frame to frame (the layer's matrices)
+// is read from the layer cameras instead, because lavapipe recompiles a shader whose
+// uniforms it inlined whenever their values change.
 struct WarpedLight {
-    // The layer's clip space back to world space (for PCSS blocker positions).
-    inv_view_proj: mat4x4<f32>,
     // Index of the scene light.
     light: u32,
     layer: u32,
@@ -83,7 +84,8 @@ fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     let ndc = vec2<f32>(m.uv.x * 2.0 - 1.0, 1.0 - m.uv.y * 2.0);
-    let stored = warped.inv_view_proj * vec4<f32>(ndc, stored_map_depth(m), 1.0);
+    let inverse = layer_cameras[warped.layer].camera.inv_view_proj;
+    let stored = inverse * vec4<f32>(ndc, stored_map_depth(m), 1.0);
     let blocker = stored.xyz / stored.w;
     return vec3<f32>(1.0, light_distance(looked_up, p), light_distance(looked_up, blocker));
 }

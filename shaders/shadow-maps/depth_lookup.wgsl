@@ -8,7 +8,7 @@
 // One layer's camera in a 256-byte slot of the depth pass's uniform buffer.
 struct CameraSlot {
     camera: LayerCamera,
-    _pad: array<vec4<f32>, 11>,
+    _pad: array<vec4<f32>, 7>,
 }
 
 @group(3) @binding(0) var depth_maps: texture_depth_2d_array;

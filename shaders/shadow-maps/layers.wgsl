@@ -7,6 +7,8 @@ struct LayerCamera {
     view_proj: mat4x4<f32>,
     // Perspective layers: the light's position and 1 / far. Orthographic layers: w = 0.
     eye: vec4<f32>,
+    // Clip space back to world space (to unproject stored depths).
+    inv_view_proj: mat4x4<f32>,
 }
 
 // The light-space depth of `world` that moment maps store: distance to the light over far

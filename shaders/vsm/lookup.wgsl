@@ -28,7 +28,7 @@ struct VsmLight {
 // One layer's camera in a 256-byte slot of the depth pass's uniform buffer.
 struct CameraSlot {
     camera: LayerCamera,
-    _pad: array<vec4<f32>, 11>,
+    _pad: array<vec4<f32>, 7>,
 }
 
 @group(2) @binding(0) var<uniform> vsm: VsmLight;

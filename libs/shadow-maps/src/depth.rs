@@ -23,6 +23,8 @@ pub struct LayerCamera {
     pub view_proj: [f32; 16],
     /// Perspective layers: the light's position and 1 / far; orthographic layers: w = 0.
     pub eye: [f32; 4],
+    /// Clip space back to world space (to unproject stored depths).
+    pub inv_view_proj: [f32; 16],
 }
 
 impl LayerCamera {
@@ -37,6 +39,7 @@ impl LayerCamera {
         LayerCamera {
             view_proj: frustum.view_proj.to_cols_array(),
             eye: eye.to_array(),
+            inv_view_proj: frustum.view_proj.inverse().to_cols_array(),
         }
     }
 }
@@ -323,7 +326,11 @@ mod tests {
             .compose("shadow-maps/depth.wgsl")
             .unwrap()
             .source;
-        let (size, fields) = zoo_host::mirror_fields!(LayerCamera { view_proj, eye });
+        let (size, fields) = zoo_host::mirror_fields!(LayerCamera {
+            view_proj,
+            eye,
+            inv_view_proj
+        });
         check_mirror(&source, "LayerCamera", size, &fields, SizeRule::Equal).unwrap();
         assert_eq!(CAMERA_STRIDE % 256, 0, "a dynamic-offset slot");
         assert!(size as u64 <= CAMERA_STRIDE);

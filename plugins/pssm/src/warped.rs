@@ -176,7 +176,6 @@ impl LayerPlan for WarpedLayers {
 #[bytemuck(crate = "zoo_host::bytemuck")]
 #[repr(C)]
 struct WarpedLight {
-    inv_view_proj: [f32; 16],
     light: u32,
     layer: u32,
     filter_mode: u32,
@@ -361,7 +360,6 @@ impl ShadowTechnique for WarpedMaps {
                     _ => light.radius,
                 };
                 WarpedLight {
-                    inv_view_proj: l.frustums[0].view_proj.inverse().to_cols_array(),
                     light: l.light as u32,
                     layer: l.first_layer,
                     filter_mode,
@@ -488,7 +486,6 @@ mod tests {
             .unwrap()
             .source;
         let (size, fields) = zoo_host::mirror_fields!(WarpedLight {
-            inv_view_proj,
             light,
             layer,
             filter_mode,
