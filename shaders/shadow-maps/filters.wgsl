@@ -11,6 +11,8 @@
 // rays at p, so taps are placed in world space and each is projected by itself (seamless
 // across cube faces).
 
+#import "shadow-maps/layers.wgsl"
+
 // Poisson disc, 16 points in the unit disk, minimum spacing 0.423.
 const POISSON_16: array<vec2<f32>, 16> = array<vec2<f32>, 16>(
     vec2<f32>(0.0118, -0.1794),
@@ -67,12 +69,6 @@ const POISSON_32: array<vec2<f32>, 32> = array<vec2<f32>, 32>(
     vec2<f32>(-0.0765, 0.4555),
 );
 
-// Two unit vectors perpendicular to the ray direction `w` and to each other.
-fn tangent_frame(w: vec3<f32>) -> mat2x3<f32> {
-    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(w.x) > 0.9);
-    let u = normalize(cross(w, helper));
-    return mat2x3<f32>(u, cross(w, u));
-}
 
 fn interleaved_gradient_noise(pixel: vec2<f32>) -> f32 {
     return fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));

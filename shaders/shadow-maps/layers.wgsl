@@ -1,5 +1,6 @@
 // Shadow-map layers as lookups see them: each layer's camera, the depth that moment maps
-// store, and the cube face a direction falls in. No bindings: the importer binds the cameras.
+// store, the cube face a direction falls in, and a tangent frame across a light ray. No
+// bindings: the importer binds the cameras.
 
 // One layer's camera (the depth pass's uniform; an array element of 256-byte slots for
 // lookups).
@@ -41,4 +42,11 @@ fn light_layer(first_layer: u32, layer_count: u32, light_position: vec3<f32>, p:
         return first_layer + cube_face(p - light_position);
     }
     return first_layer;
+}
+
+// Two unit vectors perpendicular to the ray direction `w` and to each other.
+fn tangent_frame(w: vec3<f32>) -> mat2x3<f32> {
+    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(w.x) > 0.9);
+    let u = normalize(cross(w, helper));
+    return mat2x3<f32>(u, cross(w, u));
 }

@@ -2,18 +2,7 @@
 
 #import "common/frame.wgsl"
 #import "common/fullscreen.wgsl"
-
-@vertex
-fn vs_volume(@location(0) position: vec4<f32>) -> @builtin(position) vec4<f32> {
-    // w = 0 vertices are points at infinity; depth is unclipped (clamped) on this pipeline.
-    return camera.view_proj * position;
-}
-
-// Volumes only touch the stencil.
-@fragment
-fn fs_volume() -> @location(0) vec4<f32> {
-    return vec4<f32>(0.0);
-}
+#import "shadow-volumes/draw.wgsl"
 
 // Debug pass outputs: stencil counts (integer) and translucent volumes (additive colour).
 struct DebugOut {

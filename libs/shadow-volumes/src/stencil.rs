@@ -51,6 +51,24 @@ pub fn volume_depth_stencil(
     stencil_state(wgpu::CompareFunction::Less, front, back, bias)
 }
 
+/// Counting like z-fail against a depth image in which only marked pixels hold the scene's
+/// depth and all others hold 1 (the hybrid technique's edge band): a volume fragment behind the
+/// surface passes the `Greater` test (back faces increment, front faces decrement), and at
+/// pixels holding 1 every fragment fails, so early depth tests reject it before any stencil
+/// or fragment work.
+pub fn band_volume_depth_stencil(bias: wgpu::DepthBiasState) -> wgpu::DepthStencilState {
+    let keep = wgpu::StencilOperation::Keep;
+    let face = |pass_op| wgpu::StencilFaceState {
+        compare: wgpu::CompareFunction::Always,
+        fail_op: keep,
+        depth_fail_op: keep,
+        pass_op,
+    };
+    let front = face(wgpu::StencilOperation::DecrementWrap);
+    let back = face(wgpu::StencilOperation::IncrementWrap);
+    stencil_state(wgpu::CompareFunction::Greater, front, back, bias)
+}
+
 /// A state on the G-buffer's depth-stencil that tests depth with `depth_compare` (never
 /// writing it) and applies the `front` and `back` stencil faces: the volume draw, and the
 /// passes that read its counts.

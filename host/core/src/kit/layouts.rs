@@ -146,30 +146,58 @@ pub fn slot_fullscreen_pipeline_with(
     groups: &[&wgpu::BindGroupLayout],
     more_targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
-    let layout = pipeline_layout(ctx, &format!("{label} layout"), groups);
-    let mut targets = vec![Some(super::slot_target())];
-    targets.extend_from_slice(more_targets);
-    ctx.gpu
-        .device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some("fullscreen_vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+    SlotPipeline {
+        label,
+        module,
+        entry,
+        groups,
+        more_targets,
+        depth_stencil: None,
+    }
+    .build(ctx)
+}
+
+/// A full-screen pipeline that writes visibility slots, in full: the host's groups and then
+/// `groups`, colour targets after the slot, and a depth-stencil state (for passes that write
+/// depth or test the stencil of a depth-stencil attachment).
+pub struct SlotPipeline<'a> {
+    pub label: &'a str,
+    /// Holds `common/fullscreen.wgsl`'s vertex stage and fragment `entry`.
+    pub module: &'a wgpu::ShaderModule,
+    pub entry: &'a str,
+    pub groups: &'a [&'a wgpu::BindGroupLayout],
+    pub more_targets: &'a [Option<wgpu::ColorTargetState>],
+    pub depth_stencil: Option<wgpu::DepthStencilState>,
+}
+
+impl SlotPipeline<'_> {
+    /// Creates the pipeline.
+    pub fn build(&self, ctx: &RenderContext<'_>) -> wgpu::RenderPipeline {
+        let layout = pipeline_layout(ctx, &format!("{} layout", self.label), self.groups);
+        let mut targets = vec![Some(super::slot_target())];
+        targets.extend_from_slice(self.more_targets);
+        ctx.gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(self.label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: self.module,
+                    entry_point: Some("fullscreen_vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: self.depth_stencil.clone(),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: self.module,
+                    entry_point: Some(self.entry),
+                    compilation_options: Default::default(),
+                    targets: &targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+    }
 }

@@ -18,8 +18,8 @@ pub mod slot;
 pub mod uniforms;
 
 pub use layouts::{
-    bind_group, bind_group_layout, pipeline_layout, sampler, slot_fullscreen_pipeline,
-    slot_fullscreen_pipeline_with, storage, texture, uniform,
+    SlotPipeline, bind_group, bind_group_layout, pipeline_layout, sampler,
+    slot_fullscreen_pipeline, slot_fullscreen_pipeline_with, storage, texture, uniform,
 };
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use slot::{LightSlot, slot_target};

@@ -1,0 +1,239 @@
+//! Triangle-id maps: each shadow-map layer rendered once more from its camera with vertices
+//! pulled from the scene's storage buffers, writing depth and the index of the front-most
+//! caster triangle per texel (`shaders/hybrid-edge/ids.wgsl`). They replace the shadow-map
+//! library's depth pass, so the depth maps and the ids come from one rasterisation.
+
+use zoo_host::gpu::PassRecorder;
+use zoo_host::kit::{bind_group, bind_group_layout, storage, texture};
+use zoo_host::{RenderContext, TechniqueResult, wgpu};
+use zoo_shadow_maps::{CAMERA_STRIDE, DepthState, LayerCamera, LightMaps, MAP_FORMAT, MapArray};
+
+use crate::NO_TRIANGLE;
+
+/// The id maps of one set of depth maps, and the bind groups over them.
+struct Bound {
+    /// The depth maps and layer cameras these were made for.
+    depth: wgpu::Texture,
+    cameras: wgpu::Buffer,
+    ids: MapArray,
+    camera_group: wgpu::BindGroup,
+    lookup_group: wgpu::BindGroup,
+}
+
+/// The id pass's pipeline and its bindings.
+pub(crate) struct IdMaps {
+    pipeline: wgpu::RenderPipeline,
+    camera_layout: wgpu::BindGroupLayout,
+    /// Group 4 of `fs_band_ids`: the ids, the scene's vertices and indices.
+    pub(crate) lookup_layout: wgpu::BindGroupLayout,
+    bound: Option<Bound>,
+}
+
+impl IdMaps {
+    /// Builds the pipeline with the depth maps' rasterisation `state`.
+    pub(crate) fn new(ctx: &RenderContext<'_>, state: DepthState) -> TechniqueResult<IdMaps> {
+        let device = &ctx.gpu.device;
+        let module = ctx.shaders.create_module(device, "hybrid-edge/ids.wgsl")?;
+        let vertex = wgpu::ShaderStages::VERTEX;
+        let camera_layout = bind_group_layout(
+            device,
+            "hybrid id map camera layout",
+            &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: vertex,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
+                    },
+                    count: None,
+                },
+                storage(1, vertex, true),
+                storage(2, vertex, true),
+                storage(3, vertex, true),
+            ],
+        );
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let lookup_layout = bind_group_layout(
+            device,
+            "hybrid id lookup layout",
+            &[
+                texture(
+                    0,
+                    fragment,
+                    wgpu::TextureSampleType::Uint,
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                storage(1, fragment, true),
+                storage(2, fragment, true),
+            ],
+        );
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("hybrid id map pipeline layout"),
+            bind_group_layouts: &[Some(&ctx.frame.layout), Some(&camera_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("hybrid id map pipeline"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_ids"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: state.cull_front.then_some(wgpu::Face::Front),
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: MAP_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                stencil: Default::default(),
+                bias: wgpu::DepthBiasState {
+                    constant: state.constant_bias,
+                    slope_scale: state.slope_bias,
+                    clamp: 0.0,
+                },
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_ids"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(IdMaps {
+            pipeline,
+            camera_layout,
+            lookup_layout,
+            bound: None,
+        })
+    }
+
+    /// Makes id maps and bind groups for `depth` (the depth maps) and `cameras` (their layer
+    /// cameras) when they changed.
+    pub(crate) fn prepare(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        depth: &MapArray,
+        cameras: &wgpu::Buffer,
+    ) {
+        let current = self
+            .bound
+            .as_ref()
+            .is_some_and(|b| b.depth == depth.texture && &b.cameras == cameras);
+        if current {
+            return;
+        }
+        let device = &ctx.gpu.device;
+        let ids = MapArray::with_format(
+            ctx.gpu,
+            "hybrid triangle ids",
+            depth.resolution,
+            depth.layers,
+            wgpu::TextureFormat::R32Uint,
+        );
+        let buffers = ctx.scene_buffers;
+        let camera_group = bind_group(
+            device,
+            "hybrid id map cameras",
+            &self.camera_layout,
+            &[
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: cameras,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
+                }),
+                buffers.vertices.as_entire_binding(),
+                buffers.indices.as_entire_binding(),
+                buffers.triangle_objects.as_entire_binding(),
+            ],
+        );
+        let lookup_group = bind_group(
+            device,
+            "hybrid id lookup",
+            &self.lookup_layout,
+            &[
+                wgpu::BindingResource::TextureView(&ids.array_view),
+                buffers.vertices.as_entire_binding(),
+                buffers.indices.as_entire_binding(),
+            ],
+        );
+        self.bound = Some(Bound {
+            depth: depth.texture.clone(),
+            cameras: cameras.clone(),
+            ids,
+            camera_group,
+            lookup_group,
+        });
+    }
+
+    /// The band pass's group 4, once prepared.
+    pub(crate) fn lookup_group(&self) -> Option<&wgpu::BindGroup> {
+        self.bound.as_ref().map(|b| &b.lookup_group)
+    }
+
+    /// The id maps, once prepared.
+    pub(crate) fn maps(&self) -> Option<&MapArray> {
+        self.bound.as_ref().map(|b| &b.ids)
+    }
+
+    /// Renders every layer of `lights` into `depth` and the id maps, one pass each named by
+    /// `name(light, layer)`.
+    pub(crate) fn record(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        depth: &MapArray,
+        lights: &[LightMaps],
+        name: impl Fn(&LightMaps, usize) -> String,
+    ) -> TechniqueResult {
+        let bound = self
+            .bound
+            .as_ref()
+            .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
+        let none = NO_TRIANGLE as f64;
+        let clear = wgpu::Color {
+            r: none,
+            g: none,
+            b: none,
+            a: none,
+        };
+        for light_maps in lights {
+            for k in 0..light_maps.frustums.len() {
+                let layer = light_maps.first_layer as usize + k;
+                let label = name(light_maps, k);
+                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(&label),
+                    color_attachments: &[zoo_host::gpu::color_attachment(
+                        &bound.ids.layer_views[layer],
+                        wgpu::LoadOp::Clear(clear),
+                    )],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth.layer_views[layer],
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+                let offset = (layer as u64 * CAMERA_STRIDE) as u32;
+                pass.set_bind_group(1, &bound.camera_group, &[offset]);
+                pass.draw(0..ctx.scene_buffers.index_count, 0..1);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,511 @@
+//! Hybrid shadows (seed 003): shadow maps decide every pixel they can, shadow volumes resolve
+//! only the band along shadow edges where the map cannot.
+//!
+//! Per light: (1) a shadow map from the shadow-map library; (2) a full-screen pass classifies
+//! each pixel from its (2r + 1)² shadow-map neighbourhood (nearest comparisons one texel apart)
+//! into lit, shadowed or edge, writes the visibility of lit and shadowed pixels, and writes the
+//! edge pixels' depth into a depth image whose other pixels hold 1; (3) the light's shadow
+//! volumes (from the shadow-volume library) are counted like z-fail against that image with a
+//! `Greater` depth test, so outside the band every volume fragment fails the early depth test
+//! instead of being counted; (4) edge pixels with a non-zero count are shadowed.
+//!
+//! Restriction methods, a parameter:
+//! - `DepthBand` (default): the volumes above, rejected outside the band by the depth test;
+//! - `TriangleIds`: the map pass also stores the id of the front-most triangle in each texel,
+//!   and edge pixels test their light ray exactly against the triangles of their
+//!   neighbourhood (seed 003's future-work idea), so no volume is rasterised at all (exact
+//!   unless an occluder is thinner than a texel or hidden behind another in the map);
+//! - `Everywhere`: every pixel in the band (plain shadow volumes through the same passes), to
+//!   measure what the restriction saves.
+
+mod ids;
+
+use zoo_host::gpu::PassRecorder;
+use zoo_host::gpu::layout::ChoiceCodes;
+use zoo_host::kit::{SlotPipeline, UniformSlots, light_pass_name, pipeline_layout};
+use zoo_host::prelude::*;
+use zoo_host::render::gbuffer::DEPTH_FORMAT;
+use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+use zoo_shadow_maps::{DepthState, LightMaps, ShadowMapSet, layer_pass_name};
+
+use ids::IdMaps;
+use zoo_shadow_volumes::{
+    VOLUME_VERTEX_LAYOUT, VolumeGenerator, Volumes, band_volume_depth_stencil, stencil_state,
+    volume_primitive,
+};
+
+zoo_host::param_choice! {
+    /// Where shadow volumes are counted.
+    pub enum Restriction { DepthBand, Everywhere, TriangleIds }
+}
+
+zoo_host::technique_params! {
+    /// Parameters of the hybrid shadow-map / shadow-volume technique.
+    pub struct HybridParams {
+        /// Shadow-map resolution in texels per side.
+        map_size: u32 = 2048, range(256, 8192), step(256);
+        /// Neighbourhood radius r in texels: (2r + 1)² taps decide lit, shadowed or edge.
+        radius: u32 = 1, range(1, 4), step(1);
+        /// How edge pixels are resolved: exact tests against the map's triangle ids, volumes
+        /// restricted to the band by a depth image, or volumes everywhere.
+        restriction: Restriction = Restriction::DepthBand;
+        /// Slope-scaled depth bias of the shadow map.
+        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
+        /// Normal offset of the classification taps, in texels.
+        normal_offset: f32 = 1.0, range(0.0, 8.0), step(0.1);
+        /// Constant depth bias pushing volume faces back (depth-buffer units).
+        volume_bias: u32 = 16, range(0, 65536), step(1);
+        /// Light whose classification the debug view shows.
+        debug_light: u32 = 0, range(0, 1023), step(1);
+    }
+}
+
+/// `EdgeLight` in `hybrid-edge/band.wgsl`.
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+struct EdgeLight {
+    light: u32,
+    first_layer: u32,
+    layer_count: u32,
+    radius: u32,
+    texel_scale: f32,
+    perspective: u32,
+    normal_offset: f32,
+    restriction: u32,
+}
+
+const SHADER: &str = "hybrid-edge/band.wgsl";
+const IDS_PASS: &str = "Hybrid id map";
+/// The id of texels no triangle covers.
+const NO_TRIANGLE: u32 = u32::MAX;
+const MAP_PASS: &str = "Hybrid map";
+const BAND_PASS: &str = "Hybrid band";
+const GENERATION_PASS: &str = "Hybrid volume generation";
+const VOLUME_PASS: &str = "Hybrid volumes";
+const CLASS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+const CLASS_VIEW: &str = "classification";
+
+/// Screen-sized targets: the band's depth-stencil and the classification colours.
+struct Targets {
+    band: (wgpu::Texture, wgpu::TextureView),
+    class: (wgpu::Texture, wgpu::TextureView),
+}
+
+impl Targets {
+    fn new(device: &wgpu::Device, size: zoo_host::glam::UVec2) -> Targets {
+        let target = |label, format| {
+            zoo_host::gpu::render_target(device, label, size, format, wgpu::TextureUsages::empty())
+        };
+        Targets {
+            band: target("hybrid band depth-stencil", DEPTH_FORMAT),
+            class: target("hybrid classification", CLASS_FORMAT),
+        }
+    }
+}
+
+/// Maps, volumes, pipelines and targets, built at the first `prepare`.
+struct Gpu {
+    maps: ShadowMapSet,
+    generator: VolumeGenerator,
+    uniforms: UniformSlots<EdgeLight>,
+    /// Without and with the classification written: volumes next, or exact id tests.
+    band: [wgpu::RenderPipeline; 2],
+    band_ids: [wgpu::RenderPipeline; 2],
+    ids: IdMaps,
+    /// The band shader's value of each `Restriction`.
+    restriction_codes: ChoiceCodes,
+    volume: wgpu::RenderPipeline,
+    resolve: wgpu::RenderPipeline,
+    targets: Targets,
+    /// Lights the volume buffers were made for.
+    lights: usize,
+}
+
+/// Writes the band's depth (compare always), leaves the stencil for the volumes.
+fn band_depth_state() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+impl Gpu {
+    fn new(ctx: &RenderContext<'_>, p: &HybridParams) -> TechniqueResult<Gpu> {
+        let state = DepthState {
+            constant_bias: 0,
+            slope_bias: p.slope_bias,
+            cull_front: false,
+        };
+        let maps = ShadowMapSet::new(ctx, "hybrid shadow maps", state, None)?;
+        let generator = VolumeGenerator::new(ctx, "hybrid")?;
+        let ids = IdMaps::new(ctx, state)?;
+        let stage = wgpu::ShaderStages::FRAGMENT;
+        let uniforms = UniformSlots::new(ctx.gpu, "hybrid lights", ctx.lights.len(), stage);
+        let device = &ctx.gpu.device;
+        let module = ctx.shaders.create_module(device, SHADER)?;
+        let draw_module = ctx
+            .shaders
+            .create_module(device, "shadow-volumes/draw.wgsl")?;
+        let source = ctx.shaders.compose(SHADER)?.source;
+        let restriction_codes = ChoiceCodes::read(&source, "RESTRICTION", Restriction::NAMES)
+            .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
+        let groups = [uniforms.layout(), maps.lookup_layout()];
+        let id_groups = [uniforms.layout(), maps.lookup_layout(), &ids.lookup_layout];
+        let band_pipelines = |entry: &str, groups: &[&wgpu::BindGroupLayout]| {
+            [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|write_mask| {
+                let class = Some(wgpu::ColorTargetState {
+                    format: CLASS_FORMAT,
+                    blend: None,
+                    write_mask,
+                });
+                let debug = !write_mask.is_empty();
+                SlotPipeline {
+                    label: &format!("hybrid {entry} (classification {debug})"),
+                    module: &module,
+                    entry,
+                    groups,
+                    more_targets: &[class],
+                    depth_stencil: Some(band_depth_state()),
+                }
+                .build(ctx)
+            })
+        };
+        let band = band_pipelines("fs_band", &groups);
+        let band_ids = band_pipelines("fs_band_ids", &id_groups);
+        let bias = wgpu::DepthBiasState {
+            constant: p.volume_bias as i32,
+            slope_scale: 0.0,
+            clamp: 0.0,
+        };
+        let no_colour = Some(wgpu::ColorTargetState {
+            write_mask: wgpu::ColorWrites::empty(),
+            ..zoo_host::kit::slot_target()
+        });
+        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("hybrid volume pipeline"),
+            layout: Some(&pipeline_layout(ctx, "hybrid volume pipeline layout", &[])),
+            vertex: wgpu::VertexState {
+                module: &draw_module,
+                entry_point: Some("vs_volume"),
+                compilation_options: Default::default(),
+                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
+            },
+            primitive: volume_primitive(),
+            depth_stencil: Some(band_volume_depth_stencil(bias)),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &draw_module,
+                entry_point: Some("fs_volume"),
+                compilation_options: Default::default(),
+                targets: &[no_colour],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let keep = wgpu::StencilOperation::Keep;
+        let not_zero = wgpu::StencilFaceState {
+            compare: wgpu::CompareFunction::NotEqual,
+            fail_op: keep,
+            depth_fail_op: keep,
+            pass_op: keep,
+        };
+        let always = wgpu::CompareFunction::Always;
+        let resolve = SlotPipeline {
+            label: "hybrid resolve",
+            module: &module,
+            entry: "fs_shadowed",
+            groups: &[],
+            more_targets: &[],
+            depth_stencil: Some(stencil_state(
+                always,
+                not_zero,
+                not_zero,
+                Default::default(),
+            )),
+        }
+        .build(ctx);
+        Ok(Gpu {
+            maps,
+            generator,
+            uniforms,
+            band,
+            band_ids,
+            ids,
+            restriction_codes,
+            volume,
+            resolve,
+            targets: Targets::new(device, ctx.size),
+            lights: 0,
+        })
+    }
+}
+
+/// The band pass's uniform for one light's maps.
+fn edge_light(p: &HybridParams, maps: &LightMaps, resolution: u32) -> EdgeLight {
+    let scale = maps.scale(resolution);
+    EdgeLight {
+        light: maps.light as u32,
+        first_layer: maps.first_layer,
+        layer_count: maps.frustums.len() as u32,
+        radius: p.radius,
+        texel_scale: scale.texel_scale,
+        perspective: u32::from(scale.perspective),
+        normal_offset: p.normal_offset,
+        restriction: 0,
+    }
+}
+
+/// Hybrid shadow maps and shadow volumes.
+pub struct Hybrid {
+    params: HybridParams,
+    gpu: Option<Gpu>,
+}
+
+impl ShadowTechnique for Hybrid {
+    fn passes(&self) -> Vec<PassInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let exact = self.params.restriction == Restriction::TriangleIds;
+        let mut names = gpu.maps.pass_names(if exact { IDS_PASS } else { MAP_PASS });
+        let per_light: &[&str] = if exact {
+            &[BAND_PASS]
+        } else {
+            &[BAND_PASS, GENERATION_PASS, VOLUME_PASS]
+        };
+        for l in gpu.maps.lights() {
+            for base in per_light {
+                names.push(light_pass_name(base, l.light));
+            }
+        }
+        names
+            .into_iter()
+            .map(|name| match name.starts_with(GENERATION_PASS) {
+                true => PassInfo::compute(name),
+                false => PassInfo::render(name),
+            })
+            .collect()
+    }
+
+    fn resources(&self) -> Vec<ResourceInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut out = gpu.generator.resources();
+        if let Some(maps) = gpu.maps.maps() {
+            out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
+        }
+        out.push(ResourceInfo::texture(
+            CLASS_VIEW,
+            &gpu.targets.class.0,
+            true,
+        ));
+        out.push(ResourceInfo::texture(
+            "band depth-stencil",
+            &gpu.targets.band.0,
+            false,
+        ));
+        if let Some(ids) = gpu.ids.maps() {
+            out.push(ResourceInfo::texture("triangle ids", &ids.texture, false));
+        }
+        out
+    }
+
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
+        if self.gpu.is_none() {
+            self.gpu = Some(Gpu::new(ctx, &self.params)?);
+        }
+        let gpu = self.gpu.as_mut().expect("built above");
+        if changes.resolution {
+            gpu.targets = Targets::new(&ctx.gpu.device, ctx.size);
+        }
+        if changes.scene || ctx.lights.len() != gpu.lights || gpu.generator.volume().is_none() {
+            gpu.generator.prepare(ctx, Volumes::Silhouette);
+            gpu.lights = ctx.lights.len();
+        }
+        gpu.maps.prepare(ctx, changes, self.params.map_size, true);
+        if self.params.restriction == Restriction::TriangleIds
+            && let (Some(depth), Some(cameras)) = (gpu.maps.maps(), gpu.maps.cameras())
+        {
+            gpu.ids.prepare(ctx, depth, cameras);
+        }
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> TechniqueResult {
+        let p = &self.params;
+        let gpu = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        let group = gpu
+            .maps
+            .lookup_group()
+            .ok_or_else(TechniqueError::not_prepared)?;
+        let exact = p.restriction == Restriction::TriangleIds;
+        if exact {
+            let depth = gpu.maps.maps().ok_or_else(TechniqueError::not_prepared)?;
+            let name = |l: &LightMaps, k| layer_pass_name(IDS_PASS, l, k);
+            gpu.ids
+                .record(ctx, recorder, depth, gpu.maps.lights(), name)?;
+        } else {
+            gpu.maps.record(ctx, recorder, MAP_PASS)?;
+        }
+        let resolution = gpu.maps.resolution();
+        let debug = gpu.maps.debug_light(p.debug_light).map(|l| l.light);
+        let restriction = gpu.restriction_codes.code(p.restriction.index());
+        let values: Vec<EdgeLight> = (gpu.maps.lights().iter())
+            .map(|l| EdgeLight {
+                restriction,
+                ..edge_light(p, l, resolution)
+            })
+            .collect();
+        gpu.uniforms.write(ctx.gpu, &values);
+        for (k, light_maps) in gpu.maps.lights().iter().enumerate() {
+            let light = light_maps.light;
+            let band = &gpu.targets.band.1;
+            {
+                let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
+                let class = [zoo_host::gpu::color_attachment(&gpu.targets.class.1, clear)];
+                let depth = wgpu::RenderPassDepthStencilAttachment {
+                    view: band,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                };
+                let name = light_pass_name(BAND_PASS, light);
+                let mut pass = ctx.light_pass_with(recorder, &name, light, &class, Some(depth));
+                let pipelines = if exact { &gpu.band_ids } else { &gpu.band };
+                pass.set_pipeline(&pipelines[usize::from(Some(light) == debug)]);
+                pass.set_bind_group(2, gpu.uniforms.bind_group(), &[gpu.uniforms.offset(k)]);
+                pass.set_bind_group(3, group, &[]);
+                if exact {
+                    let ids = gpu
+                        .ids
+                        .lookup_group()
+                        .ok_or_else(TechniqueError::not_prepared)?;
+                    pass.set_bind_group(4, ids, &[]);
+                }
+                pass.draw(0..3, 0..1);
+            }
+            if exact {
+                continue;
+            }
+            let (Some(volume), Some(args)) = (gpu.generator.volume(), gpu.generator.args()) else {
+                return Err(TechniqueError::not_prepared());
+            };
+            let generation = light_pass_name(GENERATION_PASS, light);
+            gpu.generator.record(ctx, recorder, light, &generation)?;
+            let depth = wgpu::RenderPassDepthStencilAttachment {
+                view: band,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Discard,
+                }),
+            };
+            let name = light_pass_name(VOLUME_PASS, light);
+            let mut pass = ctx.light_pass(recorder, &name, light, Some(depth));
+            pass.set_pipeline(&gpu.volume);
+            pass.set_vertex_buffer(0, volume.slice(..));
+            pass.draw_indirect(args, 0);
+            pass.set_pipeline(&gpu.resolve);
+            pass.set_stencil_reference(0);
+            pass.draw(0..3, 0..1);
+        }
+        Ok(())
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+        let next = HybridParams::from_values(values)?;
+        // Biases live in the map and volume pipelines; the rest applies at the next frame.
+        let built = |p: &HybridParams| (p.slope_bias.to_bits(), p.volume_bias);
+        if built(&next) != built(&self.params) {
+            return Ok(ParamUpdate::Rebuild);
+        }
+        self.params = next;
+        Ok(ParamUpdate::Applied)
+    }
+
+    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let gpu = self.gpu.as_ref()?;
+        match resource {
+            CLASS_VIEW => Some(DebugImage {
+                view: &gpu.targets.class.1,
+                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
+            }),
+            "shadow maps" => {
+                let light = gpu.maps.debug_light(self.params.debug_light)?;
+                Some(DebugImage {
+                    view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
+                    mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
+                })
+            }
+            _ => None,
+        }
+    }
+}
+
+fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    let params = HybridParams::from_values(values)?;
+    Ok(Box::new(Hybrid { params, gpu: None }))
+}
+
+zoo_host::register_technique! {
+    id: "hybrid-edge",
+    name: "Hybrid shadow maps and volumes",
+    description: "Shadow maps classify lit, shadowed and edge pixels; shadow volumes (or exact tests against the map's triangle ids) resolve only the edge band",
+    source: "seed 003 (hybrid SM/SV at shadow edges)",
+    light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
+    required_features: || wgpu::Features::DEPTH_CLIP_CONTROL,
+    required_limits: || wgpu::Limits {
+        max_storage_buffers_per_shader_stage: 8,
+        max_bind_groups: 5,
+        ..wgpu::Limits::downlevel_defaults()
+    },
+    // Volumes are generated by compute shaders into storage buffers and drawn indirectly.
+    required_downlevel: || {
+        wgpu::DownlevelFlags::COMPUTE_SHADERS | wgpu::DownlevelFlags::INDIRECT_EXECUTION
+    },
+    params: HybridParams::schema,
+    create: create,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    #[test]
+    fn edge_light_mirrors_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose(SHADER)
+            .unwrap()
+            .source;
+        let (size, fields) = zoo_host::mirror_fields!(EdgeLight {
+            light,
+            first_layer,
+            layer_count,
+            radius,
+            texel_scale,
+            perspective,
+            normal_offset,
+            restriction
+        });
+        check_mirror(&source, "EdgeLight", size, &fields, SizeRule::Equal).unwrap();
+        ChoiceCodes::read(&source, "RESTRICTION", Restriction::NAMES).unwrap();
+    }
+}

@@ -1,0 +1,136 @@
+//! The hybrid technique against the reference judge, with sv-zfail's bound, and its
+//! classification against the reference's shadow boundaries.
+
+// Link the plugin so its technique registers.
+use zoo_plugin_hybrid_edge as _;
+
+use zoo_host::glam::UVec2;
+use zoo_host::judging::{DEFAULT_SAMPLES, SceneReference};
+use zoo_host::params::{ParamValues, apply_assignments, defaults};
+use zoo_host::test_support::{JudgeRun, Metric, gpu, judge, scene_path};
+use zoo_host::{Renderer, Scene, View};
+
+const SIZE: UVec2 = UVec2::new(256, 256);
+
+fn assert_volume_bounds(run: &JudgeRun) {
+    for light in 0..run.loaded.lights.len() {
+        let m = run.metrics(light);
+        let kind = run.loaded.lights[light].kind.name();
+        eprintln!("{} light {light} ({kind}): {m:?}", run.scene);
+        run.assert_bounds(
+            light,
+            &m,
+            &[
+                (Metric::FalseShadowCore, 0.001),
+                (Metric::FalseLitCore, 0.001),
+            ],
+        );
+    }
+}
+
+const SCENES: [&str; 4] = [
+    "planar-room.ron",
+    "curved.ron",
+    "inside-shadow.ron",
+    "dense.ron",
+];
+
+#[test]
+fn exact_edge_tests_hold_the_shadow_volume_bound() {
+    for scene in SCENES {
+        assert_volume_bounds(&judge(
+            scene,
+            "hybrid-edge",
+            &[("restriction", "TriangleIds")],
+            SIZE,
+        ));
+    }
+}
+
+#[test]
+fn banded_shadow_volumes_hold_the_shadow_volume_bound() {
+    for scene in SCENES {
+        assert_volume_bounds(&judge(
+            scene,
+            "hybrid-edge",
+            &[("restriction", "DepthBand")],
+            SIZE,
+        ));
+    }
+}
+
+fn values(assignments: &[(&str, &str)]) -> ParamValues {
+    let schema = (zoo_host::find_technique("hybrid-edge").unwrap().params)();
+    let mut values = defaults(&schema);
+    let assignments: Vec<(String, String)> = assignments
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    apply_assignments(&schema, &mut values, &assignments).unwrap();
+    values
+}
+
+/// Classes in the classification view by colour (`hybrid-edge/band.wgsl`'s CLASS_*).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Class {
+    Lit,
+    Shadowed,
+    Edge,
+    Other,
+}
+
+fn class_of(p: [u8; 4]) -> Class {
+    match p {
+        [r, g, b, _] if r > 200 && g > 200 && b > 120 => Class::Lit,
+        [r, g, _, _] if r > 200 && g < 100 => Class::Edge,
+        [r, _, b, _] if r < 80 && b > 90 => Class::Shadowed,
+        _ => Class::Other,
+    }
+}
+
+#[test]
+fn lit_and_shadowed_pixels_agree_with_the_reference_and_the_band_is_narrow() {
+    let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
+    let size = UVec2::new(192, 192);
+    for light in 0..scene.lights.len() {
+        let mut renderer = Renderer::new(gpu(), scene.clone(), size).unwrap();
+        let debug = light.to_string();
+        let params = values(&[("debug_light", &debug), ("map_size", "1024")]);
+        renderer.set_technique("hybrid-edge", &params).unwrap();
+        let reference = SceneReference::compute(&mut renderer, DEFAULT_SAMPLES, |_| {}).unwrap();
+        renderer
+            .render(&View::Resource("classification".into()))
+            .unwrap();
+        let image = renderer.read_output();
+        let hard = &reference.lights[light];
+        let (w, h) = (size.x as usize, size.y as usize);
+        let (mut counts, mut wrong) = ([0usize; 4], 0usize);
+        for i in (0..w * h).filter(|&i| hard.contributing[i]) {
+            let class = class_of(image.get_pixel((i % w) as u32, (i / w) as u32).0);
+            counts[class as usize] += 1;
+            let lit = hard.hard[i] >= 0.5;
+            wrong +=
+                usize::from((class == Class::Lit && !lit) || (class == Class::Shadowed && lit));
+        }
+        let total: usize = counts.iter().sum();
+        eprintln!(
+            "light {light}: lit {}, shadowed {}, edge {}, other {}; decided wrongly {wrong}",
+            counts[0], counts[1], counts[2], counts[3]
+        );
+        assert_eq!(counts[3], 0, "light {light}: unclassified lit pixels");
+        assert!(
+            counts[1] > 0 && counts[2] > 0,
+            "light {light} casts shadows in view"
+        );
+        // The map decides: its lit and shadowed pixels agree with the rays...
+        assert!(
+            (wrong as f64) <= 0.001 * total as f64,
+            "light {light}: {wrong} decided wrongly"
+        );
+        // ...and leaves little to the exact pass.
+        assert!(
+            (counts[2] as f64) < 0.1 * total as f64,
+            "light {light}: the band is not narrow"
+        );
+    }
+}

@@ -1,0 +1,239 @@
+// Hybrid shadows, pass 2: classify every pixel from its shadow-map neighbourhood
+// ((2r + 1)² nearest depth comparisons one texel apart): all lit is lit, all shadowed is
+// shadowed, mixed is the edge band. Lit and shadowed pixels get their visibility here.
+// Edge pixels are resolved exactly, depending on the restriction:
+// - depth band (`fs_band`): edge pixels are left lit and get their own depth in the band's
+//   depth image (every other pixel holds 1), so the shadow volumes drawn next are rejected
+//   outside the band by the depth test; `everywhere` puts every pixel in the band;
+// - triangle ids (`fs_band_ids`): the light ray of an edge pixel is tested against the
+//   triangles the shadow map saw nearest the light in the pixel's neighbourhood (seed 003's
+//   future-work idea): no volumes at all.
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "common/fullscreen.wgsl"
+#import "shadow-maps/depth_lookup.wgsl"
+
+struct EdgeLight {
+    // Index of the scene light.
+    light: u32,
+    first_layer: u32,
+    // 1 (spot, directional) or 6 (point: cube faces).
+    layer_count: u32,
+    // Neighbourhood radius r in texels.
+    radius: u32,
+    // World size of a texel: per unit of distance along the layer's axis (perspective) or
+    // absolute (orthographic).
+    texel_scale: f32,
+    perspective: u32,
+    // Lookups move off the surface by this many texels.
+    normal_offset: f32,
+    // Restriction (RESTRICTION_* below).
+    restriction: u32,
+}
+
+// Restrictions, one per variant of the Rust `Restriction` parameter.
+const RESTRICTION_DEPTHBAND: u32 = 0u;
+const RESTRICTION_EVERYWHERE: u32 = 1u;
+const RESTRICTION_TRIANGLEIDS: u32 = 2u;
+
+@group(2) @binding(0) var<uniform> edge: EdgeLight;
+
+const CLASS_LIT: vec4<f32> = vec4<f32>(0.95, 0.9, 0.6, 1.0);
+const CLASS_SHADOWED: vec4<f32> = vec4<f32>(0.15, 0.2, 0.45, 1.0);
+const CLASS_EDGE: vec4<f32> = vec4<f32>(1.0, 0.2, 0.2, 1.0);
+
+// World size of one map texel at p.
+fn texel_world(light: Light, p: vec3<f32>) -> f32 {
+    if edge.perspective == 0u {
+        return edge.texel_scale;
+    }
+    let d = p - light.position;
+    if edge.layer_count == 6u {
+        let a = abs(d);
+        return edge.texel_scale * max(a.x, max(a.y, a.z));
+    }
+    return edge.texel_scale * dot(d, light.direction);
+}
+
+// Number of lit taps in the (2r + 1)² neighbourhood of p.
+fn lit_taps(light: Light, p: vec3<f32>, texel: f32) -> u32 {
+    var w = light.direction;
+    if light.kind != LIGHT_DIRECTIONAL {
+        w = normalize(p - light.position);
+    }
+    let frame = tangent_frame(w);
+    let r = i32(edge.radius);
+    var lit = 0u;
+    for (var j = -r; j <= r; j++) {
+        for (var i = -r; i <= r; i++) {
+            let q = p + (frame[0] * f32(i) + frame[1] * f32(j)) * texel;
+            let layer = light_layer(edge.first_layer, edge.layer_count, light.position, q);
+            lit += u32(compare_map(map_point(layer, q), false) > 0.5);
+        }
+    }
+    return lit;
+}
+
+struct BandOut {
+    @location(0) visibility: vec4<f32>,
+    @location(1) classification: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+// What the neighbourhood says about one pixel.
+struct Classified {
+    // 0: not lit by the light at all (or background), 1: lit, 2: shadowed, 3: edge.
+    kind: u32,
+    surface: Surface,
+    light: Light,
+    // The lookup point (moved off the surface) and the world size of a texel there.
+    lookup: vec3<f32>,
+    texel: f32,
+}
+
+const OUTSIDE: u32 = 0u;
+const LIT: u32 = 1u;
+const SHADOWED: u32 = 2u;
+const EDGE: u32 = 3u;
+
+fn classify(pixel: vec2<f32>) -> Classified {
+    var c: Classified;
+    c.kind = OUTSIDE;
+    c.surface = load_surface(vec2<i32>(pixel));
+    c.light = lights[edge.light];
+    if !c.surface.valid {
+        return c;
+    }
+    let light = c.light;
+    if light.kind != LIGHT_DIRECTIONAL {
+        let to_surface = c.surface.position - light.position;
+        let d = length(to_surface);
+        let outside_cone = light.kind == LIGHT_SPOT
+            && dot(to_surface, light.direction) <= light.cos_outer * d;
+        if d >= light.range || outside_cone {
+            return c;
+        }
+    }
+    c.texel = texel_world(light, c.surface.position);
+    c.lookup = c.surface.position + c.surface.normal * (edge.normal_offset * c.texel);
+    let n = (2u * edge.radius + 1u) * (2u * edge.radius + 1u);
+    let lit = lit_taps(light, c.lookup, c.texel);
+    if edge.restriction == RESTRICTION_EVERYWHERE || (lit > 0u && lit < n) {
+        c.kind = EDGE;
+    } else if lit == 0u {
+        c.kind = SHADOWED;
+    } else {
+        c.kind = LIT;
+    }
+    return c;
+}
+
+fn class_colour(kind: u32) -> vec4<f32> {
+    switch kind {
+        case LIT: { return CLASS_LIT; }
+        case SHADOWED: { return CLASS_SHADOWED; }
+        case EDGE: { return CLASS_EDGE; }
+        default: { return vec4<f32>(0.0); }
+    }
+}
+
+@fragment
+fn fs_band(in: FullscreenOut) -> BandOut {
+    let c = classify(in.position.xy);
+    var out: BandOut;
+    out.visibility = vec4<f32>(select(1.0, 0.0, c.kind == SHADOWED));
+    out.classification = class_colour(c.kind);
+    out.depth = 1.0;
+    if c.kind == EDGE {
+        let clip = camera.view_proj * vec4<f32>(c.surface.position, 1.0);
+        out.depth = clip.z / clip.w;
+    }
+    return out;
+}
+
+// Triangle ids of the shadow map's front-most triangles (NO_TRIANGLE where none), and the
+// scene's vertices (six floats each) and indices, for the exact test.
+@group(4) @binding(0) var triangle_ids: texture_2d_array<u32>;
+@group(4) @binding(1) var<storage, read> scene_vertices: array<f32>;
+@group(4) @binding(2) var<storage, read> scene_indices: array<u32>;
+
+const NO_TRIANGLE: u32 = 0xffffffffu;
+
+fn vertex_position(index: u32) -> vec3<f32> {
+    let base = index * 6u;
+    return vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
+}
+
+// Whether triangle `id` crosses the ray origin + t·direction for t in (0, t_max)
+// (Möller–Trumbore).
+fn ray_hits(id: u32, origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
+    let a = vertex_position(scene_indices[3u * id]);
+    let b = vertex_position(scene_indices[3u * id + 1u]);
+    let c = vertex_position(scene_indices[3u * id + 2u]);
+    let e1 = b - a;
+    let e2 = c - a;
+    let h = cross(direction, e2);
+    let det = dot(e1, h);
+    if abs(det) < 1e-12 {
+        return false;
+    }
+    let f = 1.0 / det;
+    let s = origin - a;
+    let u = f * dot(s, h);
+    let q = cross(s, e1);
+    let v = f * dot(direction, q);
+    let t = f * dot(e2, q);
+    return u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < t_max;
+}
+
+// Whether the light ray from the surface is blocked by a triangle the map saw in the
+// (2r + 3)² texels around the surface's texel.
+fn occluded(c: Classified) -> bool {
+    let light = c.light;
+    let layer = light_layer(edge.first_layer, edge.layer_count, light.position, c.lookup);
+    let m = map_point(layer, c.lookup);
+    let size = vec2<i32>(textureDimensions(triangle_ids));
+    let centre = vec2<i32>(m.uv * vec2<f32>(size));
+    // Leave the surface by a hair, relative to the scene's scale at this point.
+    let scale = max(distance(c.surface.position, camera.position), 1.0);
+    let origin = c.surface.position + c.surface.normal * (1e-4 * scale);
+    var direction = -light.direction;
+    var t_max = 3.4e38;
+    if light.kind != LIGHT_DIRECTIONAL {
+        let to_light = light.position - origin;
+        t_max = length(to_light);
+        direction = to_light / t_max;
+    }
+    let r = i32(edge.radius) + 1;
+    for (var j = -r; j <= r; j++) {
+        for (var i = -r; i <= r; i++) {
+            let texel = clamp(centre + vec2<i32>(i, j), vec2<i32>(0), size - vec2<i32>(1));
+            let id = textureLoad(triangle_ids, texel, layer, 0).r;
+            if id != NO_TRIANGLE && ray_hits(id, origin, direction, t_max) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+@fragment
+fn fs_band_ids(in: FullscreenOut) -> BandOut {
+    let c = classify(in.position.xy);
+    var out: BandOut;
+    out.classification = class_colour(c.kind);
+    out.depth = 1.0;
+    var shadowed = c.kind == SHADOWED;
+    if c.kind == EDGE {
+        shadowed = occluded(c);
+    }
+    out.visibility = vec4<f32>(select(1.0, 0.0, shadowed));
+    return out;
+}
+
+// Pass 4: edge pixels inside a volume (non-zero count) are shadowed.
+@fragment
+fn fs_shadowed() -> @location(0) vec4<f32> {
+    return vec4<f32>(0.0);
+}
