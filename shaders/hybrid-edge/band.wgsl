@@ -4,7 +4,9 @@
 // Edge pixels are resolved exactly, depending on the restriction:
 // - depth band (`fs_band`): edge pixels are left lit and get their own depth in the band's
 //   depth image (every other pixel holds 1), so the shadow volumes drawn next are rejected
-//   outside the band by the depth test; `everywhere` puts every pixel in the band;
+//   outside the band by the depth test; `everywhere` puts every pixel in the band, and
+//   `tiles` also draws the volumes only in the screen tiles that hold edge pixels
+//   (`hybrid-edge/tiles.wgsl`);
 // - triangle ids (`fs_band_ids`): the light ray of an edge pixel is tested against the
 //   triangles the shadow map saw nearest the light in the pixel's neighbourhood (seed 003's
 //   future-work idea): no volumes at all.
@@ -36,6 +38,7 @@ struct EdgeLight {
 const RESTRICTION_DEPTHBAND: u32 = 0u;
 const RESTRICTION_EVERYWHERE: u32 = 1u;
 const RESTRICTION_TRIANGLEIDS: u32 = 2u;
+const RESTRICTION_TILES: u32 = 3u;
 
 @group(2) @binding(0) var<uniform> edge: EdgeLight;
 

@@ -15,10 +15,14 @@
 //!   and edge pixels test their light ray exactly against the triangles of their
 //!   neighbourhood (seed 003's future-work idea), so no volume is rasterised at all (exact
 //!   unless an occluder is thinner than a texel or hidden behind another in the map);
+//! - `Tiles`: the depth band, with the volumes drawn only into the screen tiles that hold edge
+//!   pixels (a compute pass lists them; each tile is an instance clipped by clip distances),
+//!   so nothing is rasterised outside those tiles even where early depth tests are not;
 //! - `Everywhere`: every pixel in the band (plain shadow volumes through the same passes), to
 //!   measure what the restriction saves.
 
 mod ids;
+mod tiles;
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::gpu::layout::ChoiceCodes;
@@ -29,6 +33,7 @@ use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::{DepthState, LightMaps, ShadowMapSet, layer_pass_name};
 
 use ids::IdMaps;
+use tiles::Tiles;
 use zoo_shadow_volumes::{
     VOLUME_VERTEX_LAYOUT, VolumeGenerator, Volumes, band_volume_depth_stencil, stencil_state,
     volume_primitive,
@@ -36,18 +41,21 @@ use zoo_shadow_volumes::{
 
 zoo_host::param_choice! {
     /// Where shadow volumes are counted.
-    pub enum Restriction { DepthBand, Everywhere, TriangleIds }
+    pub enum Restriction { DepthBand, Everywhere, TriangleIds, Tiles }
 }
 
 zoo_host::technique_params! {
     /// Parameters of the hybrid shadow-map / shadow-volume technique.
     pub struct HybridParams {
+        /// Side of the screen tiles of the `Tiles` restriction, in pixels.
+        tile_size: u32 = 16, range(8, 64), step(8);
         /// Shadow-map resolution in texels per side.
         map_size: u32 = 2048, range(256, 8192), step(256);
         /// Neighbourhood radius r in texels: (2r + 1)² taps decide lit, shadowed or edge.
         radius: u32 = 1, range(1, 4), step(1);
-        /// How edge pixels are resolved: exact tests against the map's triangle ids, volumes
-        /// restricted to the band by a depth image, or volumes everywhere.
+        /// How edge pixels are resolved: volumes restricted to the band by a depth image (and
+        /// optionally to its screen tiles), exact tests against the map's triangle ids, or
+        /// volumes everywhere.
         restriction: Restriction = Restriction::DepthBand;
         /// Slope-scaled depth bias of the shadow map.
         slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
@@ -77,6 +85,7 @@ struct EdgeLight {
 
 const SHADER: &str = "hybrid-edge/band.wgsl";
 const IDS_PASS: &str = "Hybrid id map";
+const TILES_PASS: &str = "Hybrid tiles";
 /// The id of texels no triangle covers.
 const NO_TRIANGLE: u32 = u32::MAX;
 const MAP_PASS: &str = "Hybrid map";
@@ -94,12 +103,17 @@ struct Targets {
 
 impl Targets {
     fn new(device: &wgpu::Device, size: zoo_host::glam::UVec2) -> Targets {
-        let target = |label, format| {
-            zoo_host::gpu::render_target(device, label, size, format, wgpu::TextureUsages::empty())
-        };
+        let target =
+            |label, format, usage| zoo_host::gpu::render_target(device, label, size, format, usage);
+        // The tile restriction reads the band's depth.
+        let sampled = wgpu::TextureUsages::TEXTURE_BINDING;
         Targets {
-            band: target("hybrid band depth-stencil", DEPTH_FORMAT),
-            class: target("hybrid classification", CLASS_FORMAT),
+            band: target("hybrid band depth-stencil", DEPTH_FORMAT, sampled),
+            class: target(
+                "hybrid classification",
+                CLASS_FORMAT,
+                wgpu::TextureUsages::empty(),
+            ),
         }
     }
 }
@@ -113,6 +127,9 @@ struct Gpu {
     band: [wgpu::RenderPipeline; 2],
     band_ids: [wgpu::RenderPipeline; 2],
     ids: IdMaps,
+    /// The tile restriction, built when first chosen.
+    tiles: Option<Tiles>,
+    volume_bias: wgpu::DepthBiasState,
     /// The band shader's value of each `Restriction`.
     restriction_codes: ChoiceCodes,
     volume: wgpu::RenderPipeline,
@@ -235,6 +252,8 @@ impl Gpu {
             band,
             band_ids,
             ids,
+            tiles: None,
+            volume_bias: bias,
             restriction_codes,
             volume,
             resolve,
@@ -242,6 +261,28 @@ impl Gpu {
             lights: 0,
         })
     }
+}
+
+/// The tile restriction, where the device can run it: it clips by clip distances and reads the
+/// band's depth in a compute shader (which GLSL cannot).
+fn tiles_for(ctx: &RenderContext<'_>, bias: wgpu::DepthBiasState) -> TechniqueResult<Tiles> {
+    if !ctx
+        .gpu
+        .device
+        .features()
+        .contains(wgpu::Features::CLIP_DISTANCES)
+    {
+        return Err(TechniqueError::Other(
+            "hybrid-edge: the Tiles restriction needs the CLIP_DISTANCES feature".into(),
+        ));
+    }
+    if ctx.gpu.info.backend == wgpu::Backend::Gl {
+        return Err(TechniqueError::Other(
+            "hybrid-edge: the Tiles restriction reads depth in a compute shader, which GL cannot"
+                .into(),
+        ));
+    }
+    Tiles::new(ctx, bias)
 }
 
 /// The band pass's uniform for one light's maps.
@@ -272,10 +313,10 @@ impl ShadowTechnique for Hybrid {
         };
         let exact = self.params.restriction == Restriction::TriangleIds;
         let mut names = gpu.maps.pass_names(if exact { IDS_PASS } else { MAP_PASS });
-        let per_light: &[&str] = if exact {
-            &[BAND_PASS]
-        } else {
-            &[BAND_PASS, GENERATION_PASS, VOLUME_PASS]
+        let per_light: &[&str] = match self.params.restriction {
+            Restriction::TriangleIds => &[BAND_PASS],
+            Restriction::Tiles => &[BAND_PASS, GENERATION_PASS, TILES_PASS, VOLUME_PASS],
+            _ => &[BAND_PASS, GENERATION_PASS, VOLUME_PASS],
         };
         for l in gpu.maps.lights() {
             for base in per_light {
@@ -284,10 +325,12 @@ impl ShadowTechnique for Hybrid {
         }
         names
             .into_iter()
-            .map(|name| match name.starts_with(GENERATION_PASS) {
-                true => PassInfo::compute(name),
-                false => PassInfo::render(name),
-            })
+            .map(
+                |name| match name.starts_with(GENERATION_PASS) || name.starts_with(TILES_PASS) {
+                    true => PassInfo::compute(name),
+                    false => PassInfo::render(name),
+                },
+            )
             .collect()
     }
 
@@ -332,6 +375,13 @@ impl ShadowTechnique for Hybrid {
             && let (Some(depth), Some(cameras)) = (gpu.maps.maps(), gpu.maps.cameras())
         {
             gpu.ids.prepare(ctx, depth, cameras);
+        }
+        if self.params.restriction == Restriction::Tiles {
+            if gpu.tiles.is_none() {
+                gpu.tiles = Some(tiles_for(ctx, gpu.volume_bias)?);
+            }
+            let tiles = gpu.tiles.as_mut().expect("built above");
+            tiles.prepare(ctx, &gpu.targets.band.0, ctx.size, self.params.tile_size);
         }
         Ok(())
     }
@@ -417,11 +467,22 @@ impl ShadowTechnique for Hybrid {
                     store: wgpu::StoreOp::Discard,
                 }),
             };
+            let tiles = gpu
+                .tiles
+                .as_ref()
+                .filter(|_| p.restriction == Restriction::Tiles);
+            if let Some(tiles) = tiles {
+                tiles.record_list(recorder, &light_pass_name(TILES_PASS, light), args)?;
+            }
             let name = light_pass_name(VOLUME_PASS, light);
             let mut pass = ctx.light_pass(recorder, &name, light, Some(depth));
-            pass.set_pipeline(&gpu.volume);
-            pass.set_vertex_buffer(0, volume.slice(..));
-            pass.draw_indirect(args, 0);
+            if let Some(tiles) = tiles {
+                tiles.draw(&mut pass, volume)?;
+            } else {
+                pass.set_pipeline(&gpu.volume);
+                pass.set_vertex_buffer(0, volume.slice(..));
+                pass.draw_indirect(args, 0);
+            }
             pass.set_pipeline(&gpu.resolve);
             pass.set_stencil_reference(0);
             pass.draw(0..3, 0..1);
@@ -476,6 +537,7 @@ zoo_host::register_technique! {
         max_bind_groups: 5,
         ..wgpu::Limits::downlevel_defaults()
     },
+    optional_features: || wgpu::Features::CLIP_DISTANCES,
     // Volumes are generated by compute shaders into storage buffers and drawn indirectly.
     required_downlevel: || {
         wgpu::DownlevelFlags::COMPUTE_SHADERS | wgpu::DownlevelFlags::INDIRECT_EXECUTION

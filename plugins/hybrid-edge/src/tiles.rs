@@ -1,0 +1,268 @@
+//! The tile restriction: after the band pass, a compute pass lists the screen tiles that hold
+//! edge pixels (`shaders/hybrid-edge/tiles.wgsl`), and the volume is drawn once per listed tile
+//! and clipped to it with clip distances (`shaders/hybrid-edge/tiled_volumes.wgsl`), so no
+//! volume fragment is rasterised outside the edge tiles, on any rasteriser.
+
+use zoo_host::bytemuck;
+use zoo_host::glam::UVec2;
+use zoo_host::gpu::PassRecorder;
+use zoo_host::kit::{bind_group, bind_group_layout, pipeline_layout, storage, texture, uniform};
+use zoo_host::{RenderContext, TechniqueResult, wgpu};
+use zoo_shadow_volumes::{VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil, volume_primitive};
+
+/// `TileParams` in the tile shaders.
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+pub(crate) struct TileParams {
+    tile_size: u32,
+    tiles_x: u32,
+    tiles_y: u32,
+    _pad: u32,
+}
+
+/// The tile list and draw arguments for one screen size and tile size.
+struct Bound {
+    params: TileParams,
+    band: wgpu::Texture,
+    args: wgpu::Buffer,
+    compute_group: wgpu::BindGroup,
+    draw_group: wgpu::BindGroup,
+}
+
+/// Pipelines and buffers of the tile restriction.
+pub(crate) struct Tiles {
+    compute: wgpu::ComputePipeline,
+    compute_layout: wgpu::BindGroupLayout,
+    volume: wgpu::RenderPipeline,
+    draw_layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    bound: Option<Bound>,
+}
+
+impl Tiles {
+    /// Builds the pipelines; volume faces are pushed back by `bias`.
+    pub(crate) fn new(
+        ctx: &RenderContext<'_>,
+        bias: wgpu::DepthBiasState,
+    ) -> TechniqueResult<Tiles> {
+        let device = &ctx.gpu.device;
+        let tiles_module = ctx
+            .shaders
+            .create_module(device, "hybrid-edge/tiles.wgsl")?;
+        let draw_module = ctx
+            .shaders
+            .create_module(device, "hybrid-edge/tiled_volumes.wgsl")?;
+        let compute_stage = wgpu::ShaderStages::COMPUTE;
+        let compute_layout = bind_group_layout(
+            device,
+            "hybrid tile list layout",
+            &[
+                texture(
+                    0,
+                    compute_stage,
+                    wgpu::TextureSampleType::Depth,
+                    wgpu::TextureViewDimension::D2,
+                ),
+                storage(1, compute_stage, false),
+                storage(2, compute_stage, false),
+                uniform(3, compute_stage),
+            ],
+        );
+        let vertex = wgpu::ShaderStages::VERTEX;
+        let draw_layout = bind_group_layout(
+            device,
+            "hybrid tiled volume layout",
+            &[storage(0, vertex, true), uniform(1, vertex)],
+        );
+        let compute_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("hybrid tile list pipeline layout"),
+                bind_group_layouts: &[Some(&compute_layout)],
+                immediate_size: 0,
+            });
+        let compute = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("hybrid tile list pipeline"),
+            layout: Some(&compute_pipeline_layout),
+            module: &tiles_module,
+            entry_point: Some("cs_tiles"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        // The host's groups first (the shader reads only the frame's), the tiles at group 2.
+        let draw_pipeline_layout =
+            pipeline_layout(ctx, "hybrid tiled volume pipeline layout", &[&draw_layout]);
+        let no_colour = Some(wgpu::ColorTargetState {
+            write_mask: wgpu::ColorWrites::empty(),
+            ..zoo_host::kit::slot_target()
+        });
+        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("hybrid tiled volume pipeline"),
+            layout: Some(&draw_pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &draw_module,
+                entry_point: Some("vs_volume_tiled"),
+                compilation_options: Default::default(),
+                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
+            },
+            primitive: volume_primitive(),
+            depth_stencil: Some(band_volume_depth_stencil(bias)),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &draw_module,
+                entry_point: Some("fs_volume"),
+                compilation_options: Default::default(),
+                targets: &[no_colour],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("hybrid tile parameters"),
+            size: size_of::<TileParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Tiles {
+            compute,
+            compute_layout,
+            volume,
+            draw_layout,
+            params,
+            bound: None,
+        })
+    }
+
+    /// Sizes the tile list for `size` pixels in tiles of `tile_size`, over the band depth
+    /// image `band` (rebuilt when any of them changed).
+    pub(crate) fn prepare(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        band: &wgpu::Texture,
+        size: UVec2,
+        tile_size: u32,
+    ) {
+        let tiles = size.as_vec2() / tile_size as f32;
+        let params = TileParams {
+            tile_size,
+            tiles_x: tiles.x.ceil() as u32,
+            tiles_y: tiles.y.ceil() as u32,
+            _pad: 0,
+        };
+        if self
+            .bound
+            .as_ref()
+            .is_some_and(|b| b.params == params && &b.band == band)
+        {
+            return;
+        }
+        let device = &ctx.gpu.device;
+        ctx.gpu
+            .queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let list = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("hybrid tile list"),
+            size: (params.tiles_x * params.tiles_y).max(1) as u64 * 4,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let args = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("hybrid tiled volume draw arguments"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::INDIRECT
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let depth = band.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("hybrid band depth (depth aspect)"),
+            aspect: wgpu::TextureAspect::DepthOnly,
+            ..Default::default()
+        });
+        let compute_group = bind_group(
+            device,
+            "hybrid tile list",
+            &self.compute_layout,
+            &[
+                wgpu::BindingResource::TextureView(&depth),
+                list.as_entire_binding(),
+                args.as_entire_binding(),
+                self.params.as_entire_binding(),
+            ],
+        );
+        let draw_group = bind_group(
+            device,
+            "hybrid tiled volumes",
+            &self.draw_layout,
+            &[list.as_entire_binding(), self.params.as_entire_binding()],
+        );
+        self.bound = Some(Bound {
+            params,
+            band: band.clone(),
+            args,
+            compute_group,
+            draw_group,
+        });
+    }
+
+    /// Lists the edge tiles of the band depth image in compute pass `name`, with the volume's
+    /// vertex count taken from `volume_args` (the generator's draw arguments).
+    pub(crate) fn record_list(
+        &self,
+        recorder: &mut PassRecorder<'_>,
+        name: &str,
+        volume_args: &wgpu::Buffer,
+    ) -> TechniqueResult {
+        let bound = self
+            .bound
+            .as_ref()
+            .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
+        let encoder = recorder.encoder();
+        encoder.clear_buffer(&bound.args, 0, None);
+        encoder.copy_buffer_to_buffer(volume_args, 0, &bound.args, 0, 4);
+        let mut pass = recorder.compute_pass(name);
+        pass.set_pipeline(&self.compute);
+        pass.set_bind_group(0, &bound.compute_group, &[]);
+        pass.dispatch_workgroups(bound.params.tiles_x, bound.params.tiles_y, 1);
+        Ok(())
+    }
+
+    /// Draws the volume into the listed tiles (in a pass with the band attached).
+    pub(crate) fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        volume: &wgpu::Buffer,
+    ) -> TechniqueResult {
+        let bound = self
+            .bound
+            .as_ref()
+            .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
+        pass.set_pipeline(&self.volume);
+        pass.set_bind_group(2, &bound.draw_group, &[]);
+        pass.set_vertex_buffer(0, volume.slice(..));
+        pass.draw_indirect(&bound.args, 0);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    #[test]
+    fn tile_params_mirror_both_shaders() {
+        let (size, fields) = zoo_host::mirror_fields!(TileParams {
+            tile_size,
+            tiles_x,
+            tiles_y
+        });
+        for shader in ["hybrid-edge/tiles.wgsl", "hybrid-edge/tiled_volumes.wgsl"] {
+            let source = zoo_host::ShaderLibrary::embedded()
+                .compose(shader)
+                .unwrap()
+                .source;
+            check_mirror(&source, "TileParams", size, &fields, SizeRule::Equal).unwrap();
+        }
+    }
+}
