@@ -46,3 +46,4 @@ fn cs_tiles(
         tile_list[slot] = tile.x | (tile.y << 16u);
     }
 }
+

@@ -86,6 +86,8 @@ struct EdgeLight {
 const SHADER: &str = "hybrid-edge/band.wgsl";
 const IDS_PASS: &str = "Hybrid id map";
 const TILES_PASS: &str = "Hybrid tiles";
+/// Passes that only feed debug views.
+const DEBUG_PASS: &str = "Hybrid debug view";
 /// The id of texels no triangle covers.
 const NO_TRIANGLE: u32 = u32::MAX;
 const MAP_PASS: &str = "Hybrid map";
@@ -94,11 +96,19 @@ const GENERATION_PASS: &str = "Hybrid volume generation";
 const VOLUME_PASS: &str = "Hybrid volumes";
 const CLASS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const CLASS_VIEW: &str = "classification";
+const COUNTS_VIEW: &str = "stencil counts";
+const TILES_VIEW: &str = "active tiles";
+const COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
+/// Stencil levels the count view distinguishes, shown as ids 1..=10: counts 1..=8, then 255 and
+/// 254 (-1 and -2 wrapped); any other non-zero count is id 11.
+const COUNT_LEVELS: [u32; 10] = [1, 2, 3, 4, 5, 6, 7, 8, 255, 254];
 
-/// Screen-sized targets: the band's depth-stencil and the classification colours.
+/// Screen-sized targets: the band's depth-stencil and the debug views.
 struct Targets {
     band: (wgpu::Texture, wgpu::TextureView),
     class: (wgpu::Texture, wgpu::TextureView),
+    counts: (wgpu::Texture, wgpu::TextureView),
+    tiles: (wgpu::Texture, wgpu::TextureView),
 }
 
 impl Targets {
@@ -112,6 +122,16 @@ impl Targets {
             class: target(
                 "hybrid classification",
                 CLASS_FORMAT,
+                wgpu::TextureUsages::empty(),
+            ),
+            counts: target(
+                "hybrid stencil counts",
+                COUNTS_FORMAT,
+                wgpu::TextureUsages::empty(),
+            ),
+            tiles: target(
+                "hybrid active tiles",
+                tiles::OVERLAY_FORMAT,
                 wgpu::TextureUsages::empty(),
             ),
         }
@@ -134,6 +154,9 @@ struct Gpu {
     restriction_codes: ChoiceCodes,
     volume: wgpu::RenderPipeline,
     resolve: wgpu::RenderPipeline,
+    /// The count view: any non-zero count, then one level at a time.
+    count_any: wgpu::RenderPipeline,
+    count_equal: wgpu::RenderPipeline,
     targets: Targets,
     /// Lights the volume buffers were made for.
     lights: usize,
@@ -245,7 +268,41 @@ impl Gpu {
             )),
         }
         .build(ctx);
+        let count = |compare| {
+            let face = wgpu::StencilFaceState {
+                compare,
+                fail_op: keep,
+                depth_fail_op: keep,
+                pass_op: keep,
+            };
+            let layout = pipeline_layout(ctx, "hybrid stencil count layout", &[]);
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("hybrid stencil count pipeline"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_count"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: Some(stencil_state(always, face, face, Default::default())),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_count"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(COUNTS_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let count_any = count(wgpu::CompareFunction::NotEqual);
+        let count_equal = count(wgpu::CompareFunction::Equal);
         Ok(Gpu {
+            count_any,
+            count_equal,
             maps,
             generator,
             uniforms,
@@ -283,6 +340,44 @@ fn tiles_for(ctx: &RenderContext<'_>, bias: wgpu::DepthBiasState) -> TechniqueRe
         ));
     }
     Tiles::new(ctx, bias)
+}
+
+/// Draws the stencil counts the volumes left in the band into the count view.
+fn record_counts(
+    ctx: &RenderContext<'_>,
+    recorder: &mut PassRecorder<'_>,
+    gpu: &Gpu,
+    light: usize,
+) -> TechniqueResult {
+    let name = light_pass_name(DEBUG_PASS, light);
+    let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
+    let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(&name),
+        color_attachments: &[zoo_host::gpu::color_attachment(
+            &gpu.targets.counts.1,
+            clear,
+        )],
+        depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
+            &gpu.targets.band.1,
+            wgpu::LoadOp::Load,
+        ),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+    pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
+    // Any non-zero count first (id 11), then the exact levels over it.
+    pass.set_pipeline(&gpu.count_any);
+    pass.set_stencil_reference(0);
+    pass.draw(0..3, 11..12);
+    pass.set_pipeline(&gpu.count_equal);
+    for (k, level) in COUNT_LEVELS.iter().enumerate() {
+        pass.set_stencil_reference(*level);
+        let id = k as u32 + 1;
+        pass.draw(0..3, id..id + 1);
+    }
+    Ok(())
 }
 
 /// The band pass's uniform for one light's maps.
@@ -351,6 +446,16 @@ impl ShadowTechnique for Hybrid {
             "band depth-stencil",
             &gpu.targets.band.0,
             false,
+        ));
+        out.push(ResourceInfo::texture(
+            COUNTS_VIEW,
+            &gpu.targets.counts.0,
+            true,
+        ));
+        out.push(ResourceInfo::texture(
+            TILES_VIEW,
+            &gpu.targets.tiles.0,
+            true,
         ));
         if let Some(ids) = gpu.ids.maps() {
             out.push(ResourceInfo::texture("triangle ids", &ids.texture, false));
@@ -456,15 +561,23 @@ impl ShadowTechnique for Hybrid {
             };
             let generation = light_pass_name(GENERATION_PASS, light);
             gpu.generator.record(ctx, recorder, light, &generation)?;
+            let is_debug = Some(light) == debug;
+            let showing = |view| is_debug && ctx.debug_view == Some(view);
+            // The count view reads the stencil after the volumes.
+            let keep = if showing(COUNTS_VIEW) {
+                wgpu::StoreOp::Store
+            } else {
+                wgpu::StoreOp::Discard
+            };
             let depth = wgpu::RenderPassDepthStencilAttachment {
                 view: band,
                 depth_ops: Some(wgpu::Operations {
                     load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Discard,
+                    store: keep,
                 }),
                 stencil_ops: Some(wgpu::Operations {
                     load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Discard,
+                    store: keep,
                 }),
             };
             let tiles = gpu
@@ -473,6 +586,10 @@ impl ShadowTechnique for Hybrid {
                 .filter(|_| p.restriction == Restriction::Tiles);
             if let Some(tiles) = tiles {
                 tiles.record_list(recorder, &light_pass_name(TILES_PASS, light), args)?;
+                if showing(TILES_VIEW) {
+                    let name = light_pass_name(DEBUG_PASS, light);
+                    tiles.record_overlay(ctx, recorder, &gpu.targets.tiles.1, &name)?;
+                }
             }
             let name = light_pass_name(VOLUME_PASS, light);
             let mut pass = ctx.light_pass(recorder, &name, light, Some(depth));
@@ -486,6 +603,10 @@ impl ShadowTechnique for Hybrid {
             pass.set_pipeline(&gpu.resolve);
             pass.set_stencil_reference(0);
             pass.draw(0..3, 0..1);
+            drop(pass);
+            if showing(COUNTS_VIEW) {
+                record_counts(ctx, recorder, gpu, light)?;
+            }
         }
         Ok(())
     }
@@ -507,6 +628,14 @@ impl ShadowTechnique for Hybrid {
             CLASS_VIEW => Some(DebugImage {
                 view: &gpu.targets.class.1,
                 mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
+            }),
+            TILES_VIEW => Some(DebugImage {
+                view: &gpu.targets.tiles.1,
+                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
+            }),
+            COUNTS_VIEW => Some(DebugImage {
+                view: &gpu.targets.counts.1,
+                mapping: ViewMapping::Integer,
             }),
             "shadow maps" => {
                 let light = gpu.maps.debug_light(self.params.debug_light)?;

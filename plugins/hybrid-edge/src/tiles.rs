@@ -28,6 +28,9 @@ struct Bound {
     args: wgpu::Buffer,
     compute_group: wgpu::BindGroup,
     draw_group: wgpu::BindGroup,
+    /// The overlay's draw: six vertices per listed tile.
+    overlay_args: wgpu::Buffer,
+    overlay_group: wgpu::BindGroup,
 }
 
 /// Pipelines and buffers of the tile restriction.
@@ -37,8 +40,13 @@ pub(crate) struct Tiles {
     volume: wgpu::RenderPipeline,
     draw_layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
+    /// Debug view: the active tiles as squares.
+    overlay: wgpu::RenderPipeline,
     bound: Option<Bound>,
 }
+
+/// Format of the active-tiles view.
+pub(crate) const OVERLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 impl Tiles {
     /// Builds the pipelines; volume faces are pushed back by `bias`.
@@ -117,6 +125,31 @@ impl Tiles {
             multiview_mask: None,
             cache: None,
         });
+        let overlay_module = ctx
+            .shaders
+            .create_module(device, "hybrid-edge/tile_overlay.wgsl")?;
+        let overlay_layout = pipeline_layout(ctx, "hybrid tile overlay layout", &[&draw_layout]);
+        let overlay = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("hybrid tile overlay pipeline"),
+            layout: Some(&overlay_layout),
+            vertex: wgpu::VertexState {
+                module: &overlay_module,
+                entry_point: Some("vs_tile"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &overlay_module,
+                entry_point: Some("fs_tile"),
+                compilation_options: Default::default(),
+                targets: &[Some(OVERLAY_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("hybrid tile parameters"),
             size: size_of::<TileParams>() as u64,
@@ -129,6 +162,7 @@ impl Tiles {
             volume,
             draw_layout,
             params,
+            overlay,
             bound: None,
         })
     }
@@ -171,6 +205,7 @@ impl Tiles {
             size: 16,
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::INDIRECT
+                | wgpu::BufferUsages::COPY_SRC
                 | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -196,12 +231,30 @@ impl Tiles {
             &self.draw_layout,
             &[list.as_entire_binding(), self.params.as_entire_binding()],
         );
+        let overlay_args = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("hybrid tile overlay draw arguments"),
+            size: 16,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let six_vertices: [u32; 4] = [6, 0, 0, 0];
+        ctx.gpu
+            .queue
+            .write_buffer(&overlay_args, 0, bytemuck::cast_slice(&six_vertices));
+        let overlay_group = bind_group(
+            device,
+            "hybrid tile overlay",
+            &self.draw_layout,
+            &[list.as_entire_binding(), self.params.as_entire_binding()],
+        );
         self.bound = Some(Bound {
             params,
             band: band.clone(),
             args,
             compute_group,
             draw_group,
+            overlay_args,
+            overlay_group,
         });
     }
 
@@ -224,6 +277,39 @@ impl Tiles {
         pass.set_pipeline(&self.compute);
         pass.set_bind_group(0, &bound.compute_group, &[]);
         pass.dispatch_workgroups(bound.params.tiles_x, bound.params.tiles_y, 1);
+        Ok(())
+    }
+
+    /// Draws the listed tiles into `target` (the `active tiles` view), in pass `name`.
+    pub(crate) fn record_overlay(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        target: &wgpu::TextureView,
+        name: &str,
+    ) -> TechniqueResult {
+        let bound = self
+            .bound
+            .as_ref()
+            .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
+        // The instance count the list pass wrote.
+        (recorder.encoder()).copy_buffer_to_buffer(&bound.args, 4, &bound.overlay_args, 4, 4);
+        let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(name),
+            color_attachments: &[zoo_host::gpu::color_attachment(
+                target,
+                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+            )],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.overlay);
+        pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+        pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
+        pass.set_bind_group(2, &bound.overlay_group, &[]);
+        pass.draw_indirect(&bound.overlay_args, 0);
         Ok(())
     }
 
