@@ -2,6 +2,7 @@
 //! arrays and the depth pass that fills them, kept up to date from one call per frame.
 
 use zoo_host::gpu::PassRecorder;
+use zoo_host::technique::{DebugImage, ViewMapping};
 use zoo_host::{Changes, RenderContext, TechniqueResult, wgpu};
 
 use crate::depth::{ColorOutput, DepthPass, DepthState};
@@ -192,6 +193,29 @@ impl ShadowMapSet {
         shadowed()
             .find(|l| l.light as u32 == wanted)
             .or_else(|| shadowed().next())
+    }
+
+    /// The `shadow maps` debug image: the first layer of [`Self::debug_light`]`(wanted)`
+    /// (depth maps shown as depth, colour maps as colour).
+    pub fn debug_image(&self, wanted: u32) -> Option<DebugImage<'_>> {
+        let light = self.debug_light(wanted)?;
+        let mapping = match self.color {
+            Some(_) => ViewMapping::Color { min: 0.0, max: 1.0 },
+            None => ViewMapping::Depth { min: 0.0, max: 1.0 },
+        };
+        Some(DebugImage {
+            view: &self.maps()?.layer_views[light.first_layer as usize],
+            mapping,
+        })
+    }
+
+    /// Workload counters: map layers in use and their resolution.
+    pub fn counters(&self) -> Vec<(String, f64)> {
+        let layers: usize = self.lights.iter().map(|l| l.frustums.len()).sum();
+        vec![
+            ("map layers".into(), layers as f64),
+            ("map resolution".into(), self.resolution() as f64),
+        ]
     }
 
     /// The maps lookups read (the colour maps when there are any, else the depth maps).

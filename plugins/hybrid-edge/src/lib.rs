@@ -26,7 +26,9 @@ mod tiles;
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{SlotPipeline, UniformSlots, light_pass_name, pipeline_layout};
+use zoo_host::kit::{
+    SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name, pipeline_layout,
+};
 use zoo_host::prelude::*;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
@@ -196,23 +198,15 @@ impl Gpu {
         let groups = [uniforms.layout(), maps.lookup_layout()];
         let id_groups = [uniforms.layout(), maps.lookup_layout(), &ids.lookup_layout];
         let band_pipelines = |entry: &str, groups: &[&wgpu::BindGroupLayout]| {
-            [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|write_mask| {
-                let class = Some(wgpu::ColorTargetState {
-                    format: CLASS_FORMAT,
-                    blend: None,
-                    write_mask,
-                });
-                let debug = !write_mask.is_empty();
-                SlotPipeline {
-                    label: &format!("hybrid {entry} (classification {debug})"),
-                    module: &module,
-                    entry,
-                    groups,
-                    more_targets: &[class],
-                    depth_stencil: Some(band_depth_state()),
-                }
-                .build(ctx)
-            })
+            let band = SlotPipeline {
+                label: &format!("hybrid {entry}"),
+                module: &module,
+                entry,
+                groups,
+                more_targets: &[],
+                depth_stencil: Some(band_depth_state()),
+            };
+            diagnostics_pipelines(ctx, band, &[CLASS_FORMAT])
         };
         let band = band_pipelines("fs_band", &groups);
         let band_ids = band_pipelines("fs_band_ids", &id_groups);
@@ -637,13 +631,7 @@ impl ShadowTechnique for Hybrid {
                 view: &gpu.targets.counts.1,
                 mapping: ViewMapping::Integer,
             }),
-            "shadow maps" => {
-                let light = gpu.maps.debug_light(self.params.debug_light)?;
-                Some(DebugImage {
-                    view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
-                    mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
-                })
-            }
+            "shadow maps" => gpu.maps.debug_image(self.params.debug_light),
             _ => None,
         }
     }

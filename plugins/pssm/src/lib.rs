@@ -13,7 +13,7 @@ mod warped;
 pub use warped::{LispsmParams, PsmParams};
 
 use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{UniformSlots, light_pass_name, slot_fullscreen_pipeline_with};
+use zoo_host::kit::{SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::light_space::Projection;
@@ -137,16 +137,17 @@ impl Gpu {
         let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
             .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
         let groups = [uniforms.layout(), maps.lookup_layout()];
-        let lookup = [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|mask| {
-            let diagnostics = Some(wgpu::ColorTargetState {
-                format: DIAGNOSTICS_FORMAT,
-                blend: None,
-                write_mask: mask,
-            });
-            let label = format!("pssm lookup (diagnostics {})", !mask.is_empty());
-            let targets = [diagnostics.clone(), diagnostics];
-            slot_fullscreen_pipeline_with(ctx, &label, &module, "fs_pssm", &groups, &targets)
-        });
+        let lookup = SlotPipeline {
+            label: "pssm lookup",
+            module: &module,
+            entry: "fs_pssm",
+            groups: &groups,
+            more_targets: &[],
+            depth_stencil: None,
+        };
+        // Split colours and texel density.
+        let diagnostics = [DIAGNOSTICS_FORMAT, DIAGNOSTICS_FORMAT];
+        let lookup = diagnostics_pipelines(ctx, lookup, &diagnostics);
         Ok(Gpu {
             maps,
             uniforms,
@@ -347,26 +348,15 @@ impl ShadowTechnique for Pssm {
             SPLITS_VIEW => image(&gpu.diagnostics.splits.1),
             DENSITY_VIEW => image(&gpu.diagnostics.density.1),
             TOP_VIEW => image(&gpu.diagnostics.top_view.1),
-            "shadow maps" => {
-                let light = gpu.maps.debug_light(self.params.debug_light)?;
-                Some(DebugImage {
-                    view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
-                    mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
-                })
-            }
+            "shadow maps" => gpu.maps.debug_image(self.params.debug_light),
             _ => None,
         }
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        let Some(gpu) = &self.gpu else {
-            return Vec::new();
-        };
-        let layers: usize = gpu.maps.lights().iter().map(|l| l.frustums.len()).sum();
-        vec![
-            ("map layers".into(), layers as f64),
-            ("map resolution".into(), gpu.maps.resolution() as f64),
-        ]
+        self.gpu
+            .as_ref()
+            .map_or(Vec::new(), |gpu| gpu.maps.counters())
     }
 }
 

@@ -9,7 +9,7 @@ use std::cell::Cell;
 
 use zoo_host::glam::UVec2;
 use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{UniformSlots, light_pass_name, slot_fullscreen_pipeline_with};
+use zoo_host::kit::{SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::scene::Light;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
@@ -246,15 +246,16 @@ impl WarpedMaps {
         let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
             .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
         let groups = [uniforms.layout(), maps.lookup_layout()];
-        let lookup = [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|mask| {
-            let density = Some(wgpu::ColorTargetState {
-                format: DIAGNOSTICS_FORMAT,
-                blend: None,
-                write_mask: mask,
-            });
-            let label = format!("{} lookup (diagnostics {})", self.id, !mask.is_empty());
-            slot_fullscreen_pipeline_with(ctx, &label, &module, "fs_warped", &groups, &[density])
-        });
+        let label = format!("{} lookup", self.id);
+        let lookup = SlotPipeline {
+            label: &label,
+            module: &module,
+            entry: "fs_warped",
+            groups: &groups,
+            more_targets: &[],
+            depth_stencil: None,
+        };
+        let lookup = diagnostics_pipelines(ctx, lookup, &[DIAGNOSTICS_FORMAT]);
         Ok(Gpu {
             maps,
             uniforms,
@@ -411,13 +412,7 @@ impl ShadowTechnique for WarpedMaps {
                 view: &gpu.density.1,
                 mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
             }),
-            "shadow maps" => {
-                let light = gpu.maps.debug_light(self.settings.debug_light)?;
-                Some(DebugImage {
-                    view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
-                    mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
-                })
-            }
+            "shadow maps" => gpu.maps.debug_image(self.settings.debug_light),
             _ => None,
         }
     }

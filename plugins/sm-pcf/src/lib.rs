@@ -12,7 +12,7 @@
 
 use zoo_host::glam::UVec2;
 use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{UniformSlots, light_pass_name, slot_fullscreen_pipeline_with};
+use zoo_host::kit::{SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::{DepthState, LightMaps, ShadowMapSet, light_size};
@@ -116,22 +116,15 @@ impl Gpu {
         let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
             .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
         let groups = [uniforms.layout(), maps.lookup_layout()];
-        let lookup = [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|mask| {
-            let diagnostics = Some(wgpu::ColorTargetState {
-                format: DIAGNOSTICS_FORMAT,
-                blend: None,
-                write_mask: mask,
-            });
-            let label = format!("sm-pcf lookup (diagnostics {})", !mask.is_empty());
-            slot_fullscreen_pipeline_with(
-                ctx,
-                &label,
-                &module,
-                "fs_lookup",
-                &groups,
-                &[diagnostics],
-            )
-        });
+        let lookup = SlotPipeline {
+            label: "sm-pcf lookup",
+            module: &module,
+            entry: "fs_lookup",
+            groups: &groups,
+            more_targets: &[],
+            depth_stencil: None,
+        };
+        let lookup = diagnostics_pipelines(ctx, lookup, &[DIAGNOSTICS_FORMAT]);
         Ok(Gpu {
             maps,
             uniforms,
@@ -305,13 +298,7 @@ impl ShadowTechnique for ShadowMaps {
             })
         };
         match resource {
-            "shadow maps" => {
-                let light = gpu.maps.debug_light(self.params.debug_light)?;
-                Some(DebugImage {
-                    view: &gpu.maps.maps()?.layer_views[light.first_layer as usize],
-                    mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
-                })
-            }
+            "shadow maps" => gpu.maps.debug_image(self.params.debug_light),
             "coverage" => channel(0, 0.0, 1.0),
             "depth difference" => channel(1, -2.0, 2.0),
             _ => None,
@@ -319,14 +306,9 @@ impl ShadowTechnique for ShadowMaps {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        let Some(gpu) = &self.gpu else {
-            return Vec::new();
-        };
-        let layers: usize = gpu.maps.lights().iter().map(|l| l.frustums.len()).sum();
-        vec![
-            ("map layers".into(), layers as f64),
-            ("map resolution".into(), gpu.maps.resolution() as f64),
-        ]
+        self.gpu
+            .as_ref()
+            .map_or(Vec::new(), |gpu| gpu.maps.counters())
     }
 }
 

@@ -157,6 +157,42 @@ pub fn slot_fullscreen_pipeline_with(
     .build(ctx)
 }
 
+/// Two versions of `pipeline` (its `more_targets` ignored) whose fragment also writes
+/// `diagnostics` targets (locations 1, 2, ...): `[0]` leaves them untouched, `[1]` writes them,
+/// for the light a debug view shows.
+pub fn diagnostics_pipelines(
+    ctx: &RenderContext<'_>,
+    pipeline: SlotPipeline<'_>,
+    diagnostics: &[wgpu::TextureFormat],
+) -> [wgpu::RenderPipeline; 2] {
+    [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|write_mask| {
+        let targets: Vec<_> = diagnostics
+            .iter()
+            .map(|&format| {
+                Some(wgpu::ColorTargetState {
+                    format,
+                    blend: None,
+                    write_mask,
+                })
+            })
+            .collect();
+        let label = format!(
+            "{} (diagnostics {})",
+            pipeline.label,
+            !write_mask.is_empty()
+        );
+        SlotPipeline {
+            label: &label,
+            module: pipeline.module,
+            entry: pipeline.entry,
+            groups: pipeline.groups,
+            more_targets: &targets,
+            depth_stencil: pipeline.depth_stencil.clone(),
+        }
+        .build(ctx)
+    })
+}
+
 /// A full-screen pipeline that writes visibility slots, in full: the host's groups and then
 /// `groups`, colour targets after the slot, and a depth-stencil state (for passes that write
 /// depth or test the stencil of a depth-stencil attachment).

@@ -18,7 +18,7 @@ pub mod slot;
 pub mod uniforms;
 
 pub use layouts::{
-    SlotPipeline, bind_group, bind_group_layout, pipeline_layout, sampler,
+    SlotPipeline, bind_group, bind_group_layout, diagnostics_pipelines, pipeline_layout, sampler,
     slot_fullscreen_pipeline, slot_fullscreen_pipeline_with, storage, texture, uniform,
 };
 pub use light_pass::{FullscreenLightPass, light_pass_name};
