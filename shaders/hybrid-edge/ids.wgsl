@@ -26,9 +26,9 @@ fn scene_position(index: u32) -> vec3<f32> {
 fn vs_ids(@builtin(vertex_index) vertex: u32) -> IdVertex {
     var out: IdVertex;
     out.triangle = vertex / 3u;
-    // Triangles of objects that cast no shadows collapse to a point at infinity (clipped).
+    // Triangles of objects that cast no shadows move outside the clip volume.
     if objects[triangle_objects[out.triangle]].material.y == 0.0 {
-        out.clip = vec4<f32>(0.0);
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
     out.clip = layer_camera.view_proj * vec4<f32>(scene_position(scene_indices[vertex]), 1.0);

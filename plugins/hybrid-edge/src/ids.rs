@@ -12,9 +12,10 @@ use crate::NO_TRIANGLE;
 
 /// The id maps of one set of depth maps, and the bind groups over them.
 struct Bound {
-    /// The depth maps and layer cameras these were made for.
+    /// The depth maps, layer cameras and scene vertices these were made for.
     depth: wgpu::Texture,
     cameras: wgpu::Buffer,
+    vertices: wgpu::Buffer,
     ids: MapArray,
     camera_group: wgpu::BindGroup,
     lookup_group: wgpu::BindGroup,
@@ -124,10 +125,11 @@ impl IdMaps {
         depth: &MapArray,
         cameras: &wgpu::Buffer,
     ) {
-        let current = self
-            .bound
-            .as_ref()
-            .is_some_and(|b| b.depth == depth.texture && &b.cameras == cameras);
+        let current = self.bound.as_ref().is_some_and(|b| {
+            b.depth == depth.texture
+                && &b.cameras == cameras
+                && b.vertices == ctx.scene_buffers.vertices
+        });
         if current {
             return;
         }
@@ -168,6 +170,7 @@ impl IdMaps {
         self.bound = Some(Bound {
             depth: depth.texture.clone(),
             cameras: cameras.clone(),
+            vertices: buffers.vertices.clone(),
             ids,
             camera_group,
             lookup_group,

@@ -49,7 +49,8 @@ zoo_host::param_choice! {
 zoo_host::technique_params! {
     /// Parameters of the hybrid shadow-map / shadow-volume technique.
     pub struct HybridParams {
-        /// Side of the screen tiles of the `Tiles` restriction, in pixels.
+        /// Side of the screen tiles of the `Tiles` restriction, in pixels (rounded up to a
+        /// multiple of 8).
         tile_size: u32 = 16, range(8, 64), step(8);
         /// Shadow-map resolution in texels per side.
         map_size: u32 = 2048, range(256, 8192), step(256);

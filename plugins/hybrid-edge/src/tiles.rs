@@ -176,6 +176,8 @@ impl Tiles {
         size: UVec2,
         tile_size: u32,
     ) {
+        // The list pass scans a tile with 8 x 8 invocations.
+        let tile_size = tile_size.max(8).div_ceil(8) * 8;
         let tiles = size.as_vec2() / tile_size as f32;
         let params = TileParams {
             tile_size,

@@ -59,6 +59,32 @@ fn banded_shadow_volumes_hold_the_shadow_volume_bound() {
     }
 }
 
+#[test]
+fn everywhere_and_tiled_shadow_volumes_hold_the_shadow_volume_bound() {
+    // Volumes everywhere through the same passes: plain shadow volumes.
+    let everywhere = [("restriction", "Everywhere")];
+    assert_volume_bounds(&judge("planar-room.ron", "hybrid-edge", &everywhere, SIZE));
+    let clip_distances = zoo_host::test_support::gpu()
+        .device
+        .features()
+        .contains(zoo_host::wgpu::Features::CLIP_DISTANCES);
+    if !clip_distances {
+        eprintln!("SKIPPED (Tiles): this device has no CLIP_DISTANCES");
+        return;
+    }
+    for scene in SCENES {
+        assert_volume_bounds(&judge(
+            scene,
+            "hybrid-edge",
+            &[("restriction", "Tiles")],
+            SIZE,
+        ));
+    }
+    // A tile size that is not a multiple of the list pass's 8 x 8 steps is rounded up.
+    let odd = [("restriction", "Tiles"), ("tile_size", "20")];
+    assert_volume_bounds(&judge("curved.ron", "hybrid-edge", &odd, SIZE));
+}
+
 fn values(assignments: &[(&str, &str)]) -> ParamValues {
     let schema = (zoo_host::find_technique("hybrid-edge").unwrap().params)();
     let mut values = defaults(&schema);
