@@ -424,6 +424,20 @@ mod tests {
         assert_eq!(fit.frustum.view_proj, uniform.frustum.view_proj);
     }
 
+    /// A directional light travelling along `direction`.
+    fn sun(direction: Vec3) -> Light {
+        Light {
+            kind: LightKind::Directional,
+            position: Vec3::ZERO,
+            direction,
+            radiance: Vec3::ONE,
+            range: 0.0,
+            spot_angle: 0.0,
+            spot_softness: 0.0,
+            radius: 0.0,
+        }
+    }
+
     /// Map position and depth of `p`.
     fn map(frustum: &LightFrustum, p: Vec3) -> Vec3 {
         let clip = frustum.view_proj * p.extend(1.0);
@@ -435,16 +449,7 @@ mod tests {
         let c = camera();
         // A low sun from the left and behind the viewer: its rays pass behind the viewer
         // before they reach the view.
-        let light = Light {
-            kind: LightKind::Directional,
-            position: Vec3::ZERO,
-            direction: Vec3::new(0.9, -0.4, -0.15).normalize(),
-            radiance: Vec3::ONE,
-            range: 0.0,
-            spot_angle: 0.0,
-            spot_softness: 0.0,
-            radius: 0.0,
-        };
+        let light = sun(Vec3::new(0.9, -0.4, -0.15).normalize());
         // A receiver point in view, and a caster on its light ray behind the viewer.
         let receiver = Vec3::new(2.0, 0.0, -6.0);
         let blocker = receiver - light.direction * 60.0;
@@ -485,16 +490,7 @@ mod tests {
         // A sun straight behind the viewer lands just past the far plane, inside the view's
         // post-perspective footprint: it would need a field of view near 180 degrees.
         let c = camera();
-        let light = Light {
-            kind: LightKind::Directional,
-            position: Vec3::ZERO,
-            direction: Vec3::new(0.0, -0.4, -1.0).normalize(),
-            radiance: Vec3::ONE,
-            range: 0.0,
-            spot_angle: 0.0,
-            spot_softness: 0.0,
-            radius: 0.0,
-        };
+        let light = sun(Vec3::new(0.0, -0.4, -1.0).normalize());
         let fit = psm_frustum(
             &light,
             &c,
@@ -510,16 +506,7 @@ mod tests {
     #[test]
     fn psm_orders_depth_along_a_light_in_front() {
         let c = camera();
-        let light = Light {
-            kind: LightKind::Directional,
-            position: Vec3::ZERO,
-            direction: Vec3::new(0.9, -0.4, 0.3).normalize(),
-            radiance: Vec3::ONE,
-            range: 0.0,
-            spot_angle: 0.0,
-            spot_softness: 0.0,
-            radius: 0.0,
-        };
+        let light = sun(Vec3::new(0.9, -0.4, 0.3).normalize());
         let receiver = Vec3::new(1.0, 0.0, -12.0);
         let blocker = receiver - light.direction * 3.0;
         let caster = (blocker - Vec3::splat(0.2), blocker + Vec3::splat(0.2));

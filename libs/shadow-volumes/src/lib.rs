@@ -11,6 +11,6 @@ pub use generation::{
     ARGS_BYTES, VolumeGenerator, Volumes, dispatch_size, triangle_flags, volume_capacity,
 };
 pub use stencil::{
-    Counting, VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil, stencil_state, volume_depth_stencil,
-    volume_primitive,
+    Counting, VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil, band_volume_pipeline, stencil_state,
+    volume_depth_stencil, volume_primitive,
 };

@@ -1,5 +1,7 @@
 //! Counting volume crossings in the stencil buffer.
 
+use zoo_host::RenderContext;
+use zoo_host::kit::{pipeline_layout, slot_target};
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::wgpu;
 
@@ -67,6 +69,48 @@ pub fn band_volume_depth_stencil(bias: wgpu::DepthBiasState) -> wgpu::DepthStenc
     let front = face(wgpu::StencilOperation::DecrementWrap);
     let back = face(wgpu::StencilOperation::IncrementWrap);
     stencil_state(wgpu::CompareFunction::Greater, front, back, bias)
+}
+
+/// A pipeline that counts volumes in a band ([`band_volume_depth_stencil`]) from vertex stage
+/// `vertex_entry` and fragment `fs_volume` of `module`, inside a light pass whose colour
+/// attachment is the light's visibility slot (left untouched), with the host's groups and then
+/// `groups`.
+pub fn band_volume_pipeline(
+    ctx: &RenderContext<'_>,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    vertex_entry: &str,
+    groups: &[&wgpu::BindGroupLayout],
+    bias: wgpu::DepthBiasState,
+) -> wgpu::RenderPipeline {
+    let layout = pipeline_layout(ctx, &format!("{label} layout"), groups);
+    let untouched = Some(wgpu::ColorTargetState {
+        write_mask: wgpu::ColorWrites::empty(),
+        ..slot_target()
+    });
+    ctx.gpu
+        .device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some(vertex_entry),
+                compilation_options: Default::default(),
+                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
+            },
+            primitive: volume_primitive(),
+            depth_stencil: Some(band_volume_depth_stencil(bias)),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some("fs_volume"),
+                compilation_options: Default::default(),
+                targets: &[untouched],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
 }
 
 /// A state on the G-buffer's depth-stencil that tests depth with `depth_compare` (never

@@ -36,10 +36,7 @@ use zoo_shadow_maps::{DepthState, LightMaps, ShadowMapSet, layer_pass_name};
 
 use ids::IdMaps;
 use tiles::Tiles;
-use zoo_shadow_volumes::{
-    VOLUME_VERTEX_LAYOUT, VolumeGenerator, Volumes, band_volume_depth_stencil, stencil_state,
-    volume_primitive,
-};
+use zoo_shadow_volumes::{VolumeGenerator, Volumes, band_volume_pipeline, stencil_state};
 
 zoo_host::param_choice! {
     /// Where shadow volumes are counted.
@@ -216,31 +213,14 @@ impl Gpu {
             slope_scale: 0.0,
             clamp: 0.0,
         };
-        let no_colour = Some(wgpu::ColorTargetState {
-            write_mask: wgpu::ColorWrites::empty(),
-            ..zoo_host::kit::slot_target()
-        });
-        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("hybrid volume pipeline"),
-            layout: Some(&pipeline_layout(ctx, "hybrid volume pipeline layout", &[])),
-            vertex: wgpu::VertexState {
-                module: &draw_module,
-                entry_point: Some("vs_volume"),
-                compilation_options: Default::default(),
-                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
-            },
-            primitive: volume_primitive(),
-            depth_stencil: Some(band_volume_depth_stencil(bias)),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &draw_module,
-                entry_point: Some("fs_volume"),
-                compilation_options: Default::default(),
-                targets: &[no_colour],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let volume = band_volume_pipeline(
+            ctx,
+            "hybrid volume pipeline",
+            &draw_module,
+            "vs_volume",
+            &[],
+            bias,
+        );
         let keep = wgpu::StencilOperation::Keep;
         let not_zero = wgpu::StencilFaceState {
             compare: wgpu::CompareFunction::NotEqual,

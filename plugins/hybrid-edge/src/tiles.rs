@@ -8,7 +8,7 @@ use zoo_host::glam::UVec2;
 use zoo_host::gpu::PassRecorder;
 use zoo_host::kit::{bind_group, bind_group_layout, pipeline_layout, storage, texture, uniform};
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
-use zoo_shadow_volumes::{VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil, volume_primitive};
+use zoo_shadow_volumes::band_volume_pipeline;
 
 /// `TileParams` in the tile shaders.
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -98,33 +98,15 @@ impl Tiles {
             cache: None,
         });
         // The host's groups first (the shader reads only the frame's), the tiles at group 2.
-        let draw_pipeline_layout =
-            pipeline_layout(ctx, "hybrid tiled volume pipeline layout", &[&draw_layout]);
-        let no_colour = Some(wgpu::ColorTargetState {
-            write_mask: wgpu::ColorWrites::empty(),
-            ..zoo_host::kit::slot_target()
-        });
-        let volume = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("hybrid tiled volume pipeline"),
-            layout: Some(&draw_pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &draw_module,
-                entry_point: Some("vs_volume_tiled"),
-                compilation_options: Default::default(),
-                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
-            },
-            primitive: volume_primitive(),
-            depth_stencil: Some(band_volume_depth_stencil(bias)),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &draw_module,
-                entry_point: Some("fs_volume"),
-                compilation_options: Default::default(),
-                targets: &[no_colour],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let label = "hybrid tiled volume pipeline";
+        let volume = band_volume_pipeline(
+            ctx,
+            label,
+            &draw_module,
+            "vs_volume_tiled",
+            &[&draw_layout],
+            bias,
+        );
         let overlay_module = ctx
             .shaders
             .create_module(device, "hybrid-edge/tile_overlay.wgsl")?;
