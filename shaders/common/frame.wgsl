@@ -42,6 +42,8 @@ struct Object {
     color: vec4<f32>,
     // x shininess, y casts shadows (0 or 1).
     material: vec4<f32>,
+    // Translucent casters: rgb the colour they let through, w = 1; opaque casters: all 0.
+    transmittance: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> camera: Camera;

@@ -1,4 +1,4 @@
-// Deferred lighting: ambient + sum over lights of visibility * direct + indirect.
+// Deferred lighting: ambient + sum over lights of visibility * transmittance * direct + indirect.
 // Every technique is shaded by this same pass from the visibility it wrote.
 
 #import "common/frame.wgsl"
@@ -8,6 +8,17 @@
 
 @group(2) @binding(0) var visibility: texture_2d_array<f32>;
 @group(2) @binding(1) var indirect: texture_2d<f32>;
+// The colour each light keeps through translucent casters: a layer per visibility slot, or one
+// white texel for techniques that do not write it.
+@group(2) @binding(2) var transmittance: texture_2d_array<f32>;
+
+// Light `light`'s transmittance colour at `pixel` (white where no technique wrote one).
+fn light_transmittance(light: Light, pixel: vec2<i32>) -> vec3<f32> {
+    let size = vec2<i32>(textureDimensions(transmittance));
+    let slots = textureNumLayers(transmittance);
+    let slot = min(light.slot_layer * 4u + light.slot_channel, slots - 1u);
+    return textureLoad(transmittance, min(pixel, size - vec2<i32>(1)), slot, 0).rgb;
+}
 
 fn tonemap(c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(1.0) - exp(-c);
@@ -33,7 +44,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         }
         let v = textureLoad(visibility, pixel, light.slot_layer, 0)[light.slot_channel];
         if v > 0.0 {
-            color += v * direct_light(light, s.position, s.normal, view_dir,
+            color += v * light_transmittance(light, pixel) * direct_light(light, s.position, s.normal, view_dir,
                                       s.albedo, s.specular, s.shininess);
         }
     }

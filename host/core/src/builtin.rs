@@ -16,9 +16,12 @@ impl ShadowTechnique for Unshadowed {
         Vec::new()
     }
 
-    fn packs_visibility_slots(&self) -> bool {
+    fn assign_slots(
+        &self,
+        request: &crate::render::SlotRequest<'_>,
+    ) -> crate::technique::TechniqueResult<crate::render::SlotAssignment> {
         // It writes nothing, so any sharing is exact.
-        true
+        Ok(crate::render::SlotAssignment::packed(request.lights))
     }
 
     fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> Result<(), TechniqueError> {

@@ -100,8 +100,11 @@ pub struct Judged {
     pub gpu_ms: f64,
     /// The final image.
     pub image: RgbaImage,
-    /// The technique's visibility per light.
+    /// The technique's visibility per light (times the mean of its transmittance colour
+    /// where it writes one).
     pub visibility: Vec<Vec<f32>>,
+    /// The technique's transmittance colour per light, when it writes one.
+    pub transmittance: Vec<Option<Vec<glam::Vec3>>>,
     /// Visibility slots the lights shared (fewer than lights when the technique packs them).
     pub slot_count: u32,
 }
@@ -122,8 +125,21 @@ pub fn judge_technique(
     let (width, height) = reference.size();
     let mut scores = Vec::new();
     let mut visibility = Vec::new();
+    let colored = renderer
+        .technique_instance()
+        .writes_transmittance(renderer.scene());
+    let mut transmittance = Vec::new();
     for (i, light) in renderer.lights().iter().enumerate() {
-        let v = renderer.read_visibility(i);
+        let mut v = renderer.read_visibility(i);
+        // Behind translucent casters the judge scores the light that arrives: visibility
+        // times the mean of the transmittance colour, as its reference does.
+        let t = colored.then(|| renderer.read_transmittance(i));
+        if let Some(t) = &t {
+            for (v, t) in v.iter_mut().zip(t) {
+                *v *= (t.x + t.y + t.z) / 3.0;
+            }
+        }
+        transmittance.push(t);
         let metrics = registration
             .supports(light.kind)
             .then(|| Metrics::compute(&reference.lights[i], &v, width, height, None));
@@ -142,6 +158,7 @@ pub fn judge_technique(
         timings,
         image: renderer.read_output(),
         visibility,
+        transmittance,
         slot_count: renderer.slots().slot_count(),
     })
 }

@@ -7,7 +7,10 @@
 
 use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
 use crate::params::{ParamError, ParamSpec, ParamValues};
-use crate::render::{FrameBindings, GBuffer, IndirectTarget, SceneBuffers, VisibilityTargets};
+use crate::render::{
+    FrameBindings, GBuffer, IndirectTarget, SceneBuffers, SlotAssignment, SlotRequest,
+    TransmittanceTargets, VisibilityTargets,
+};
 use crate::scene::{Camera, Light, LightKind, Scene};
 
 /// Creates a technique instance for a device and validated parameter values.
@@ -386,6 +389,9 @@ pub struct RenderContext<'a> {
     pub gbuffer: &'a GBuffer,
     /// Where visibility goes: one (layer, channel) slot per light.
     pub visibility: &'a VisibilityTargets,
+    /// The colour each light keeps through translucent casters: one layer per visibility slot,
+    /// cleared to white, when the technique [writes it](ShadowTechnique::writes_transmittance).
+    pub transmittance: &'a TransmittanceTargets,
     /// Additive indirect radiance (for global-illumination techniques).
     pub indirect: &'a IndirectTarget,
     /// The current camera (may differ from the scene's when animated).
@@ -410,9 +416,26 @@ pub trait ShadowTechnique: Send {
         Vec::new()
     }
 
-    /// Whether lights whose influence volumes do not overlap may share one visibility slot.
-    /// Techniques that write visibility only inside a light's influence may say yes.
-    fn packs_visibility_slots(&self) -> bool {
+    /// Which visibility slot each light writes, for the current lights and camera. The default
+    /// gives every light its own; a technique that writes a light's visibility only inside
+    /// its influence may share slots between lights whose influences do not overlap
+    /// ([`SlotAssignment::packed`]), or colour the lights itself. Called when the technique or
+    /// the lights change, and on camera moves when [`Self::slots_follow_camera`]. An error
+    /// (an assignment over the technique's cap, naming the lights) disables the technique.
+    fn assign_slots(&self, request: &SlotRequest<'_>) -> TechniqueResult<SlotAssignment> {
+        Ok(SlotAssignment::one_per_light(request.lights.len()))
+    }
+
+    /// Whether [`Self::assign_slots`] depends on the camera (it is called again whenever the
+    /// camera moves).
+    fn slots_follow_camera(&self) -> bool {
+        false
+    }
+
+    /// Whether it writes a transmittance colour per light ([`RenderContext::transmittance`])
+    /// in `scene`, for translucent casters whose shadows are coloured. Techniques that treat translucent
+    /// casters as opaque leave it `false`.
+    fn writes_transmittance(&self, _scene: &Scene) -> bool {
         false
     }
 

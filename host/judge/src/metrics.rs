@@ -151,6 +151,7 @@ mod tests {
             contributing: vec![true; hard.len()],
             hard: hard.to_vec(),
             area: hard.to_vec(),
+            color: None,
             samples: 1,
         }
     }

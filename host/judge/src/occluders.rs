@@ -21,64 +21,23 @@ const CANONICAL_TMIN: f32 = 2e-4;
 /// 65 ulps of the largest canonical coordinate (512).
 const BOX_PADDING: f32 = 4e-3;
 
-/// The occluding geometry of a scene.
-///
-/// The triangles are stored in a canonical frame (centred on the scene, scaled so that its
-/// diagonal is [`CANONICAL_SIZE`]): obvhs culls BVH nodes that end before a fixed distance of
-/// 1e-4 from the ray origin, which would otherwise drop nearby occluders in small scenes.
-pub struct Occluders {
+/// Triangles in a BVH, in the canonical frame of their [`Occluders`].
+struct TriangleBvh {
     bvh: CwBvh,
     triangles: Vec<Triangle>,
-    /// World-space centre of the canonical frame.
-    centre: Vec3,
-    /// World to canonical scale.
-    scale: f32,
-    epsilon: f32,
+    /// Per kept triangle: the index of the input triangle it came from.
+    sources: Vec<usize>,
 }
 
-impl Occluders {
-    /// The triangles of every shadow-casting object of `scene`.
-    pub fn new(scene: &Scene) -> Occluders {
-        let mut triangles = Vec::new();
-        for object in scene.objects.iter().filter(|o| o.casts_shadows) {
-            for tri in scene.mesh.indices[object.indices.clone()].chunks_exact(3) {
-                let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| scene.mesh.positions[i as usize]);
-                triangles.push([a, b, c]);
-            }
-        }
-        let (lo, hi) = scene.bounds();
-        Occluders::from_triangles(&triangles, lo.distance(hi))
-    }
-
-    /// Occluders from world-space triangles in a scene of the given diagonal size.
-    pub fn from_triangles(triangles: &[[Vec3; 3]], scene_size: f32) -> Occluders {
-        let (lo, hi) = triangles
+impl TriangleBvh {
+    /// Builds the BVH over the non-degenerate ones of `triangles` (already canonical).
+    fn new(triangles: &[Triangle]) -> TriangleBvh {
+        let (sources, triangles): (Vec<usize>, Vec<Triangle>) = triangles
             .iter()
-            .flatten()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(*v), hi.max(*v))
-            });
-        let (centre, scale) = if triangles.is_empty() {
-            (Vec3::ZERO, 1.0)
-        } else {
-            let diagonal = lo.distance(hi);
-            let scale = if diagonal > 0.0 {
-                CANONICAL_SIZE / diagonal
-            } else {
-                1.0
-            };
-            ((lo + hi) * 0.5, scale)
-        };
-        let canonical = |v: Vec3| Vec3A::from((v - centre) * scale);
-        let triangles: Vec<Triangle> = triangles
-            .iter()
-            .map(|[a, b, c]| Triangle {
-                v0: canonical(*a),
-                v1: canonical(*b),
-                v2: canonical(*c),
-            })
-            .filter(|t| !is_degenerate(t))
-            .collect();
+            .enumerate()
+            .filter(|(_, t)| !is_degenerate(t))
+            .map(|(i, t)| (i, *t))
+            .unzip();
         // Leaf boxes are padded so that node tests, which lose about one ulp of the canonical
         // coordinates, never reject a ray that the triangle test accepts.
         let boxes: Vec<Aabb> = triangles
@@ -96,23 +55,167 @@ impl Occluders {
             BvhBuildParams::fast_build(),
             &mut Duration::default(),
         );
-        Occluders {
+        TriangleBvh {
             bvh,
             triangles,
+            sources,
+        }
+    }
+
+    /// Whether `ray` hits any triangle before its `tmax`.
+    fn any_hit(&self, ray: Ray) -> bool {
+        !self.triangles.is_empty()
+            && !self.bvh.ray_traverse_miss(ray, |ray, id| {
+                let index = self.bvh.primitive_indices[id] as usize;
+                self.triangles[index].intersect(ray)
+            })
+    }
+
+    /// Calls `hit` with the source index of every triangle `ray` crosses before its `tmax`.
+    fn each_hit(&self, ray: Ray, mut hit: impl FnMut(usize)) {
+        if self.triangles.is_empty() {
+            return;
+        }
+        self.bvh.ray_traverse_miss(ray, |ray, id| {
+            let index = self.bvh.primitive_indices[id] as usize;
+            if self.triangles[index].intersect(ray) < ray.tmax {
+                hit(self.sources[index]);
+            }
+            // Never report a hit, so traversal visits every candidate.
+            f32::INFINITY
+        });
+    }
+}
+
+/// Translucent shadow casters: their triangles, the object each belongs to, and the colour
+/// each object lets through.
+struct TranslucentCasters {
+    bvh: TriangleBvh,
+    /// Per input triangle: its object (an index into `transmittance`).
+    owners: Vec<usize>,
+    transmittance: Vec<Vec3>,
+}
+
+/// The occluding geometry of a scene: opaque casters, which block shadow rays, and
+/// translucent ones, each of which filters a ray that crosses it once by its transmittance
+/// colour (however many of its surfaces the ray crosses).
+///
+/// The triangles are stored in a canonical frame (centred on the scene, scaled so that its
+/// diagonal is [`CANONICAL_SIZE`]): obvhs culls BVH nodes that end before a fixed distance of
+/// 1e-4 from the ray origin, which would otherwise drop nearby occluders in small scenes.
+pub struct Occluders {
+    opaque: TriangleBvh,
+    translucent: Option<TranslucentCasters>,
+    /// World-space centre of the canonical frame.
+    centre: Vec3,
+    /// World to canonical scale.
+    scale: f32,
+    epsilon: f32,
+}
+
+/// An object's world-space triangles.
+fn object_triangles(scene: &Scene, object: &zoo_scene::SceneObject) -> Vec<[Vec3; 3]> {
+    scene.mesh.indices[object.indices.clone()]
+        .chunks_exact(3)
+        .map(|tri| [tri[0], tri[1], tri[2]].map(|i| scene.mesh.positions[i as usize]))
+        .collect()
+}
+
+impl Occluders {
+    /// The triangles of every shadow-casting object of `scene`: opaque objects block, and
+    /// translucent ones (opacity below 1) filter.
+    pub fn new(scene: &Scene) -> Occluders {
+        let mut opaque = Vec::new();
+        let mut translucent = Vec::new();
+        for object in scene.objects.iter().filter(|o| o.casts_shadows) {
+            let triangles = object_triangles(scene, object);
+            match object.transmittance() {
+                None => opaque.extend(triangles),
+                Some(t) => translucent.push((triangles, t)),
+            }
+        }
+        let (lo, hi) = scene.bounds();
+        Occluders::with_translucent(&opaque, &translucent, lo.distance(hi))
+    }
+
+    /// Opaque occluders from world-space triangles in a scene of the given diagonal size.
+    pub fn from_triangles(triangles: &[[Vec3; 3]], scene_size: f32) -> Occluders {
+        Occluders::with_translucent(triangles, &[], scene_size)
+    }
+
+    /// Opaque triangles and translucent objects (their triangles and the colour each lets
+    /// through) in a scene of the given diagonal size.
+    pub fn with_translucent(
+        opaque: &[[Vec3; 3]],
+        translucent: &[(Vec<[Vec3; 3]>, Vec3)],
+        scene_size: f32,
+    ) -> Occluders {
+        let all = opaque
+            .iter()
+            .chain(translucent.iter().flat_map(|(t, _)| t.iter()));
+        let (lo, hi) = all
+            .clone()
+            .flatten()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(*v), hi.max(*v))
+            });
+        let (centre, scale) = if all.clone().next().is_none() {
+            (Vec3::ZERO, 1.0)
+        } else {
+            let diagonal = lo.distance(hi);
+            let scale = if diagonal > 0.0 {
+                CANONICAL_SIZE / diagonal
+            } else {
+                1.0
+            };
+            ((lo + hi) * 0.5, scale)
+        };
+        let canonical = |v: Vec3| Vec3A::from((v - centre) * scale);
+        let to_canonical = |tris: &mut dyn Iterator<Item = &[Vec3; 3]>| -> Vec<Triangle> {
+            tris.map(|[a, b, c]| Triangle {
+                v0: canonical(*a),
+                v1: canonical(*b),
+                v2: canonical(*c),
+            })
+            .collect()
+        };
+        let translucent = (!translucent.is_empty()).then(|| TranslucentCasters {
+            bvh: TriangleBvh::new(&to_canonical(
+                &mut translucent.iter().flat_map(|(t, _)| t.iter()),
+            )),
+            owners: translucent
+                .iter()
+                .enumerate()
+                .flat_map(|(k, (t, _))| std::iter::repeat_n(k, t.len()))
+                .collect(),
+            transmittance: translucent.iter().map(|(_, t)| *t).collect(),
+        });
+        Occluders {
+            opaque: TriangleBvh::new(&to_canonical(&mut opaque.iter())),
+            translucent,
             centre,
             scale,
             epsilon: (scene_size * 2e-5).max(1e-5),
         }
     }
 
-    /// Number of triangles.
+    /// Number of triangles (opaque and translucent).
     pub fn len(&self) -> usize {
-        self.triangles.len()
+        self.opaque.triangles.len()
+            + self
+                .translucent
+                .as_ref()
+                .map_or(0, |t| t.bvh.triangles.len())
     }
 
     /// Whether there are no occluders.
     pub fn is_empty(&self) -> bool {
-        self.triangles.is_empty()
+        self.len() == 0
+    }
+
+    /// Whether any caster is translucent.
+    pub fn has_translucent(&self) -> bool {
+        self.translucent.is_some()
     }
 
     /// Offset along the normal applied to ray origins (scaled to the scene).
@@ -120,7 +223,8 @@ impl Occluders {
         self.epsilon
     }
 
-    /// Whether anything lies on the segment from `origin` along unit `direction` up to `tmax`.
+    /// Whether an opaque caster lies on the segment from `origin` along unit `direction` up to
+    /// `tmax`.
     ///
     /// Exact for every direction, including axis-aligned ones: obvhs 0.4 picks each slab's near
     /// plane from `direction < 0` but inverts -0.0 to a negative reciprocal, so a -0.0 component
@@ -128,18 +232,36 @@ impl Occluders {
     /// zeros are turned into positive ones and the ray's reciprocals are computed here (see
     /// [`reciprocal`]). Occluders closer than 2e-7 of the scene's diagonal are not counted.
     pub fn occluded(&self, origin: Vec3, direction: Vec3, tmax: f32) -> bool {
+        self.canonical_ray(origin, direction, tmax)
+            .is_some_and(|ray| self.opaque.any_hit(ray))
+    }
+
+    /// The colour fraction of light that travels the segment: 0 when an opaque caster is on
+    /// it, else the product of the transmittance of every translucent object it crosses.
+    pub fn transmittance(&self, origin: Vec3, direction: Vec3, tmax: f32) -> Vec3 {
         let Some(ray) = self.canonical_ray(origin, direction, tmax) else {
-            return false;
+            return Vec3::ONE;
         };
-        !self.bvh.ray_traverse_miss(ray, |ray, id| {
-            let index = self.bvh.primitive_indices[id] as usize;
-            self.triangles[index].intersect(ray)
-        })
+        if self.opaque.any_hit(ray) {
+            return Vec3::ZERO;
+        }
+        let Some(translucent) = &self.translucent else {
+            return Vec3::ONE;
+        };
+        let mut crossed = vec![false; translucent.transmittance.len()];
+        translucent
+            .bvh
+            .each_hit(ray, |source| crossed[translucent.owners[source]] = true);
+        crossed
+            .iter()
+            .zip(&translucent.transmittance)
+            .filter(|(c, _)| **c)
+            .fold(Vec3::ONE, |product, (_, t)| product * *t)
     }
 
     /// The query as a ray in the canonical frame (`None` when nothing can be hit).
     fn canonical_ray(&self, origin: Vec3, direction: Vec3, tmax: f32) -> Option<Ray> {
-        if self.triangles.is_empty() || !direction.is_finite() || !origin.is_finite() {
+        if self.is_empty() || !direction.is_finite() || !origin.is_finite() {
             return None;
         }
         // -0.0 + 0.0 == +0.0; every other value is unchanged.
@@ -343,6 +465,7 @@ mod tests {
                 let bvh = occluders.occluded(origin, direction, tmax);
                 let ray = occluders.canonical_ray(origin, direction, tmax).unwrap();
                 let brute = occluders
+                    .opaque
                     .triangles
                     .iter()
                     .any(|t| t.intersect(&ray) < ray.tmax);

@@ -25,11 +25,16 @@ pub struct LightReference {
     /// Whether the light reaches the pixel's surface (facing it, in range and cone). Pixels
     /// where it does not are left out of every metric.
     pub contributing: Vec<bool>,
-    /// Point-light visibility: 0 or 1 (1 where not contributing).
+    /// Point-light visibility: 0 or 1 (1 where not contributing); behind translucent casters,
+    /// the mean over the colour channels of the light they let through.
     pub hard: Vec<f32>,
     /// Fraction of the light's area visible, each part weighted by its cosine to the normal
-    /// (equals `hard` for lights of radius 0).
+    /// (equals `hard` for lights of radius 0); behind translucent casters, the mean over the
+    /// colour channels of [`Self::color`].
     pub area: Vec<f32>,
+    /// In scenes with translucent casters: the colour fraction of the light's area that
+    /// arrives (weighted as `area`), per pixel.
+    pub color: Option<Vec<Vec3>>,
     /// Area samples used per contributing pixel.
     pub samples: u32,
 }
@@ -59,47 +64,57 @@ fn basis(w: Vec3) -> (Vec3, Vec3) {
     (u, w.cross(u))
 }
 
-fn visible(occluders: &Occluders, origin: Vec3, target: Vec3) -> bool {
+/// The colour fraction of light that travels from `origin` along unit `direction` for
+/// `distance` (infinite for directional lights): 0 or 1, or filtered by translucent casters.
+fn transmitted(occluders: &Occluders, origin: Vec3, direction: Vec3, distance: f32) -> Vec3 {
+    if occluders.has_translucent() {
+        return occluders.transmittance(origin, direction, distance);
+    }
+    Vec3::splat(if occluders.occluded(origin, direction, distance) {
+        0.0
+    } else {
+        1.0
+    })
+}
+
+/// [`transmitted`] from `origin` to the point `target`.
+fn transmitted_to(occluders: &Occluders, origin: Vec3, target: Vec3) -> Vec3 {
     let to = target - origin;
     let distance = to.length();
-    distance <= 0.0 || !occluders.occluded(origin, to / distance, distance * (1.0 - 1e-4))
+    if distance <= 0.0 {
+        return Vec3::ONE;
+    }
+    transmitted(occluders, origin, to / distance, distance * (1.0 - 1e-4))
 }
 
-fn visible_direction(occluders: &Occluders, origin: Vec3, direction: Vec3) -> bool {
-    !occluders.occluded(origin, direction, f32::INFINITY)
-}
-
-/// Cosine-weighted fraction of samples that are visible: each sample direction counts with
+/// Cosine-weighted mean of the samples' transmitted light: each sample direction counts with
 /// max(0, n . direction), so the part of an emitter below the surface's horizon (which lights
 /// nothing, shadowed or not) does not count as shadow. For a light at grazing incidence the
 /// plain fraction would be about 0.5 (half the disk below the horizon) where the ratio of
 /// shadowed to unshadowed irradiance is 1. `None` when no sample lies above the horizon.
-fn weighted_fraction(samples: impl Iterator<Item = (Vec3, bool)>, normal: Vec3) -> Option<f32> {
-    let (mut visible, mut total) = (0.0f32, 0.0f32);
-    for (direction, seen) in samples {
+fn weighted_fraction(samples: impl Iterator<Item = (Vec3, Vec3)>, normal: Vec3) -> Option<Vec3> {
+    let (mut arrived, mut total) = (Vec3::ZERO, 0.0f32);
+    for (direction, light) in samples {
         let weight = normal.dot(direction).max(0.0);
         total += weight;
-        if seen {
-            visible += weight;
-        }
+        arrived += weight * light;
     }
-    (total > 0.0).then(|| visible / total)
+    (total > 0.0).then(|| arrived / total)
 }
 
-/// Visibility of `light` from one surface point: (hard, area).
+/// Visibility of `light` from one surface point: (hard, area) colour fractions.
 fn point_visibility(
     occluders: &Occluders,
     light: &Light,
     point: &SurfacePoint,
     grid: u32,
     seed: u32,
-) -> (f32, f32) {
+) -> (Vec3, Vec3) {
     let origin = point.position + point.normal * occluders.epsilon();
-    let as_f32 = |b: bool| if b { 1.0 } else { 0.0 };
     match light.kind {
         LightKind::Directional => {
             let toward = -light.direction;
-            let hard = as_f32(visible_direction(occluders, origin, toward));
+            let hard = transmitted(occluders, origin, toward, f32::INFINITY);
             if light.radius <= 0.0 {
                 return (hard, hard);
             }
@@ -107,7 +122,7 @@ fn point_visibility(
             let spread = light.radius.tan();
             let samples = stratified_disk(grid, seed).map(|d: Vec2| {
                 let dir = (toward + spread * (u * d.x + v * d.y)).normalize();
-                (dir, visible_direction(occluders, origin, dir))
+                (dir, transmitted(occluders, origin, dir, f32::INFINITY))
             });
             (
                 hard,
@@ -115,7 +130,7 @@ fn point_visibility(
             )
         }
         LightKind::Point | LightKind::Spot => {
-            let hard = as_f32(visible(occluders, origin, light.position));
+            let hard = transmitted_to(occluders, origin, light.position);
             if light.radius <= 0.0 {
                 return (hard, hard);
             }
@@ -123,7 +138,7 @@ fn point_visibility(
             let samples = stratified_disk(grid, seed).map(|d: Vec2| {
                 let target = light.position + light.radius * (u * d.x + v * d.y);
                 let dir = (target - origin).normalize_or_zero();
-                (dir, visible(occluders, origin, target))
+                (dir, transmitted_to(occluders, origin, target))
             });
             (
                 hard,
@@ -131,6 +146,11 @@ fn point_visibility(
             )
         }
     }
+}
+
+/// Mean of the colour channels.
+fn mean(c: Vec3) -> f32 {
+    (c.x + c.y + c.z) / 3.0
 }
 
 /// Reference visibility of `light` at every point (`None` = background pixel). `samples` is
@@ -142,7 +162,7 @@ pub fn reference_visibility(
     samples: u32,
 ) -> LightReference {
     let grid = (samples.max(1) as f32).sqrt().ceil() as u32;
-    let results: Vec<(bool, f32, f32)> = points
+    let results: Vec<(bool, Vec3, Vec3)> = points
         .par_iter()
         .enumerate()
         .with_min_len(64)
@@ -151,13 +171,16 @@ pub fn reference_visibility(
                 let (hard, area) = point_visibility(occluders, light, p, grid, i as u32);
                 (true, hard, area)
             }
-            _ => (false, 1.0, 1.0),
+            _ => (false, Vec3::ONE, Vec3::ONE),
         })
         .collect();
     LightReference {
         contributing: results.iter().map(|r| r.0).collect(),
-        hard: results.iter().map(|r| r.1).collect(),
-        area: results.iter().map(|r| r.2).collect(),
+        hard: results.iter().map(|r| mean(r.1)).collect(),
+        area: results.iter().map(|r| mean(r.2)).collect(),
+        color: occluders
+            .has_translucent()
+            .then(|| results.iter().map(|r| r.2).collect()),
         samples: grid * grid,
     }
 }

@@ -258,3 +258,120 @@ fn a_wall_at_grazing_incidence_is_fully_visible() {
         }
     }
 }
+
+/// A unit box (12 triangles) centred at `c` with half-size `h`.
+fn cube(c: Vec3, h: f32) -> Vec<[Vec3; 3]> {
+    let v = |x: f32, y: f32, z: f32| c + Vec3::new(x, y, z) * h;
+    let quads = [
+        [
+            v(-1., -1., -1.),
+            v(1., -1., -1.),
+            v(1., 1., -1.),
+            v(-1., 1., -1.),
+        ],
+        [
+            v(-1., -1., 1.),
+            v(1., -1., 1.),
+            v(1., 1., 1.),
+            v(-1., 1., 1.),
+        ],
+        [
+            v(-1., -1., -1.),
+            v(-1., 1., -1.),
+            v(-1., 1., 1.),
+            v(-1., -1., 1.),
+        ],
+        [
+            v(1., -1., -1.),
+            v(1., 1., -1.),
+            v(1., 1., 1.),
+            v(1., -1., 1.),
+        ],
+        [
+            v(-1., -1., -1.),
+            v(1., -1., -1.),
+            v(1., -1., 1.),
+            v(-1., -1., 1.),
+        ],
+        [
+            v(-1., 1., -1.),
+            v(1., 1., -1.),
+            v(1., 1., 1.),
+            v(-1., 1., 1.),
+        ],
+    ];
+    quads
+        .iter()
+        .flat_map(|[a, b, c, d]| [[*a, *b, *c], [*a, *c, *d]])
+        .collect()
+}
+
+#[test]
+fn translucent_casters_filter_once_each_and_opaque_ones_block() {
+    let red = Vec3::new(0.5, 0.0, 0.0);
+    let cyan = Vec3::new(0.0, 0.8, 0.6);
+    let occluders = Occluders::with_translucent(
+        &cube(Vec3::new(4.0, 3.0, 0.0), 0.5),
+        &[
+            (cube(Vec3::new(0.0, 2.0, 0.0), 0.5), red),
+            (cube(Vec3::new(0.0, 4.0, 0.0), 0.5), cyan),
+            (cube(Vec3::new(-4.0, 2.0, 0.0), 0.5), cyan),
+        ],
+        20.0,
+    );
+    let up = Vec3::Y;
+    // Through one closed box: two of its faces, one filter.
+    assert_eq!(occluders.transmittance(Vec3::ZERO, up, 3.0), red);
+    // Through both boxes above the origin: the product.
+    assert_eq!(occluders.transmittance(Vec3::ZERO, up, 10.0), red * cyan);
+    assert!(
+        !occluders.occluded(Vec3::ZERO, up, 10.0),
+        "translucent casters do not block"
+    );
+    // An opaque box stops everything, whatever is translucent on the way.
+    assert_eq!(
+        occluders.transmittance(Vec3::new(4.0, 0.0, 0.0), up, 10.0),
+        Vec3::ZERO
+    );
+    assert!(occluders.occluded(Vec3::new(4.0, 0.0, 0.0), up, 10.0));
+    // Nothing in the way, or the segment ends before the box.
+    assert_eq!(
+        occluders.transmittance(Vec3::new(2.0, 0.0, 0.0), up, 10.0),
+        Vec3::ONE
+    );
+    assert_eq!(
+        occluders.transmittance(Vec3::new(-4.0, 0.0, 0.0), up, 1.0),
+        Vec3::ONE
+    );
+    assert_eq!(
+        occluders.transmittance(Vec3::new(-4.0, 0.0, 0.0), up, 2.0),
+        cyan
+    );
+}
+
+#[test]
+fn scenes_give_translucent_shadows_their_colour() {
+    let pole = "(mesh: Box(size: (0.4, 2, 0.4)), transform: (translation: (0, 1, 0)), \
+                opacity: 0.5, transmission: (1, 0.1, 0.1))";
+    let s = scene(pole, "Point(position: (0, 6, 0), intensity: 10, range: 50)");
+    let occluders = Occluders::new(&s);
+    assert!(occluders.has_translucent());
+    let points = floor_points(Vec2::ZERO, 2.0);
+    let r = reference_visibility(&occluders, &s.lights[0], &points, 1);
+    let color = r
+        .color
+        .as_ref()
+        .expect("colour kept in scenes with translucent casters");
+    let center = GRID / 2 * GRID + GRID / 2;
+    let expected = Vec3::new(0.5, 0.05, 0.05);
+    assert!(color[center].distance(expected) < 1e-6, "{}", color[center]);
+    assert!((r.hard[center] - 0.2).abs() < 1e-6, "{}", r.hard[center]);
+    assert_eq!(color[0], Vec3::ONE, "outside the shadow");
+    // Opacity outside [0, 1] is refused with the field named.
+    let bad = "(mesh: Box(size: (1, 1, 1)), opacity: 1.5)";
+    let text = format!(
+        "(camera: (position: (0, 5, 5), target: (0, 0, 0)), lights: [Point(position: (0, 6, 0))], objects: [{bad}])"
+    );
+    let e = Scene::from_ron(&text, Path::new("bad.ron"), Path::new(".")).unwrap_err();
+    assert!(e.to_string().contains("objects[0].opacity"), "{e}");
+}

@@ -151,6 +151,14 @@ pub struct ObjectDesc {
     /// Whether the object casts shadows.
     #[serde(default = "yes")]
     pub casts_shadows: bool,
+    /// How much light the object stops where a shadow ray crosses it, in [0, 1]: 1 (the
+    /// default) is opaque; below 1 the object is a translucent caster that lets
+    /// `(1 - opacity) * transmission` through.
+    #[serde(default = "one")]
+    pub opacity: f32,
+    /// Colour of the light a translucent caster lets through (linear RGB in [0, 1]).
+    #[serde(default = "white")]
+    pub transmission: Vec3,
 }
 
 fn default_color() -> Vec3 {

@@ -167,8 +167,20 @@ pub struct SceneObject {
     pub specular: f32,
     pub shininess: f32,
     pub casts_shadows: bool,
+    /// Opacity of a shadow caster in [0, 1] (1: opaque).
+    pub opacity: f32,
+    /// Colour a translucent caster lets through.
+    pub transmission: Vec3,
     /// What loading changed.
     pub report: MeshReport,
+}
+
+impl SceneObject {
+    /// The colour fraction of light a shadow ray keeps when it crosses this object, or `None`
+    /// for an opaque caster (opacity 1) or one that casts no shadow.
+    pub fn transmittance(&self) -> Option<Vec3> {
+        (self.casts_shadows && self.opacity < 1.0).then(|| self.transmission * (1.0 - self.opacity))
+    }
 }
 
 /// A receiver plane for planar projected shadows.
@@ -289,6 +301,20 @@ impl Scene {
                     "specular must be in [0, 1] and shininess finite",
                 ));
             }
+            if !(0.0..=1.0).contains(&object.opacity) {
+                return Err(invalid(
+                    format!("{field}.opacity"),
+                    "opacity must be in [0, 1] (1 is opaque)",
+                ));
+            }
+            if !(object.transmission.cmpge(Vec3::ZERO).all()
+                && object.transmission.cmple(Vec3::ONE).all())
+            {
+                return Err(invalid(
+                    format!("{field}.transmission"),
+                    "transmission components must be in [0, 1]",
+                ));
+            }
             let transform = t.matrix();
             let world = local.transformed(transform);
             let start = mesh.indices.len();
@@ -321,6 +347,8 @@ impl Scene {
                 specular: object.specular,
                 shininess: object.shininess,
                 casts_shadows: object.casts_shadows,
+                opacity: object.opacity,
+                transmission: object.transmission,
                 report,
             });
         }

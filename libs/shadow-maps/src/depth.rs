@@ -64,11 +64,15 @@ pub struct DepthState {
     pub slope_bias: f32,
     /// Store back faces (cull front faces).
     pub cull_front: bool,
+    /// Leave translucent casters out (for techniques that draw them into a transmittance map,
+    /// [`crate::TranslucentPass`]); by default they are drawn as opaque.
+    pub opaque_only: bool,
 }
 
 /// The depth pipeline and the layer cameras.
 pub struct DepthPass {
     label: String,
+    opaque_only: bool,
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     clear: Option<wgpu::Color>,
@@ -163,6 +167,7 @@ impl DepthPass {
         });
         Ok(DepthPass {
             label: label.to_string(),
+            opaque_only: state.opaque_only,
             pipeline,
             layout,
             clear: color.map(|c| c.clear),
@@ -245,7 +250,7 @@ impl DepthPass {
         lights: &[LightMaps],
         name: impl Fn(&LightMaps, usize) -> String,
     ) -> Result<(), TechniqueError> {
-        self.record_into(ctx, recorder, None, maps, lights, name)
+        self.record_into(ctx, recorder, None, maps, lights, name, &|_| true)
     }
 
     /// As [`Self::record`] for a pass with a [`ColorOutput`]: the colour goes into the layers
@@ -260,9 +265,26 @@ impl DepthPass {
         lights: &[LightMaps],
         name: impl Fn(&LightMaps, usize) -> String,
     ) -> Result<(), TechniqueError> {
-        self.record_into(ctx, recorder, Some(color), depth, lights, name)
+        self.record_into(ctx, recorder, Some(color), depth, lights, name, &|_| true)
     }
 
+    /// As [`Self::record`] or [`Self::record_color`] (with `color`), rendering only the layers
+    /// `keep` accepts (by layer index), for techniques that cull layers the view cannot see.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_kept(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        color: Option<&MapArray>,
+        depth: &MapArray,
+        lights: &[LightMaps],
+        name: impl Fn(&LightMaps, usize) -> String,
+        keep: &dyn Fn(u32) -> bool,
+    ) -> Result<(), TechniqueError> {
+        self.record_into(ctx, recorder, color, depth, lights, name, keep)
+    }
+
+    #[allow(clippy::too_many_arguments)]
     fn record_into(
         &self,
         ctx: &RenderContext<'_>,
@@ -271,6 +293,7 @@ impl DepthPass {
         depth: &MapArray,
         lights: &[LightMaps],
         name: impl Fn(&LightMaps, usize) -> String,
+        keep: &dyn Fn(u32) -> bool,
     ) -> Result<(), TechniqueError> {
         let (_, bind_group) = self
             .cameras
@@ -284,6 +307,9 @@ impl DepthPass {
         for light_maps in lights {
             for face in 0..light_maps.frustums.len() {
                 let layer = light_maps.first_layer + face as u32;
+                if !keep(layer) {
+                    continue;
+                }
                 let label = name(light_maps, face);
                 let clear = wgpu::LoadOp::Clear(self.clear.unwrap_or_default());
                 let colors: Vec<_> = color
@@ -308,7 +334,11 @@ impl DepthPass {
                 });
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, bind_group, &[(layer as u64 * CAMERA_STRIDE) as u32]);
-                ctx.scene_buffers.draw_objects(&mut pass, ctx.scene, true);
+                let opaque_only = self.opaque_only;
+                ctx.scene_buffers
+                    .draw_objects_where(&mut pass, ctx.scene, |o| {
+                        o.casts_shadows && !(opaque_only && o.transmittance().is_some())
+                    });
             }
         }
         Ok(())

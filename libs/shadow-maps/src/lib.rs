@@ -9,12 +9,14 @@
 
 pub mod blur;
 pub mod cascades;
+pub mod culling;
 pub mod depth;
 pub mod light_space;
 pub mod lookup;
 pub mod maps;
 pub mod planning;
 pub mod set;
+pub mod translucent;
 pub mod warped;
 
 pub use blur::LayerBlur;
@@ -28,3 +30,4 @@ pub use planning::{
     light_scissor, light_size, object_bounds, plan, plan_with,
 };
 pub use set::{ShadowMapSet, layer_pass_name};
+pub use translucent::{TRANSLUCENT_FORMAT, TranslucentPass};

@@ -37,6 +37,8 @@ pub struct ShadowMapSet {
     depth: Option<MapArray>,
     color: Option<MapArray>,
     fitted: bool,
+    /// Per layer: whether [`Self::record`] renders it (all, unless [`Self::cull`] says not).
+    kept: Vec<bool>,
 }
 
 impl ShadowMapSet {
@@ -71,6 +73,7 @@ impl ShadowMapSet {
             depth: None,
             color: None,
             fitted: false,
+            kept: Vec::new(),
         })
     }
 
@@ -117,6 +120,7 @@ impl ShadowMapSet {
             layout,
         );
         self.fitted = true;
+        self.kept.clear();
         let replaced = self.depth_pass.write_cameras(ctx.gpu, &self.lights) || replanned;
         let lookup = &mut self.lookup;
         let maps = self.color.as_ref().or(self.depth.as_ref());
@@ -233,12 +237,42 @@ impl ShadowMapSet {
         self.depth_pass.cameras()
     }
 
-    /// The passes [`Self::record`] records, named by [`layer_pass_name`] with `base`.
-    pub fn pass_names(&self, base: &str) -> Vec<String> {
-        DepthPass::pass_names(&self.lights, |l, k| layer_pass_name(base, l, k))
+    /// Renders only the layers `keep(light_maps, layer within the light)` accepts, until the
+    /// next [`Self::prepare`] (which keeps every layer again): for techniques that cull the
+    /// maps of lights and cube faces the view cannot see.
+    pub fn cull(&mut self, keep: impl Fn(&LightMaps, usize) -> bool) {
+        self.kept = self
+            .lights
+            .iter()
+            .flat_map(|l| (0..l.frustums.len()).map(move |k| (l, k)))
+            .map(|(l, k)| keep(l, k))
+            .collect();
     }
 
-    /// Renders every layer, one pass each named by [`layer_pass_name`] with `base`.
+    /// Whether [`Self::record`] renders `layer`.
+    pub fn is_kept(&self, layer: u32) -> bool {
+        self.kept.get(layer as usize).copied().unwrap_or(true)
+    }
+
+    /// The passes [`Self::record`] records, named by [`layer_pass_name`] with `base`.
+    pub fn pass_names(&self, base: &str) -> Vec<String> {
+        let mut names = Vec::new();
+        for l in &self.lights {
+            for k in 0..l.frustums.len() {
+                if self.is_kept(l.first_layer + k as u32) {
+                    names.push(layer_pass_name(base, l, k));
+                }
+            }
+        }
+        names
+    }
+
+    /// The depth maps (the depth-test scratch layer when the set has colour maps).
+    pub fn depth_maps(&self) -> Option<&MapArray> {
+        self.depth.as_ref()
+    }
+
+    /// Renders every kept layer, one pass each named by [`layer_pass_name`] with `base`.
     pub fn record(
         &self,
         ctx: &RenderContext<'_>,
@@ -250,13 +284,8 @@ impl ShadowMapSet {
             .as_ref()
             .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
         let name = |l: &LightMaps, k| layer_pass_name(base, l, k);
-        match &self.color {
-            Some(color) => {
-                (self.depth_pass).record_color(ctx, recorder, color, depth, &self.lights, name)
-            }
-            None => self
-                .depth_pass
-                .record(ctx, recorder, depth, &self.lights, name),
-        }
+        let keep = |layer| self.is_kept(layer);
+        let color = self.color.as_ref();
+        (self.depth_pass).record_kept(ctx, recorder, color, depth, &self.lights, name, &keep)
     }
 }

@@ -178,7 +178,7 @@ impl Gpu {
         let state = DepthState {
             constant_bias: 0,
             slope_bias: p.slope_bias,
-            cull_front: false,
+            ..DepthState::default()
         };
         let maps = ShadowMapSet::new(ctx, "hybrid shadow maps", state, None)?;
         let generator = VolumeGenerator::new(ctx, "hybrid")?;

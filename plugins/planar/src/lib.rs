@@ -311,11 +311,6 @@ impl ShadowTechnique for Planar {
         out
     }
 
-    fn packs_visibility_slots(&self) -> bool {
-        // Shadows are drawn wherever a plane faces the light, not only inside its range.
-        false
-    }
-
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError> {
         if self.gpu.is_none() {
             self.gpu = Some(self.create_pipelines(ctx)?);

@@ -127,7 +127,7 @@ impl Gpu {
         let state = DepthState {
             constant_bias: params.constant_bias as i32,
             slope_bias: params.slope_bias,
-            cull_front: false,
+            ..DepthState::default()
         };
         let maps = ShadowMapSet::new(ctx, "pssm maps", state, None)?;
         let stage = wgpu::ShaderStages::FRAGMENT;

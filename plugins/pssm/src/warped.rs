@@ -235,7 +235,7 @@ impl WarpedMaps {
         let state = DepthState {
             constant_bias: 0,
             slope_bias: self.settings.slope_bias,
-            cull_front: false,
+            ..DepthState::default()
         };
         let label = format!("{} maps", self.id);
         let maps = ShadowMapSet::new(ctx, &label, state, None)?;
@@ -301,10 +301,13 @@ impl ShadowTechnique for WarpedMaps {
         out
     }
 
-    fn packs_visibility_slots(&self) -> bool {
+    fn assign_slots(
+        &self,
+        request: &zoo_host::render::SlotRequest<'_>,
+    ) -> zoo_host::TechniqueResult<zoo_host::render::SlotAssignment> {
         // Spot lookups write only inside the light's range and cone; directional lights
         // cover the screen and are never packed with others.
-        true
+        Ok(zoo_host::render::SlotAssignment::packed(request.lights))
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {

@@ -107,6 +107,7 @@ impl Gpu {
             constant_bias: params.constant_bias as i32,
             slope_bias: params.slope_bias,
             cull_front: params.cull_front,
+            ..DepthState::default()
         };
         let maps = ShadowMapSet::new(ctx, "sm-pcf shadow maps", state, None)?;
         let stage = wgpu::ShaderStages::FRAGMENT;
@@ -215,9 +216,12 @@ impl ShadowTechnique for ShadowMaps {
         out
     }
 
-    fn packs_visibility_slots(&self) -> bool {
+    fn assign_slots(
+        &self,
+        request: &zoo_host::render::SlotRequest<'_>,
+    ) -> zoo_host::TechniqueResult<zoo_host::render::SlotAssignment> {
         // The lookup writes only inside each light's range and cone.
-        true
+        Ok(zoo_host::render::SlotAssignment::packed(request.lights))
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {

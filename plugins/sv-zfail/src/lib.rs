@@ -116,11 +116,6 @@ impl ShadowTechnique for ShadowVolumes {
         out
     }
 
-    fn packs_visibility_slots(&self) -> bool {
-        // Volumes are infinite: a light's shadow is written wherever it falls.
-        false
-    }
-
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError> {
         if self.pipelines.is_none() {
             self.pipelines = Some(Pipelines::new(ctx, &self.params)?);

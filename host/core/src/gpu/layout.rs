@@ -224,7 +224,8 @@ mod tests {
         let (size, fields) = crate::mirror_fields!(GpuObject {
             model,
             color,
-            material
+            material,
+            transmittance
         });
         check_mirror(&source, "Object", size, &fields, SizeRule::Equal).unwrap();
     }

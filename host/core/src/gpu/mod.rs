@@ -10,7 +10,7 @@ mod targets;
 
 pub use context::{GpuContext, GpuError};
 pub use recorder::{
-    FrameTimings, MAX_TIMED_PASSES, PassOwner, PassRecorder, PassTiming, RecordedComputePass,
+    FrameTimings, PASSES_PER_CHUNK, PassOwner, PassRecorder, PassTiming, RecordedComputePass,
     RecordedRenderPass, StatisticsQueries, TimestampQueries, TimingSource,
 };
 pub use shaders::{ComposedShader, ShaderError, ShaderLibrary};

@@ -8,8 +8,9 @@ use std::time::Instant;
 
 use super::GpuContext;
 
-/// Passes one frame can time.
-pub const MAX_TIMED_PASSES: u32 = 1024;
+/// Passes timed per query chunk. A frame with more passes takes further chunks (created on
+/// first use and kept), so every pass is timed however many a technique records.
+pub const PASSES_PER_CHUNK: u32 = 1024;
 
 /// Who recorded a pass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -84,52 +85,107 @@ impl FrameTimings {
     }
 }
 
-/// Reusable timestamp query storage.
-pub struct TimestampQueries {
+/// One chunk of queries for [`PASSES_PER_CHUNK`] passes, with its resolve and readback
+/// buffers (handles are shared, so a recorder holds clones).
+#[derive(Clone)]
+struct QueryChunk {
     set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
     readback: wgpu::Buffer,
 }
 
+/// Query chunks of one kind, created as frames need them.
+struct QueryChunks {
+    label: &'static str,
+    ty: wgpu::QueryType,
+    /// Queries per pass (two timestamps, or one statistics query).
+    queries_per_pass: u32,
+    /// Bytes one query resolves to.
+    bytes_per_query: u64,
+    chunks: std::sync::Mutex<Vec<QueryChunk>>,
+}
+
+impl QueryChunks {
+    fn new(
+        label: &'static str,
+        ty: wgpu::QueryType,
+        queries_per_pass: u32,
+        bytes_per_query: u64,
+    ) -> QueryChunks {
+        QueryChunks {
+            label,
+            ty,
+            queries_per_pass,
+            bytes_per_query,
+            chunks: std::sync::Mutex::new(Vec::new()),
+        }
+    }
+
+    /// Bytes of one chunk's results.
+    fn chunk_bytes(&self) -> u64 {
+        u64::from(PASSES_PER_CHUNK * self.queries_per_pass) * self.bytes_per_query
+    }
+
+    /// Chunk `index`, created (with any before it) on first use.
+    fn chunk(&self, gpu: &GpuContext, index: usize) -> QueryChunk {
+        let mut chunks = self
+            .chunks
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        while chunks.len() <= index {
+            let n = chunks.len();
+            let buffer = |what: &str, usage| {
+                gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(&format!("{} {what} (chunk {n})", self.label)),
+                    size: self.chunk_bytes(),
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            chunks.push(QueryChunk {
+                set: gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some(&format!("{} (chunk {n})", self.label)),
+                    ty: self.ty,
+                    count: PASSES_PER_CHUNK * self.queries_per_pass,
+                }),
+                resolve: buffer(
+                    "resolve",
+                    wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                ),
+                readback: buffer(
+                    "readback",
+                    wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                ),
+            });
+        }
+        chunks[index].clone()
+    }
+}
+
+/// Reusable timestamp query storage.
+pub struct TimestampQueries {
+    chunks: QueryChunks,
+}
+
 impl TimestampQueries {
-    /// Creates the query set and buffers, or `None` without timestamp support.
+    /// Creates the query storage, or `None` without timestamp support.
     pub fn new(gpu: &GpuContext) -> Option<TimestampQueries> {
         if !gpu.has_timestamps() {
             return None;
         }
-        let count = MAX_TIMED_PASSES * 2;
-        let size = count as u64 * 8;
-        Some(TimestampQueries {
-            set: gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("pass timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count,
-            }),
-            resolve: gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pass timestamps resolve"),
-                size,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            readback: gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pass timestamps readback"),
-                size,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            }),
-        })
+        let chunks = QueryChunks::new("pass timestamps", wgpu::QueryType::Timestamp, 2, 8);
+        chunks.chunk(gpu, 0);
+        Some(TimestampQueries { chunks })
     }
 }
 
 /// Pipeline-statistics query storage: vertex, fragment and compute invocations per pass.
 pub struct StatisticsQueries {
-    set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
+    chunks: QueryChunks,
 }
 
 impl StatisticsQueries {
-    /// Creates the query set, or `None` when the device lacks `PIPELINE_STATISTICS_QUERY`.
+    /// Creates the query storage, or `None` when the device lacks `PIPELINE_STATISTICS_QUERY`.
     pub fn new(gpu: &GpuContext) -> Option<StatisticsQueries> {
         if !gpu
             .device
@@ -138,30 +194,18 @@ impl StatisticsQueries {
         {
             return None;
         }
-        let size = MAX_TIMED_PASSES as u64 * 24;
-        Some(StatisticsQueries {
-            set: gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("pass pipeline statistics"),
-                ty: wgpu::QueryType::PipelineStatistics(
-                    wgpu::PipelineStatisticsTypes::VERTEX_SHADER_INVOCATIONS
-                        | wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS
-                        | wgpu::PipelineStatisticsTypes::COMPUTE_SHADER_INVOCATIONS,
-                ),
-                count: MAX_TIMED_PASSES,
-            }),
-            resolve: gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pass statistics resolve"),
-                size,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            readback: gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pass statistics readback"),
-                size,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            }),
-        })
+        let chunks = QueryChunks::new(
+            "pass pipeline statistics",
+            wgpu::QueryType::PipelineStatistics(
+                wgpu::PipelineStatisticsTypes::VERTEX_SHADER_INVOCATIONS
+                    | wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS
+                    | wgpu::PipelineStatisticsTypes::COMPUTE_SHADER_INVOCATIONS,
+            ),
+            1,
+            24,
+        );
+        chunks.chunk(gpu, 0);
+        Some(StatisticsQueries { chunks })
     }
 }
 
@@ -219,6 +263,14 @@ impl Drop for RecordedComputePass<'_> {
     }
 }
 
+/// Query slots of a pass being opened.
+struct NextPass {
+    /// The chunk's timestamp set and the pass's first query.
+    timestamps: Option<(wgpu::QuerySet, u32)>,
+    /// The chunk's statistics set and the pass's query.
+    statistics: Option<(wgpu::QuerySet, u32)>,
+}
+
 /// Opens the passes of one frame and times them.
 pub struct PassRecorder<'a> {
     gpu: &'a GpuContext,
@@ -228,6 +280,9 @@ pub struct PassRecorder<'a> {
     owner: PassOwner,
     names: Vec<(String, PassOwner)>,
     cpu_times: Vec<f64>,
+    /// Chunks this frame has used, in order.
+    timestamp_chunks: Vec<QueryChunk>,
+    statistics_chunks: Vec<QueryChunk>,
 }
 
 impl<'a> PassRecorder<'a> {
@@ -241,6 +296,8 @@ impl<'a> PassRecorder<'a> {
             owner: PassOwner::Host,
             names: Vec::new(),
             cpu_times: Vec::new(),
+            timestamp_chunks: Vec::new(),
+            statistics_chunks: Vec::new(),
         }
     }
 
@@ -290,30 +347,49 @@ impl<'a> PassRecorder<'a> {
         }
     }
 
-    fn next_pass(&mut self, name: &str) -> Option<(u32, u32)> {
+    /// Names the next pass and returns its index and the query chunk slots it writes:
+    /// (timestamp set, begin, end) and (statistics set, index).
+    fn next_pass(&mut self, name: &str) -> NextPass {
         if self.queries.is_none() {
             self.flush();
         }
         let index = self.names.len() as u32;
         self.names.push((name.to_string(), self.owner));
-        (self.queries.is_some() && index < MAX_TIMED_PASSES).then_some((2 * index, 2 * index + 1))
+        let (chunk, local) = (
+            (index / PASSES_PER_CHUNK) as usize,
+            index % PASSES_PER_CHUNK,
+        );
+        let gpu = self.gpu;
+        let timestamps = self.queries.map(|q| {
+            if self.timestamp_chunks.len() <= chunk {
+                self.timestamp_chunks.push(q.chunks.chunk(gpu, chunk));
+            }
+            (self.timestamp_chunks[chunk].set.clone(), 2 * local)
+        });
+        let statistics = self.statistics.map(|s| {
+            if self.statistics_chunks.len() <= chunk {
+                self.statistics_chunks.push(s.chunks.chunk(gpu, chunk));
+            }
+            (self.statistics_chunks[chunk].set.clone(), local)
+        });
+        NextPass {
+            timestamps,
+            statistics,
+        }
     }
 
     /// Opens a render pass; `desc.label` names it in timings and captures.
     pub fn render_pass(&mut self, desc: &wgpu::RenderPassDescriptor<'_>) -> RecordedRenderPass<'_> {
         let name = desc.label.unwrap_or("unnamed render pass").to_string();
-        let slots = self.next_pass(&name);
-        let index = self.names.len() as u32 - 1;
-        let statistics = self.statistics.filter(|_| index < MAX_TIMED_PASSES);
-        let queries = self.queries;
-        let timestamp_writes = match (slots, queries) {
-            (Some((begin, end)), Some(q)) => Some(wgpu::RenderPassTimestampWrites {
-                query_set: &q.set,
-                beginning_of_pass_write_index: Some(begin),
-                end_of_pass_write_index: Some(end),
-            }),
-            _ => None,
-        };
+        let next = self.next_pass(&name);
+        let timestamp_writes =
+            next.timestamps
+                .as_ref()
+                .map(|(set, begin)| wgpu::RenderPassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(*begin),
+                    end_of_pass_write_index: Some(begin + 1),
+                });
         let desc = wgpu::RenderPassDescriptor {
             label: desc.label,
             color_attachments: desc.color_attachments,
@@ -323,97 +399,106 @@ impl<'a> PassRecorder<'a> {
             multiview_mask: desc.multiview_mask,
         };
         let mut pass = self.encoder().begin_render_pass(&desc);
-        if let Some(s) = statistics {
-            pass.begin_pipeline_statistics_query(&s.set, index);
+        if let Some((set, index)) = &next.statistics {
+            pass.begin_pipeline_statistics_query(set, *index);
         }
         RecordedRenderPass {
             pass,
-            statistics: statistics.is_some(),
+            statistics: next.statistics.is_some(),
         }
     }
 
     /// Opens a compute pass named `label`.
     pub fn compute_pass(&mut self, label: &str) -> RecordedComputePass<'_> {
-        let slots = self.next_pass(label);
-        let index = self.names.len() as u32 - 1;
-        let statistics = self.statistics.filter(|_| index < MAX_TIMED_PASSES);
-        let queries = self.queries;
-        let timestamp_writes = match (slots, queries) {
-            (Some((begin, end)), Some(q)) => Some(wgpu::ComputePassTimestampWrites {
-                query_set: &q.set,
-                beginning_of_pass_write_index: Some(begin),
-                end_of_pass_write_index: Some(end),
-            }),
-            _ => None,
-        };
+        let next = self.next_pass(label);
+        let timestamp_writes =
+            next.timestamps
+                .as_ref()
+                .map(|(set, begin)| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(*begin),
+                    end_of_pass_write_index: Some(begin + 1),
+                });
         let mut pass = self
             .encoder()
             .begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(label),
                 timestamp_writes,
             });
-        if let Some(s) = statistics {
-            pass.begin_pipeline_statistics_query(&s.set, index);
+        if let Some((set, index)) = &next.statistics {
+            pass.begin_pipeline_statistics_query(set, *index);
         }
         RecordedComputePass {
             pass,
-            statistics: statistics.is_some(),
+            statistics: next.statistics.is_some(),
         }
+    }
+
+    /// Resolves the used part of every chunk into its readback buffer.
+    fn resolve_chunks(&mut self, chunks: &[QueryChunk], queries_per_pass: u32, bytes: u64) {
+        let passes = self.names.len() as u32;
+        for (k, chunk) in chunks.iter().enumerate() {
+            let used = (passes - k as u32 * PASSES_PER_CHUNK).min(PASSES_PER_CHUNK);
+            let queries = used * queries_per_pass;
+            let encoder = self.encoder();
+            encoder.resolve_query_set(&chunk.set, 0..queries, &chunk.resolve, 0);
+            encoder.copy_buffer_to_buffer(
+                &chunk.resolve,
+                0,
+                &chunk.readback,
+                0,
+                u64::from(queries) * bytes,
+            );
+        }
+    }
+
+    /// The resolved results of every chunk, in pass order (`bytes_per_pass` each).
+    fn read_chunks(&self, chunks: &[QueryChunk], bytes_per_pass: usize) -> Vec<u8> {
+        let mut all = Vec::new();
+        for chunk in chunks {
+            all.extend(super::readback::map_buffer(self.gpu, &chunk.readback));
+        }
+        all.truncate(self.names.len() * bytes_per_pass);
+        all
     }
 
     /// Submits the frame, waits for it and returns the pass times.
     pub fn finish(mut self) -> FrameTimings {
-        let pass_count = (self.names.len() as u32).min(MAX_TIMED_PASSES);
-        if let Some(q) = self.queries
-            && pass_count > 0
-        {
-            let encoder = self.encoder();
-            encoder.resolve_query_set(&q.set, 0..pass_count * 2, &q.resolve, 0);
-            encoder.copy_buffer_to_buffer(&q.resolve, 0, &q.readback, 0, pass_count as u64 * 16);
-        }
-        if let Some(s) = self.statistics
-            && pass_count > 0
-        {
-            let encoder = self.encoder();
-            encoder.resolve_query_set(&s.set, 0..pass_count, &s.resolve, 0);
-            encoder.copy_buffer_to_buffer(&s.resolve, 0, &s.readback, 0, pass_count as u64 * 24);
-        }
+        let timestamp_chunks = std::mem::take(&mut self.timestamp_chunks);
+        let statistics_chunks = std::mem::take(&mut self.statistics_chunks);
+        self.resolve_chunks(&timestamp_chunks, 2, 8);
+        self.resolve_chunks(&statistics_chunks, 1, 24);
         self.flush();
         self.gpu.wait_idle();
         let (source, times) = match self.queries {
-            Some(q) if pass_count > 0 => {
-                let bytes = super::readback::map_buffer(self.gpu, &q.readback);
+            Some(_) => {
+                let bytes = self.read_chunks(&timestamp_chunks, 16);
                 let period_ms = self.gpu.queue.get_timestamp_period() as f64 * 1e-6;
-                let ticks: Vec<u64> = bytes
-                    .chunks_exact(8)
-                    .take(pass_count as usize * 2)
-                    .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")))
-                    .collect();
-                let times = ticks
-                    .chunks_exact(2)
-                    .map(|t| t[1].saturating_sub(t[0]) as f64 * period_ms)
+                let times = bytes
+                    .chunks_exact(16)
+                    .map(|b| {
+                        let tick = |k: usize| {
+                            u64::from_le_bytes(b[8 * k..8 * k + 8].try_into().expect("8 bytes"))
+                        };
+                        tick(1).saturating_sub(tick(0)) as f64 * period_ms
+                    })
                     .collect();
                 (TimingSource::GpuTimestamps, times)
             }
-            Some(_) => (TimingSource::GpuTimestamps, Vec::new()),
             None => (
                 TimingSource::CpuWallClock,
                 std::mem::take(&mut self.cpu_times),
             ),
         };
-        let invocations: Vec<[u64; 3]> = match self.statistics {
-            Some(s) if pass_count > 0 => super::readback::map_buffer(self.gpu, &s.readback)
-                .chunks_exact(24)
-                .take(pass_count as usize)
-                .map(|b| {
-                    let word = |k: usize| {
-                        u64::from_le_bytes(b[8 * k..8 * k + 8].try_into().expect("8 bytes"))
-                    };
-                    [word(0), word(1), word(2)]
-                })
-                .collect(),
-            _ => Vec::new(),
-        };
+        let invocations: Vec<[u64; 3]> = self
+            .read_chunks(&statistics_chunks, 24)
+            .chunks_exact(24)
+            .map(|b| {
+                let word =
+                    |k: usize| u64::from_le_bytes(b[8 * k..8 * k + 8].try_into().expect("8 bytes"));
+                [word(0), word(1), word(2)]
+            })
+            .collect();
         FrameTimings {
             source,
             passes: self

@@ -47,6 +47,8 @@ pub struct GpuObject {
     pub model: [[f32; 4]; 4],
     pub color: [f32; 4],
     pub material: [f32; 4],
+    /// Translucent casters: the colour they let through and w = 1; opaque: (0, 0, 0, 0).
+    pub transmittance: [f32; 4],
 }
 
 /// The view and projection of the current camera at the current size.
@@ -177,6 +179,9 @@ impl FrameBindings {
                 model: o.transform.to_cols_array_2d(),
                 color: o.color.extend(o.specular).to_array(),
                 material: [o.shininess, f32::from(u8::from(o.casts_shadows)), 0.0, 0.0],
+                transmittance: o
+                    .transmittance()
+                    .map_or([0.0; 4], |t| t.extend(1.0).to_array()),
             })
             .collect();
         gpu.queue

@@ -2,7 +2,7 @@
 
 use super::frame::FrameBindings;
 use super::gbuffer::GBuffer;
-use super::visibility::{IndirectTarget, VisibilityTargets};
+use super::visibility::{IndirectTarget, TransmittanceTargets, VisibilityTargets};
 use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
 
 /// Format of the final image.
@@ -44,6 +44,7 @@ impl LightingPass {
             entries: &[
                 texture(0, wgpu::TextureViewDimension::D2Array),
                 texture(1, wgpu::TextureViewDimension::D2),
+                texture(2, wgpu::TextureViewDimension::D2Array),
             ],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -75,6 +76,7 @@ impl LightingPass {
         gpu: &GpuContext,
         visibility: &VisibilityTargets,
         indirect: &IndirectTarget,
+        transmittance: &TransmittanceTargets,
     ) -> wgpu::BindGroup {
         gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lighting inputs"),
@@ -87,6 +89,10 @@ impl LightingPass {
                 wgpu::BindGroupEntry {
                     binding: 1,
                     resource: wgpu::BindingResource::TextureView(&indirect.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&transmittance.array_view),
                 },
             ],
         })

@@ -14,4 +14,6 @@ pub use frame::{CameraMatrices, FrameBindings};
 pub use gbuffer::GBuffer;
 pub use renderer::{GBufferData, MAX_OUTPUT_SIDE, Overlay, RenderError, Renderer, View};
 pub use scene_buffers::{SceneBuffers, Vertex};
-pub use visibility::{IndirectTarget, SlotAssignment, VisibilityTargets};
+pub use visibility::{
+    IndirectTarget, SlotAssignment, SlotRequest, TransmittanceTargets, VisibilityTargets,
+};

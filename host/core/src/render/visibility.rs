@@ -8,7 +8,7 @@
 use glam::{UVec2, Vec3};
 
 use crate::gpu::GpuContext;
-use crate::scene::{Light, LightKind};
+use crate::scene::{Camera, Light, LightKind};
 
 /// Texture format of the visibility array.
 pub const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -18,6 +18,22 @@ pub const VISIBILITY_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_AT
     .union(wgpu::TextureUsages::TEXTURE_BINDING)
     .union(wgpu::TextureUsages::STORAGE_BINDING)
     .union(wgpu::TextureUsages::COPY_SRC);
+
+/// What a technique assigns visibility slots for ([`crate::ShadowTechnique::assign_slots`]).
+#[derive(Debug, Clone, Copy)]
+pub struct SlotRequest<'a> {
+    pub lights: &'a [Light],
+    pub camera: &'a Camera,
+    /// Output width over height.
+    pub aspect: f32,
+}
+
+impl SlotRequest<'_> {
+    /// The camera's world-to-clip matrix (depth 0 at near, 1 at far).
+    pub fn view_proj(&self) -> glam::Mat4 {
+        self.camera.projection(self.aspect) * self.camera.view()
+    }
+}
 
 /// Which slot each light writes.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -34,6 +50,12 @@ impl SlotAssignment {
             slots: (0..light_count as u32).collect(),
             slot_count: light_count as u32,
         }
+    }
+
+    /// Slot `slots[i]` for light `i`; the slot count is one more than the largest.
+    pub fn from_slots(slots: Vec<u32>) -> SlotAssignment {
+        let slot_count = slots.iter().max().map_or(0, |s| s + 1);
+        SlotAssignment { slots, slot_count }
     }
 
     /// Greedy colouring: each light takes the first slot none of whose lights' influence
@@ -67,6 +89,16 @@ impl SlotAssignment {
     pub fn slot(&self, light: usize) -> (u32, u32) {
         let s = self.slots[light];
         (s / 4, s % 4)
+    }
+
+    /// Number of lights assigned.
+    pub fn len(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// Whether no light is assigned.
+    pub fn is_empty(&self) -> bool {
+        self.slots.is_empty()
     }
 
     /// Number of distinct slots.
@@ -155,6 +187,116 @@ impl VisibilityTargets {
             layer_views,
             slots,
         }
+    }
+}
+
+/// Per-light transmittance colour: the light a technique lets through translucent casters,
+/// which the lighting pass multiplies into each light's contribution besides its visibility.
+/// One `Rgba8Unorm` array layer per visibility slot (rgb; a unused), cleared to white each
+/// frame, for techniques that write it ([`crate::ShadowTechnique::writes_transmittance`]);
+/// otherwise a single white texel that every light reads.
+pub struct TransmittanceTargets {
+    pub texture: wgpu::Texture,
+    /// All layers, for the lighting pass.
+    pub array_view: wgpu::TextureView,
+    /// One 2D view per slot, for render attachments (empty when not in use).
+    pub slot_views: Vec<wgpu::TextureView>,
+    /// Whether the technique writes it (a layer per slot at the output size).
+    pub in_use: bool,
+}
+
+impl TransmittanceTargets {
+    /// A layer per slot of `slots` at `size` when `in_use`, else one white texel.
+    pub fn new(
+        gpu: &GpuContext,
+        size: UVec2,
+        slots: &SlotAssignment,
+        in_use: bool,
+    ) -> TransmittanceTargets {
+        let (extent, layers) = if in_use {
+            (size, slots.slot_count().max(1))
+        } else {
+            (UVec2::ONE, 1)
+        };
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("transmittance slots"),
+            size: wgpu::Extent3d {
+                width: extent.x,
+                height: extent.y,
+                depth_or_array_layers: crate::gpu::array_layers(gpu, extent.x, extent.y, layers),
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: VISIBILITY_FORMAT,
+            usage: VISIBILITY_USAGE | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        // Every layer of the white texel: GL binds the whole texture, spare layers included.
+        for layer in (0..texture.depth_or_array_layers()).filter(|_| !in_use) {
+            gpu.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: layer,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &[255; 4],
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4),
+                    rows_per_image: None,
+                },
+                wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("transmittance slots (array)"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            array_layer_count: Some(layers),
+            ..Default::default()
+        });
+        let slot_views = if in_use {
+            (0..layers)
+                .map(|slot| {
+                    texture.create_view(&wgpu::TextureViewDescriptor {
+                        label: Some(&format!("transmittance slot {slot}")),
+                        dimension: Some(wgpu::TextureViewDimension::D2),
+                        base_array_layer: slot,
+                        array_layer_count: Some(1),
+                        ..Default::default()
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        TransmittanceTargets {
+            texture,
+            array_view,
+            slot_views,
+            in_use,
+        }
+    }
+
+    /// Whether this storage fits `slots` at `size` for a technique that does (or does not)
+    /// write transmittance.
+    pub fn fits(&self, size: UVec2, slots: &SlotAssignment, in_use: bool) -> bool {
+        if in_use != self.in_use {
+            return false;
+        }
+        !in_use
+            || (self.texture.width() == size.x
+                && self.texture.height() == size.y
+                && self.slot_views.len() as u32 == slots.slot_count().max(1))
     }
 }
 

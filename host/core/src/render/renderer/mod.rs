@@ -18,7 +18,9 @@ use super::frame::FrameBindings;
 use super::gbuffer::{GBuffer, GBufferPass};
 use super::lighting::{LightingPass, OUTPUT_FORMAT};
 use super::scene_buffers::SceneBuffers;
-use super::visibility::{IndirectTarget, SlotAssignment, VisibilityTargets};
+use super::visibility::{
+    IndirectTarget, SlotAssignment, SlotRequest, TransmittanceTargets, VisibilityTargets,
+};
 use crate::gpu::{
     FrameTimings, GpuContext, PassOwner, PassRecorder, ShaderError, ShaderLibrary,
     StatisticsQueries, TimestampQueries,
@@ -55,6 +57,7 @@ pub struct Renderer {
     frame: FrameBindings,
     gbuffer: GBuffer,
     visibility: VisibilityTargets,
+    transmittance: TransmittanceTargets,
     indirect: IndirectTarget,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
@@ -65,6 +68,8 @@ pub struct Renderer {
     timestamps: Option<TimestampQueries>,
     statistics: Option<StatisticsQueries>,
     technique: ActiveTechnique,
+    /// Why the technique's last slot assignment was refused, until the next frame reports it.
+    slot_error: Option<TechniqueError>,
 }
 
 fn create_output(gpu: &GpuContext, size: UVec2) -> (wgpu::Texture, wgpu::TextureView) {
@@ -100,6 +105,7 @@ macro_rules! render_context {
             frame: &$renderer.frame,
             gbuffer: &$renderer.gbuffer,
             visibility: &$renderer.visibility,
+            transmittance: &$renderer.transmittance,
             indirect: &$renderer.indirect,
             camera: &$renderer.camera,
             lights: &$renderer.lights,
@@ -132,12 +138,13 @@ impl Renderer {
         let frame = FrameBindings::new(&gpu, &scene);
         let gbuffer = GBuffer::new(&gpu, size);
         let slots = SlotAssignment::one_per_light(scene.lights.len());
+        let transmittance = TransmittanceTargets::new(&gpu, size, &slots, false);
         let visibility = VisibilityTargets::new(&gpu, size, slots);
         let indirect = IndirectTarget::new(&gpu, size);
         let (output, output_view) = create_output(&gpu, size);
         let gbuffer_pass = GBufferPass::new(&gpu, &shaders, &frame)?;
         let lighting = LightingPass::new(&gpu, &shaders, &frame, &gbuffer)?;
-        let lighting_inputs = lighting.inputs(&gpu, &visibility, &indirect);
+        let lighting_inputs = lighting.inputs(&gpu, &visibility, &indirect, &transmittance);
         let debug = DebugViewPass::new(&gpu, &shaders)?;
         let timestamps = TimestampQueries::new(&gpu);
         let mut renderer = Renderer {
@@ -151,6 +158,7 @@ impl Renderer {
             frame,
             gbuffer,
             visibility,
+            transmittance,
             indirect,
             output,
             output_view,
@@ -161,6 +169,7 @@ impl Renderer {
             timestamps,
             statistics: None,
             technique,
+            slot_error: None,
         };
         renderer.update_slots();
         Ok(renderer)
@@ -239,6 +248,10 @@ impl Renderer {
         let next = instantiate(&self.gpu, registration, values)?;
         self.technique = next;
         self.update_slots();
+        if let Some(error) = self.slot_error.take() {
+            self.fallback_later(error.clone());
+            return Err(error);
+        }
         Ok(())
     }
 
@@ -291,9 +304,7 @@ impl Renderer {
             (self.output, self.output_view) = create_output(&self.gpu, size);
             self.visibility =
                 VisibilityTargets::new(&self.gpu, size, self.visibility.slots.clone());
-            self.lighting_inputs =
-                self.lighting
-                    .inputs(&self.gpu, &self.visibility, &self.indirect);
+            self.update_transmittance(true);
             self.technique.pending.resolution = true;
         }
         Ok(())
@@ -304,6 +315,9 @@ impl Renderer {
         if camera != self.camera {
             self.camera = camera;
             self.technique.pending.camera = true;
+            if self.technique.instance.slots_follow_camera() {
+                self.update_slots();
+            }
         }
     }
 
@@ -320,18 +334,56 @@ impl Renderer {
         }
     }
 
+    /// Asks the technique for its slot assignment and resizes the visibility storage when it
+    /// changed. A refusal is kept and reported by the next [`Self::render`].
     fn update_slots(&mut self) {
-        let slots = if self.technique.instance.packs_visibility_slots() {
-            SlotAssignment::packed(&self.lights)
-        } else {
-            SlotAssignment::one_per_light(self.lights.len())
+        let request = SlotRequest {
+            lights: &self.lights,
+            camera: &self.camera,
+            aspect: self.size.x as f32 / self.size.y as f32,
         };
-        if slots != self.visibility.slots {
+        let instance = &self.technique.instance;
+        let id = self.technique.registration.id;
+        let slots = match guarded(&self.gpu, id, || instance.assign_slots(&request)) {
+            Ok(slots) if slots.len() == self.lights.len() => slots,
+            Ok(slots) => {
+                self.slot_error = Some(TechniqueError::Other(format!(
+                    "{id}: assigned visibility slots to {} lights, the scene has {}",
+                    slots.len(),
+                    self.lights.len()
+                )));
+                return;
+            }
+            Err(e) => {
+                self.slot_error = Some(e);
+                return;
+            }
+        };
+        self.slot_error = None;
+        let changed = slots != self.visibility.slots;
+        if changed {
             self.visibility = VisibilityTargets::new(&self.gpu, self.size, slots);
-            self.lighting_inputs =
-                self.lighting
-                    .inputs(&self.gpu, &self.visibility, &self.indirect);
             self.technique.pending.lights = true;
+        }
+        self.update_transmittance(changed);
+    }
+
+    /// Fits the transmittance storage to the technique, the slots and the size, and rebuilds
+    /// the lighting inputs when it or the visibility storage (`visibility_changed`) changed.
+    fn update_transmittance(&mut self, visibility_changed: bool) {
+        let in_use = self.technique.instance.writes_transmittance(&self.scene);
+        let slots = &self.visibility.slots;
+        let fits = self.transmittance.fits(self.size, slots, in_use);
+        if !fits {
+            self.transmittance = TransmittanceTargets::new(&self.gpu, self.size, slots, in_use);
+        }
+        if !fits || visibility_changed {
+            self.lighting_inputs = self.lighting.inputs(
+                &self.gpu,
+                &self.visibility,
+                &self.indirect,
+                &self.transmittance,
+            );
         }
     }
 
@@ -348,6 +400,9 @@ impl Renderer {
         view: &View,
         overlay: Option<&Overlay>,
     ) -> Result<FrameTimings, RenderError> {
+        if let Some(error) = self.slot_error.take() {
+            return Err(self.fallback_later(error));
+        }
         let overlay = overlay.filter(|o| *view == View::Final && o.view != View::Final);
         let resource = match (view, overlay) {
             (View::Resource(name), _) => Some(name.as_str()),
@@ -398,7 +453,12 @@ impl Renderer {
             &self.scene,
             &self.scene_buffers,
         );
-        clear_visibility(&mut recorder, &self.visibility, &self.indirect);
+        clear_visibility(
+            &mut recorder,
+            &self.visibility,
+            &self.transmittance,
+            &self.indirect,
+        );
         recorder.set_owner(PassOwner::Technique);
         let active = &mut self.technique;
         let recorded = guarded(&self.gpu, id, || {
@@ -466,7 +526,12 @@ impl Renderer {
             next.instance.prepare(&ctx, Changes::ALL)
         })?;
         next.pending = Changes::default();
-        self.lighting_inputs = lighting.inputs(&self.gpu, &self.visibility, &self.indirect);
+        self.lighting_inputs = lighting.inputs(
+            &self.gpu,
+            &self.visibility,
+            &self.indirect,
+            &self.transmittance,
+        );
         self.gbuffer_pass = gbuffer_pass;
         self.lighting = lighting;
         self.debug = debug;
@@ -497,10 +562,12 @@ fn check_size(size: UVec2) -> Result<(), RenderError> {
     Ok(())
 }
 
-/// Clears every visibility layer to 1 (lit) and the indirect target to 0.
+/// Clears every visibility layer to 1 (lit), the transmittance slots in use to white and the
+/// indirect target to 0.
 fn clear_visibility(
     recorder: &mut PassRecorder<'_>,
     visibility: &VisibilityTargets,
+    transmittance: &TransmittanceTargets,
     indirect: &IndirectTarget,
 ) {
     let attachment = |view, value: f64| {
@@ -522,6 +589,7 @@ fn clear_visibility(
     let mut targets: Vec<_> = visibility
         .layer_views
         .iter()
+        .chain(&transmittance.slot_views)
         .map(|v| attachment(v, 1.0))
         .collect();
     targets.push(attachment(&indirect.view, 0.0));

@@ -46,6 +46,27 @@ impl Renderer {
             .collect()
     }
 
+    /// The colour light `light` keeps through translucent casters per pixel, in [0, 1]
+    /// (white everywhere when the technique does not write transmittance).
+    pub fn read_transmittance(&self, light: usize) -> Vec<glam::Vec3> {
+        let pixels = (self.size.x * self.size.y) as usize;
+        if !self.transmittance.in_use {
+            return vec![glam::Vec3::ONE; pixels];
+        }
+        let (layer, channel) = self.visibility.slots.slot(light);
+        let bytes = readback::read_texture(
+            &self.gpu,
+            &self.transmittance.texture,
+            layer * 4 + channel,
+            wgpu::TextureAspect::All,
+            4,
+        );
+        bytes
+            .chunks_exact(4)
+            .map(|t| glam::Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 255.0)
+            .collect()
+    }
+
     /// World positions and normals per pixel.
     pub fn read_gbuffer(&self) -> GBufferData {
         let depths = readback::f32s(&readback::read_texture(

@@ -1,0 +1,413 @@
+//! The GPU side of the layered soft shadows: the layered targets and the compute passes
+//! (penumbra, two blur passes, debug views) with their bind groups.
+
+use zoo_host::glam::UVec2;
+use zoo_host::gpu::array_layers;
+use zoo_host::kit::{self, bind_group, bind_group_layout, pipeline_layout};
+use zoo_host::prelude::*;
+use zoo_shadow_maps::{ShadowMapSet, TranslucentPass};
+
+/// `Settings` in `ssss/data.wgsl`.
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+pub struct Settings {
+    pub layer_count: u32,
+    pub half_taps: u32,
+    pub translucent: u32,
+    pub pixel_scale: f32,
+    pub depth_threshold: f32,
+    pub grazing_clamp: f32,
+    pub max_sigma: f32,
+    pub search_texels: f32,
+    pub penumbra_scale: f32,
+    pub normal_offset: f32,
+    pub debug_mode: u32,
+    pub _pad: u32,
+}
+
+/// `SsssLight` in `ssss/data.wgsl`.
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+pub struct SsssLight {
+    pub first_layer: u32,
+    pub layer_count: u32,
+    pub layer: u32,
+    pub perspective: u32,
+    pub near: f32,
+    pub far: f32,
+    pub texel_scale: f32,
+    pub size: f32,
+}
+
+/// Byte offset of `debug_mode` in the data buffer.
+pub const DEBUG_MODE_OFFSET: u64 = std::mem::offset_of!(Settings, debug_mode) as u64;
+
+/// A layered screen-size target: its texture and an array view.
+pub struct Layered {
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+    /// Layers in use.
+    pub layers: u32,
+}
+
+impl Layered {
+    fn new(
+        gpu: &GpuContext,
+        label: &str,
+        size: UVec2,
+        layers: u32,
+        format: wgpu::TextureFormat,
+    ) -> Layered {
+        let layers = layers.max(1);
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: size.x,
+                height: size.y,
+                depth_or_array_layers: array_layers(gpu, size.x, size.y, layers),
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some(&format!("{label} (array)")),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            array_layer_count: Some(layers),
+            ..Default::default()
+        });
+        Layered {
+            texture,
+            view,
+            layers,
+        }
+    }
+}
+
+/// Every screen-size target, sized for a layer count.
+pub struct Targets {
+    pub size: UVec2,
+    pub layer_count: u32,
+    pub translucent: bool,
+    /// Blur sigma in pixels, four layers per texel.
+    pub penumbra: Layered,
+    /// Occluded then tinted bits, 32 layers per texel.
+    pub bits: Layered,
+    /// Tint colour per layer (translucent scenes; one dummy layer otherwise).
+    pub tints: Layered,
+    /// First blur pass: occlusion, four layers per texel.
+    pub occlusion: Layered,
+    /// First blur pass: colour that arrives per layer (translucent scenes).
+    pub light: Layered,
+    /// Debug views.
+    pub debug: (wgpu::Texture, wgpu::TextureView),
+}
+
+impl Targets {
+    pub fn new(gpu: &GpuContext, size: UVec2, layer_count: u32, translucent: bool) -> Targets {
+        let groups = layer_count.div_ceil(4);
+        let words = layer_count.div_ceil(32);
+        let colored = if translucent { layer_count } else { 1 };
+        use wgpu::TextureFormat as F;
+        let layered = |label, layers, format| Layered::new(gpu, label, size, layers, format);
+        Targets {
+            size,
+            layer_count,
+            translucent,
+            penumbra: layered("ssss penumbra", groups, F::Rgba16Float),
+            bits: layered("ssss hard shadow bits", 2 * words, F::R32Uint),
+            tints: layered("ssss tints", colored, F::Rgba16Float),
+            occlusion: layered("ssss blurred occlusion", groups, F::Rgba16Float),
+            light: layered("ssss blurred light", colored, F::Rgba16Float),
+            debug: zoo_host::gpu::render_target(
+                &gpu.device,
+                "ssss debug view",
+                size,
+                F::Rgba8Unorm,
+                wgpu::TextureUsages::STORAGE_BINDING,
+            ),
+        }
+    }
+
+    /// Whether these targets serve `layer_count` layers at `size`.
+    pub fn fit(&self, size: UVec2, layer_count: u32, translucent: bool) -> bool {
+        self.size == size
+            && self.translucent == translucent
+            && self.layer_count.div_ceil(4) == layer_count.div_ceil(4)
+            && (!translucent || self.layer_count == layer_count)
+            && self.layer_count.div_ceil(32) == layer_count.div_ceil(32)
+    }
+}
+
+/// One compute pass: its pipeline and the layout of its group 2.
+struct ComputeStage {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl ComputeStage {
+    fn new(
+        ctx: &RenderContext<'_>,
+        label: &str,
+        shader: &str,
+        entry: &str,
+        entries: &[wgpu::BindGroupLayoutEntry],
+        more: &[&wgpu::BindGroupLayout],
+    ) -> TechniqueResult<ComputeStage> {
+        let device = &ctx.gpu.device;
+        let module = ctx.shaders.create_module(device, shader)?;
+        let layout = bind_group_layout(device, &format!("{label} layout"), entries);
+        let mut groups = vec![&layout];
+        groups.extend_from_slice(more);
+        let pipeline_layout = pipeline_layout(ctx, &format!("{label} pipeline layout"), &groups);
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(&format!("{label} pipeline")),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Ok(ComputeStage { pipeline, layout })
+    }
+}
+
+/// The four compute passes and their current bind groups.
+pub struct Passes {
+    penumbra: ComputeStage,
+    blur_first: ComputeStage,
+    blur_second: ComputeStage,
+    debug: ComputeStage,
+    groups: Option<[wgpu::BindGroup; 4]>,
+}
+
+/// Entries of the group every pass starts with: the data buffer.
+fn data_entry() -> wgpu::BindGroupLayoutEntry {
+    kit::storage(0, wgpu::ShaderStages::COMPUTE, true)
+}
+
+fn sampled(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
+    kit::texture(
+        binding,
+        wgpu::ShaderStages::COMPUTE,
+        sample_type,
+        wgpu::TextureViewDimension::D2Array,
+    )
+}
+
+fn storage_texture(
+    binding: u32,
+    format: wgpu::TextureFormat,
+    dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: dimension,
+        },
+        count: None,
+    }
+}
+
+const FLOAT: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: false };
+const UINT: wgpu::TextureSampleType = wgpu::TextureSampleType::Uint;
+const ARRAY: wgpu::TextureViewDimension = wgpu::TextureViewDimension::D2Array;
+
+/// Pass names, in recording order after the map passes.
+pub const PENUMBRA_PASS: &str = "SSSS penumbra";
+pub const BLUR_FIRST_PASS: &str = "SSSS blur 1";
+pub const BLUR_SECOND_PASS: &str = "SSSS blur 2";
+pub const DEBUG_PASS: &str = "SSSS debug view";
+
+impl Passes {
+    pub fn new(ctx: &RenderContext<'_>, maps: &ShadowMapSet) -> TechniqueResult<Passes> {
+        use wgpu::TextureFormat as F;
+        let rgba16 = F::Rgba16Float;
+        let penumbra = ComputeStage::new(
+            ctx,
+            "ssss penumbra",
+            "ssss/penumbra.wgsl",
+            "cs_penumbra",
+            &[
+                data_entry(),
+                storage_texture(1, rgba16, ARRAY),
+                storage_texture(2, F::R32Uint, ARRAY),
+                storage_texture(3, rgba16, ARRAY),
+                sampled(4, FLOAT),
+            ],
+            &[maps.lookup_layout()],
+        )?;
+        let blur = |label, shader, entry, inputs: [wgpu::TextureSampleType; 2], output| {
+            ComputeStage::new(
+                ctx,
+                label,
+                shader,
+                entry,
+                &[
+                    data_entry(),
+                    sampled(1, FLOAT),
+                    sampled(2, inputs[0]),
+                    sampled(3, inputs[1]),
+                    storage_texture(4, output, ARRAY),
+                    storage_texture(5, output, ARRAY),
+                ],
+                &[],
+            )
+        };
+        let blur_first = blur(
+            "ssss blur 1",
+            "ssss/blur_first.wgsl",
+            "cs_blur_first",
+            [UINT, FLOAT],
+            rgba16,
+        )?;
+        let blur_second = blur(
+            "ssss blur 2",
+            "ssss/blur_second.wgsl",
+            "cs_blur_second",
+            [FLOAT, FLOAT],
+            F::Rgba8Unorm,
+        )?;
+        let debug = ComputeStage::new(
+            ctx,
+            "ssss debug view",
+            "ssss/debug.wgsl",
+            "cs_debug",
+            &[
+                data_entry(),
+                sampled(1, FLOAT),
+                sampled(2, UINT),
+                sampled(3, FLOAT),
+                sampled(4, FLOAT),
+                storage_texture(5, F::Rgba8Unorm, wgpu::TextureViewDimension::D2),
+            ],
+            &[],
+        )?;
+        Ok(Passes {
+            penumbra,
+            blur_first,
+            blur_second,
+            debug,
+            groups: None,
+        })
+    }
+
+    /// Rebuilds the bind groups over the current data, targets, maps and host slots.
+    pub fn bind(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        data: &wgpu::Buffer,
+        targets: &Targets,
+        translucency: &wgpu::TextureView,
+    ) {
+        let device = &ctx.gpu.device;
+        let view = wgpu::BindingResource::TextureView;
+        let data = data.as_entire_binding();
+        let t = targets;
+        let penumbra = bind_group(
+            device,
+            "ssss penumbra group",
+            &self.penumbra.layout,
+            &[
+                data.clone(),
+                view(&t.penumbra.view),
+                view(&t.bits.view),
+                view(&t.tints.view),
+                view(translucency),
+            ],
+        );
+        let blur_first = bind_group(
+            device,
+            "ssss blur 1 group",
+            &self.blur_first.layout,
+            &[
+                data.clone(),
+                view(&t.penumbra.view),
+                view(&t.bits.view),
+                view(&t.tints.view),
+                view(&t.occlusion.view),
+                view(&t.light.view),
+            ],
+        );
+        let blur_second = bind_group(
+            device,
+            "ssss blur 2 group",
+            &self.blur_second.layout,
+            &[
+                data.clone(),
+                view(&t.penumbra.view),
+                view(&t.occlusion.view),
+                view(&t.light.view),
+                view(&ctx.visibility.array_view),
+                view(&ctx.transmittance.array_view),
+            ],
+        );
+        let debug = bind_group(
+            device,
+            "ssss debug group",
+            &self.debug.layout,
+            &[
+                data,
+                view(&t.penumbra.view),
+                view(&t.bits.view),
+                view(&ctx.visibility.array_view),
+                view(&ctx.transmittance.array_view),
+                view(&t.debug.1),
+            ],
+        );
+        self.groups = Some([penumbra, blur_first, blur_second, debug]);
+    }
+
+    /// Records the penumbra pass and both blur passes, and the debug pass when `debug`.
+    pub fn record(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        maps: &ShadowMapSet,
+        debug: bool,
+    ) -> TechniqueResult {
+        let (Some(groups), Some(lookup)) = (&self.groups, maps.lookup_group()) else {
+            return Err(TechniqueError::not_prepared());
+        };
+        let workgroups = ctx.size.map(|side| side.div_ceil(8));
+        let stages = [
+            (PENUMBRA_PASS, &self.penumbra, Some(lookup)),
+            (BLUR_FIRST_PASS, &self.blur_first, None),
+            (BLUR_SECOND_PASS, &self.blur_second, None),
+            (DEBUG_PASS, &self.debug, None),
+        ];
+        for (k, (name, stage, lookup)) in stages.into_iter().enumerate() {
+            if k == 3 && !debug {
+                break;
+            }
+            let mut pass = recorder.compute_pass(name);
+            pass.set_pipeline(&stage.pipeline);
+            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+            pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
+            pass.set_bind_group(2, &groups[k], &[]);
+            if let Some(lookup) = lookup {
+                pass.set_bind_group(3, lookup, &[]);
+            }
+            pass.dispatch_workgroups(workgroups.x, workgroups.y, 1);
+        }
+        Ok(())
+    }
+}
+
+/// The translucency maps' array view, or a white placeholder when the scene has none.
+pub fn translucency_view<'a>(
+    translucent: Option<&'a TranslucentPass>,
+    placeholder: &'a wgpu::TextureView,
+) -> &'a wgpu::TextureView {
+    translucent
+        .and_then(|t| t.maps())
+        .map_or(placeholder, |m| &m.array_view)
+}

@@ -1,0 +1,598 @@
+//! Layered screen-space soft shadows (seed 001: Tamás and Heisenberger's practical SSSS after
+//! Gumbau et al. 2010) for many lights.
+//!
+//! Every light renders shadow maps from the shadow-map library (a spot cone, six cube faces,
+//! a fitted directional box); maps of lights and cube faces the view cannot see are culled.
+//! Lights are coloured into screen-space layers so that lights whose influence can meet on
+//! screen never share one ([`layers`]); the layers are the host's visibility slots. One
+//! compute pass then handles every light at every pixel: a hard shadow test (a bit per layer),
+//! a blocker search whose PCSS estimate gives the penumbra width, turned into a Gaussian sigma
+//! in screen pixels (a quarter of the width, the standard deviation of a disk light's
+//! penumbra across an edge, times sqrt(max(n_view.z, 0.25)) / view depth), and the tint of
+//! translucent casters in front. Two separable passes blur all layers at once along rotated
+//! screen directions, skipping taps across depth discontinuities, and write each layer's
+//! visibility and transmittance colour into the host's slots.
+
+pub mod gpu;
+pub mod layers;
+
+use zoo_host::glam::Mat4;
+use zoo_host::gpu::layout::ChoiceCodes;
+use zoo_host::prelude::*;
+use zoo_host::render::{SlotAssignment, SlotRequest};
+use zoo_host::scene::Scene;
+use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+use zoo_shadow_maps::culling::frusta_intersect;
+use zoo_shadow_maps::{DepthState, ShadowMapSet, TRANSLUCENT_FORMAT, TranslucentPass, light_size};
+
+use gpu::{DEBUG_MODE_OFFSET, Passes, Settings, SsssLight, Targets};
+use layers::{Layers, assign_layers};
+
+zoo_host::param_choice! {
+    /// Taps of each separable blur pass (the seed's 5, 11 and 23); the kernel always spans
+    /// +-2.5 sigma, so more taps sample it more finely rather than widen it.
+    pub enum Kernel { Taps5, Taps11, Taps23 }
+}
+
+zoo_host::technique_params! {
+    /// Parameters of layered screen-space soft shadows.
+    pub struct SsssParams {
+        /// Shadow-map resolution in texels per side (clamped to the device and memory budget).
+        map_size: u32 = 1024, range(256, 4096), step(256);
+        /// Taps of each blur pass.
+        kernel: Kernel = Kernel::Taps11;
+        /// Most screen-space layers; an assignment needing more is refused, naming the lights.
+        max_layers: u32 = 64, range(1, 64), step(1);
+        /// Scales the estimated penumbra (1: the width the light's size gives).
+        penumbra_scale: f32 = 1.0, range(0.0, 4.0), step(0.05);
+        /// Blur taps whose view depth differs from the centre's by more than this fraction of
+        /// it are skipped.
+        depth_threshold: f32 = 0.05, range(0.005, 0.5), step(0.005);
+        /// Smallest value of the kernel's grazing-angle factor n_view.z.
+        grazing_clamp: f32 = 0.25, range(0.01, 1.0), step(0.01);
+        /// Largest blur sigma, in pixels.
+        max_blur: f32 = 32.0, range(1.0, 128.0), step(1.0);
+        /// Largest blocker-search radius, in map texels.
+        search_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
+        /// Slope-scaled depth bias of the depth pass.
+        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
+        /// Lookups move off the surface by this many map texels along the normal.
+        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
+        /// Render only the maps of lights and cube faces that can shadow the view.
+        cull_maps: bool = true;
+        /// Keep directional maps stable as the camera moves.
+        stable_fit: bool = true;
+        /// Light whose maps the `shadow maps` view shows.
+        debug_light: u32 = 0, range(0, 1023), step(1);
+    }
+}
+
+const MAP_PASS: &str = "SSSS shadow map";
+const TRANSLUCENT_PASS: &str = "SSSS translucency";
+/// Debug views drawn by the debug pass, in the order of its `DEBUG_*` constants.
+const DEBUG_VIEWS: [&str; 5] = [
+    "layer assignment",
+    "penumbra sizes",
+    "hard shadows",
+    "blurred shadows",
+    "translucency",
+];
+const DEBUG_NAMES: [&str; 5] = ["Layers", "Penumbra", "Hard", "Blurred", "Translucency"];
+
+/// Whether any shadow caster of `scene` is translucent.
+fn has_translucent_casters(scene: &Scene) -> bool {
+    scene.objects.iter().any(|o| o.transmittance().is_some())
+}
+
+/// Maps, passes and targets, built at the first `prepare`.
+struct Gpu {
+    maps: ShadowMapSet,
+    translucent: Option<TranslucentPass>,
+    passes: Passes,
+    targets: Option<Targets>,
+    data: Option<wgpu::Buffer>,
+    /// A white translucency map for scenes without translucent casters.
+    placeholder: (wgpu::Texture, wgpu::TextureView),
+    debug_codes: ChoiceCodes,
+}
+
+impl Gpu {
+    fn new(ctx: &RenderContext<'_>, params: &SsssParams) -> TechniqueResult<Gpu> {
+        let state = DepthState {
+            slope_bias: params.slope_bias,
+            opaque_only: true,
+            ..DepthState::default()
+        };
+        let maps = ShadowMapSet::new(ctx, "ssss shadow maps", state, None)?;
+        let translucent = has_translucent_casters(ctx.scene)
+            .then(|| TranslucentPass::new(ctx, "ssss translucency"))
+            .transpose()?;
+        let passes = Passes::new(ctx, &maps)?;
+        let source = ctx.shaders.compose("ssss/debug.wgsl")?.source;
+        let debug_codes = ChoiceCodes::read(&source, "DEBUG", &DEBUG_NAMES)
+            .map_err(|e| TechniqueError::Other(format!("ssss/debug.wgsl: {e}")))?;
+        Ok(Gpu {
+            maps,
+            translucent,
+            passes,
+            targets: None,
+            data: None,
+            placeholder: placeholder(ctx.gpu),
+            debug_codes,
+        })
+    }
+}
+
+/// One white texel in a one-layer array of the translucency format.
+fn placeholder(gpu: &GpuContext) -> (wgpu::Texture, wgpu::TextureView) {
+    let layers = zoo_host::gpu::array_layers(gpu, 1, 1, 1);
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("ssss no translucency"),
+        size: wgpu::Extent3d {
+            width: 1,
+            height: 1,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: TRANSLUCENT_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    // 1.0 as four little-endian halves.
+    let one = [0x00, 0x3c].repeat(4);
+    for layer in 0..layers {
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: layer,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            &one,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(8),
+                rows_per_image: None,
+            },
+            wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("ssss no translucency (array)"),
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        array_layer_count: Some(1),
+        ..Default::default()
+    });
+    (texture, view)
+}
+
+/// Layered screen-space soft shadows.
+pub struct Ssss {
+    params: SsssParams,
+    gpu: Option<Gpu>,
+    /// The layers of the current lights and camera (as assigned to the visibility slots).
+    layers: Layers,
+}
+
+impl Ssss {
+    /// The colouring for the lights and camera of `request`, or an error naming the lights
+    /// beyond the layer cap.
+    fn layers_for(&self, request: &SlotRequest<'_>) -> TechniqueResult<Layers> {
+        let layers = assign_layers(request.lights, request.view_proj());
+        let cap = self.params.max_layers;
+        if layers.count > cap {
+            let over: Vec<String> = (0..request.lights.len())
+                .filter(|&i| layers.of_light[i].is_some_and(|l| l >= cap))
+                .map(|i| i.to_string())
+                .collect();
+            return Err(TechniqueError::Other(format!(
+                "ssss: the lights need {} screen-space layers, more than max_layers = {cap}: \
+                 lights {} overlap on screen with lights in every one of the first {cap} \
+                 (shorter ranges, fewer overlapping lights or a larger max_layers)",
+                layers.count,
+                over.join(", ")
+            )));
+        }
+        Ok(layers)
+    }
+
+    fn settings(&self, ctx: &RenderContext<'_>) -> Settings {
+        let p = &self.params;
+        let proj = ctx.frame.matrices.proj;
+        Settings {
+            layer_count: self.layers.count.max(1),
+            half_taps: match p.kernel {
+                Kernel::Taps5 => 2,
+                Kernel::Taps11 => 5,
+                Kernel::Taps23 => 11,
+            },
+            translucent: u32::from(has_translucent_casters(ctx.scene)),
+            pixel_scale: proj.y_axis.y * ctx.size.y as f32 * 0.5,
+            depth_threshold: p.depth_threshold,
+            grazing_clamp: p.grazing_clamp,
+            max_sigma: p.max_blur,
+            search_texels: p.search_texels,
+            penumbra_scale: p.penumbra_scale,
+            normal_offset: p.normal_offset,
+            debug_mode: 0,
+            _pad: 0,
+        }
+    }
+}
+
+/// Which of a light's map layers can shadow what the camera sees.
+fn layer_visible(layers: &Layers, view_proj: Mat4, light: usize, frustum: Mat4) -> bool {
+    layers.of_light[light].is_some() && frusta_intersect(frustum, view_proj)
+}
+
+impl ShadowTechnique for Ssss {
+    fn passes(&self) -> Vec<PassInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut passes: Vec<PassInfo> = gpu
+            .maps
+            .pass_names(MAP_PASS)
+            .into_iter()
+            .map(PassInfo::render)
+            .collect();
+        if gpu.translucent.is_some() {
+            let names = TranslucentPass::pass_names(&gpu.maps, TRANSLUCENT_PASS);
+            passes.extend(names.into_iter().map(PassInfo::render));
+        }
+        passes.extend(
+            [
+                gpu::PENUMBRA_PASS,
+                gpu::BLUR_FIRST_PASS,
+                gpu::BLUR_SECOND_PASS,
+            ]
+            .map(PassInfo::compute),
+        );
+        passes
+    }
+
+    fn resources(&self) -> Vec<ResourceInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        if let Some(maps) = gpu.maps.maps() {
+            out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
+        }
+        if let Some(maps) = gpu.translucent.as_ref().and_then(|t| t.maps()) {
+            out.push(ResourceInfo::texture(
+                "translucency maps",
+                &maps.texture,
+                false,
+            ));
+        }
+        if let Some(t) = &gpu.targets {
+            for name in DEBUG_VIEWS {
+                out.push(ResourceInfo::texture(name, &t.debug.0, true));
+            }
+            out.push(ResourceInfo::texture(
+                "layered penumbra",
+                &t.penumbra.texture,
+                false,
+            ));
+            out.push(ResourceInfo::texture(
+                "layered bits",
+                &t.bits.texture,
+                false,
+            ));
+            out.push(ResourceInfo::texture(
+                "layered tints",
+                &t.tints.texture,
+                false,
+            ));
+            out.push(ResourceInfo::texture(
+                "blurred occlusion",
+                &t.occlusion.texture,
+                false,
+            ));
+            out.push(ResourceInfo::texture(
+                "blurred light",
+                &t.light.texture,
+                false,
+            ));
+        }
+        out
+    }
+
+    fn assign_slots(&self, request: &SlotRequest<'_>) -> TechniqueResult<SlotAssignment> {
+        let layers = self.layers_for(request)?;
+        // Culled lights light no visible pixel: any slot will do.
+        let slots = layers.of_light.iter().map(|l| l.unwrap_or(0)).collect();
+        Ok(SlotAssignment::from_slots(slots))
+    }
+
+    fn slots_follow_camera(&self) -> bool {
+        true
+    }
+
+    fn writes_transmittance(&self, scene: &Scene) -> bool {
+        has_translucent_casters(scene)
+    }
+
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
+        if self.gpu.is_none() || changes.scene {
+            self.gpu = Some(Gpu::new(ctx, &self.params)?);
+        }
+        let aspect = ctx.size.x as f32 / ctx.size.y as f32;
+        let request = SlotRequest {
+            lights: ctx.lights,
+            camera: ctx.camera,
+            aspect,
+        };
+        self.layers = self.layers_for(&request)?;
+        let settings = self.settings(ctx);
+        let p = &self.params;
+        let gpu = self.gpu.as_mut().expect("built above");
+        let replaced = gpu.maps.prepare(ctx, changes, p.map_size, p.stable_fit);
+        let view_proj = ctx.frame.matrices.view_proj;
+        if p.cull_maps {
+            let layers = &self.layers;
+            gpu.maps
+                .cull(|l, k| layer_visible(layers, view_proj, l.light, l.frustums[k].view_proj));
+        } else {
+            let layers = &self.layers;
+            gpu.maps.cull(|l, _| layers.of_light[l.light].is_some());
+        }
+        if let Some(translucent) = &mut gpu.translucent {
+            translucent.prepare(ctx, &gpu.maps, replaced);
+        }
+        let translucent = gpu.translucent.is_some();
+        let layer_count = settings.layer_count;
+        if !gpu
+            .targets
+            .as_ref()
+            .is_some_and(|t| t.fit(ctx.size, layer_count, translucent))
+        {
+            gpu.targets = Some(Targets::new(ctx.gpu, ctx.size, layer_count, translucent));
+        }
+        // The data buffer: settings, then one record per scene light.
+        let resolution = gpu.maps.resolution();
+        let mut records = vec![SsssLight::default(); ctx.lights.len().max(1)];
+        for maps in gpu.maps.lights() {
+            let (Some(layer), false) = (self.layers.of_light[maps.light], maps.frustums.is_empty())
+            else {
+                continue;
+            };
+            let scale = maps.scale(resolution);
+            records[maps.light] = SsssLight {
+                first_layer: maps.first_layer,
+                layer_count: maps.frustums.len() as u32,
+                layer,
+                perspective: u32::from(scale.perspective),
+                near: scale.near,
+                far: scale.far,
+                texel_scale: scale.texel_scale,
+                size: light_size(&ctx.lights[maps.light]),
+            };
+        }
+        let mut bytes = bytemuck::bytes_of(&settings).to_vec();
+        bytes.extend_from_slice(bytemuck::cast_slice(&records));
+        if gpu
+            .data
+            .as_ref()
+            .is_none_or(|b| b.size() < bytes.len() as u64)
+        {
+            gpu.data = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("ssss data"),
+                size: (bytes.len() as u64).next_power_of_two(),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        let data = gpu.data.as_ref().expect("created above");
+        ctx.gpu.queue.write_buffer(data, 0, &bytes);
+        let translucency = gpu::translucency_view(gpu.translucent.as_ref(), &gpu.placeholder.1);
+        let targets = gpu.targets.as_ref().expect("created above");
+        gpu.passes.bind(ctx, data, targets, translucency);
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> TechniqueResult {
+        let gpu = self.gpu.as_ref().ok_or_else(TechniqueError::not_prepared)?;
+        gpu.maps.record(ctx, recorder, MAP_PASS)?;
+        if let Some(translucent) = &gpu.translucent {
+            translucent.record(ctx, recorder, &gpu.maps, TRANSLUCENT_PASS)?;
+        }
+        let debug = ctx
+            .debug_view
+            .and_then(|name| DEBUG_VIEWS.iter().position(|v| *v == name));
+        if let (Some(view), Some(data)) = (debug, &gpu.data) {
+            let code = gpu.debug_codes.code(view);
+            ctx.gpu
+                .queue
+                .write_buffer(data, DEBUG_MODE_OFFSET, bytemuck::bytes_of(&code));
+        }
+        gpu.passes.record(ctx, recorder, &gpu.maps, debug.is_some())
+    }
+
+    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let gpu = self.gpu.as_ref()?;
+        if resource == "shadow maps" {
+            return gpu.maps.debug_image(self.params.debug_light);
+        }
+        DEBUG_VIEWS.contains(&resource).then(|| DebugImage {
+            view: &gpu
+                .targets
+                .as_ref()
+                .expect("targets exist once maps do")
+                .debug
+                .1,
+            mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
+        })
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+        let next = SsssParams::from_values(values)?;
+        // The depth bias lives in the depth pipeline; everything else reaches the shaders
+        // through the data buffer at the next `prepare`.
+        if next.slope_bias != self.params.slope_bias {
+            return Ok(ParamUpdate::Rebuild);
+        }
+        self.params = next;
+        Ok(ParamUpdate::Applied)
+    }
+
+    fn counters(&self) -> Vec<(String, f64)> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut counters = gpu.maps.counters();
+        let kept = gpu
+            .maps
+            .lights()
+            .iter()
+            .flat_map(|l| (0..l.frustums.len() as u32).map(move |k| l.first_layer + k))
+            .filter(|&layer| gpu.maps.is_kept(layer))
+            .count();
+        let shadowed = self.layers.of_light.iter().filter(|l| l.is_some()).count();
+        counters.push(("map layers rendered".into(), kept as f64));
+        counters.push(("screen-space layers".into(), f64::from(self.layers.count)));
+        counters.push(("lights on screen".into(), shadowed as f64));
+        counters
+    }
+}
+
+fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    let params = SsssParams::from_values(values)?;
+    Ok(Box::new(Ssss {
+        params,
+        gpu: None,
+        layers: Layers {
+            of_light: Vec::new(),
+            count: 0,
+        },
+    }))
+}
+
+zoo_host::register_technique! {
+    id: "ssss",
+    name: "Layered screen-space soft shadows",
+    description: "Shadow maps for many lights, penumbrae estimated per light and blurred in screen space, one layer per group of lights that never overlap on screen; coloured translucent shadows",
+    source: "seed 001 (Tamás and Heisenberger, practical SSSS; Gumbau et al. 2010)",
+    light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
+    required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS,
+    params: SsssParams::schema,
+    create: create,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    fn shader(name: &str) -> String {
+        zoo_host::ShaderLibrary::embedded()
+            .compose(name)
+            .unwrap()
+            .source
+    }
+
+    #[test]
+    fn data_mirrors_the_shader() {
+        let source = shader("ssss/penumbra.wgsl");
+        let (size, fields) = zoo_host::mirror_fields!(Settings {
+            layer_count,
+            half_taps,
+            translucent,
+            pixel_scale,
+            depth_threshold,
+            grazing_clamp,
+            max_sigma,
+            search_texels,
+            penumbra_scale,
+            normal_offset,
+            debug_mode,
+            _pad
+        });
+        check_mirror(&source, "Settings", size, &fields, SizeRule::Equal).unwrap();
+        let (size, fields) = zoo_host::mirror_fields!(SsssLight {
+            first_layer,
+            layer_count,
+            layer,
+            perspective,
+            near,
+            far,
+            texel_scale,
+            size
+        });
+        check_mirror(&source, "SsssLight", size, &fields, SizeRule::Equal).unwrap();
+    }
+
+    #[test]
+    fn every_debug_view_has_a_shader_constant() {
+        let codes = ChoiceCodes::read(&shader("ssss/debug.wgsl"), "DEBUG", &DEBUG_NAMES).unwrap();
+        let mut values: Vec<u32> = (0..DEBUG_NAMES.len()).map(|i| codes.code(i)).collect();
+        values.sort();
+        values.dedup();
+        assert_eq!(values.len(), DEBUG_VIEWS.len());
+    }
+
+    #[test]
+    fn the_layer_cap_is_reported_with_the_lights() {
+        let light = |x: f32| zoo_host::Light {
+            kind: LightKind::Point,
+            position: zoo_host::glam::Vec3::new(x, 1.0, 0.0),
+            direction: zoo_host::glam::Vec3::NEG_Y,
+            radiance: zoo_host::glam::Vec3::ONE,
+            range: 5.0,
+            spot_angle: 0.5,
+            spot_softness: 0.1,
+            radius: 0.1,
+        };
+        let lights: Vec<_> = (0..4).map(|i| light(i as f32 * 0.5)).collect();
+        let camera = zoo_host::Camera {
+            position: zoo_host::glam::Vec3::new(0.0, 5.0, 10.0),
+            target: zoo_host::glam::Vec3::ZERO,
+            fov_y: 1.0,
+            near: 0.1,
+            far: 100.0,
+        };
+        let request = SlotRequest {
+            lights: &lights,
+            camera: &camera,
+            aspect: 1.0,
+        };
+        let mut values = zoo_host::params::defaults(&SsssParams::schema());
+        values.insert("max_layers".into(), zoo_host::ParamValue::Int(2));
+        let technique = create_for_test(&values);
+        let error = technique.assign_slots(&request).unwrap_err().to_string();
+        assert!(error.contains("need 4 screen-space layers"), "{error}");
+        assert!(error.contains("max_layers = 2"), "{error}");
+        // All four overlap with equal degree and are coloured in index order: the last two
+        // are over the cap.
+        assert!(error.contains("lights 2, 3 overlap"), "{error}");
+        let technique = create_for_test(&zoo_host::params::defaults(&SsssParams::schema()));
+        let slots = technique.assign_slots(&request).unwrap();
+        assert_eq!(slots.slot_count(), 4);
+    }
+
+    fn create_for_test(values: &ParamValues) -> Ssss {
+        Ssss {
+            params: SsssParams::from_values(values).unwrap(),
+            gpu: None,
+            layers: Layers {
+                of_light: Vec::new(),
+                count: 0,
+            },
+        }
+    }
+}

@@ -1,0 +1,83 @@
+// Layered screen-space soft shadows: the data every pass reads (group 2, binding 0) and the
+// layout of the layered targets. A layer is a visibility slot: layer `l` is channel `l % 4`
+// of array layer `l / 4` in the float targets, and bit `l % 32` of array layer `l / 32` in
+// the bit targets (occluded bits; the tinted bits follow in as many layers again).
+
+// Largest layer count the passes handle (the private arrays below are sized by it).
+const MAX_LAYERS: u32 = 64u;
+const MAX_GROUPS: u32 = 16u;
+const MAX_WORDS: u32 = 2u;
+
+struct Settings {
+    // Layers in use.
+    layer_count: u32,
+    // Blur taps on each side of the centre (kernel = 2 * half_taps + 1).
+    half_taps: u32,
+    // 1 when the scene has translucent casters.
+    translucent: u32,
+    // Pixels per world unit at unit view depth: proj[1][1] * height / 2.
+    pixel_scale: f32,
+    // Depth rejection: taps farther than this fraction of the centre's view depth are skipped.
+    depth_threshold: f32,
+    // Grazing-angle clamp of the kernel's sqrt(n_view.z) factor.
+    grazing_clamp: f32,
+    // Largest blur sigma, in pixels.
+    max_sigma: f32,
+    // Blocker-search radius limit, in map texels.
+    search_texels: f32,
+    // Scales the estimated penumbra (1: the calibrated width).
+    penumbra_scale: f32,
+    // Lookups move off the surface by this many map texels along the normal.
+    normal_offset: f32,
+    // What the debug pass shows (`DEBUG_*` in `ssss/debug.wgsl`).
+    debug_mode: u32,
+    _pad: u32,
+}
+
+// One scene light's maps and layer (indexed like the scene's lights).
+struct SsssLight {
+    first_layer: u32,
+    // 0 when the light is culled or not shadowed; 1 or 6 (cube faces).
+    layer_count: u32,
+    // Its screen-space layer (visibility slot).
+    layer: u32,
+    perspective: u32,
+    near: f32,
+    far: f32,
+    // World size of a texel: per unit of distance along the face axis (perspective) or
+    // absolute (orthographic).
+    texel_scale: f32,
+    // Radius (point, spot) or tangent of the angular radius (directional).
+    size: f32,
+}
+
+struct SsssData {
+    settings: Settings,
+    lights: array<SsssLight>,
+}
+
+@group(2) @binding(0) var<storage, read> data: SsssData;
+
+fn group_of(layer: u32) -> u32 {
+    return layer / 4u;
+}
+
+fn word_of(layer: u32) -> u32 {
+    return layer / 32u;
+}
+
+fn bit_of(layer: u32) -> u32 {
+    return 1u << (layer % 32u);
+}
+
+// 32-bit words per bit set (occluded or tinted).
+fn word_count() -> u32 {
+    return (data.settings.layer_count + 31u) / 32u;
+}
+
+// Screen directions of the two separable passes: rotated by 26.6 degrees so that vertical
+// walls do not band (seed 001, from the authors' sample).
+const BLUR_DIRECTIONS: array<vec2<f32>, 2> = array<vec2<f32>, 2>(
+    vec2<f32>(0.894427, 0.447214),
+    vec2<f32>(-0.447214, 0.894427),
+);

@@ -1,0 +1,186 @@
+// Layered penumbra pass (seed 001 §6), all lights in one compute pass: for every pixel and
+// every light that reaches it, a hard shadow test against the light's depth map, a blocker
+// search for the penumbra width, and the colour of translucent casters in front. Written per
+// layer (the light's visibility slot): the blur sigma in pixels (0 = no blur), occlusion and
+// tint bits, and the tint colour.
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "common/lighting.wgsl"
+#import "shadow-maps/filters.wgsl"
+#import "shadow-maps/depth_lookup.wgsl"
+#import "ssss/data.wgsl"
+
+// Blur sigma per layer, four layers per texel.
+@group(2) @binding(1) var penumbra_out: texture_storage_2d_array<rgba16float, write>;
+// Occluded bits, 32 layers per texel, then tinted bits (behind translucent casters).
+@group(2) @binding(2) var bits_out: texture_storage_2d_array<r32uint, write>;
+// Tint colour per layer (rgb), where its tinted bit is set.
+@group(2) @binding(3) var tint_out: texture_storage_2d_array<rgba16float, write>;
+// Translucent casters per map layer: min transmittance (rgb), nearest depth (a).
+@group(2) @binding(4) var translucency: texture_2d_array<f32>;
+
+// The light being looked up, for the filters' map access.
+var<private> current: SsssLight;
+var<private> current_position: vec3<f32>;
+
+fn project(p: vec3<f32>) -> MapPoint {
+    let layer = light_layer(current.first_layer, current.layer_count, current_position, p);
+    return map_point(layer, p);
+}
+
+// Distance along the map's axis for a [0, 1] depth value.
+fn linear_depth(d: f32) -> f32 {
+    if current.perspective == 1u {
+        return current.near * current.far / (current.far - d * (current.far - current.near));
+    }
+    return current.near + d * (current.far - current.near);
+}
+
+// The nearest translucent caster's depth in the texel under `m` (1 where there is none).
+fn translucent_depth(m: MapPoint) -> f32 {
+    if data.settings.translucent == 0u {
+        return 1.0;
+    }
+    let size = vec2<i32>(textureDimensions(translucency));
+    let texel = clamp(vec2<i32>(m.uv * vec2<f32>(size)), vec2<i32>(0), size - vec2<i32>(1));
+    return textureLoad(translucency, texel, m.layer, 0).a;
+}
+
+fn shadow_tap(p: vec3<f32>, linear: bool) -> f32 {
+    return compare_map(project(p), linear);
+}
+
+// (inside, receiver depth, nearest blocker depth: opaque or translucent), along the map axis.
+fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
+    let m = project(p);
+    if !m.inside {
+        return vec3<f32>(0.0);
+    }
+    let stored = min(stored_map_depth(m), translucent_depth(m));
+    return vec3<f32>(1.0, linear_depth(m.depth), linear_depth(stored));
+}
+
+// World size of one map texel at p.
+fn texel_world(p: vec3<f32>) -> f32 {
+    if current.perspective == 0u {
+        return current.texel_scale;
+    }
+    let d = p - current_position;
+    if current.layer_count == 6u {
+        let a = abs(d);
+        return current.texel_scale * max(a.x, max(a.y, a.z));
+    }
+    return current.texel_scale * length(d);
+}
+
+// Penumbra width in world units on a receiver at p facing the light (0: no blocker found):
+// the PCSS estimate from the average blocker depth, w = 2 R (d_r - d_b) / d_b for lights of
+// radius R, 2 tan(theta) (d_r - d_b) for directional lights of angular radius theta.
+fn penumbra_width(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>) -> f32 {
+    let center = shadow_depths(p);
+    if center.x == 0.0 {
+        return 0.0;
+    }
+    let receiver = center.y;
+    var search = current.size * (receiver - current.near);
+    if current.perspective == 1u {
+        search /= max(current.near, 1e-4);
+    }
+    search = clamp(search, texel, data.settings.search_texels * texel);
+    var blockers = 0.0;
+    var blocker_sum = 0.0;
+    for (var k = 0u; k < 16u; k++) {
+        let o = r * POISSON_16[k] * search;
+        let d = shadow_depths(p + frame[0] * o.x + frame[1] * o.y);
+        if d.x > 0.0 && d.z < d.y - texel {
+            blockers += 1.0;
+            blocker_sum += d.z;
+        }
+    }
+    if blockers == 0.0 {
+        return 0.0;
+    }
+    let blocker = blocker_sum / blockers;
+    var width = 2.0 * current.size * (receiver - blocker);
+    if current.perspective == 1u {
+        width /= max(blocker, 1e-4);
+    }
+    return width;
+}
+
+fn pack_tint(c: vec3<f32>) -> vec4<f32> {
+    return vec4<f32>(c, 1.0);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_penumbra(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(camera.size);
+    if id.x >= size.x || id.y >= size.y {
+        return;
+    }
+    let pixel = vec2<i32>(id.xy);
+    let settings = data.settings;
+    let groups = (settings.layer_count + 3u) / 4u;
+    let words = word_count();
+    var sigma: array<vec4<f32>, MAX_GROUPS>;
+    var occluded: array<u32, MAX_WORDS>;
+    var tinted: array<u32, MAX_WORDS>;
+    let s = load_surface(pixel);
+    if s.valid {
+        let view_depth = bitcast<f32>(textureLoad(gbuffer_view_depth, pixel, 0).r);
+        let view_normal = (camera.view * vec4<f32>(s.normal, 0.0)).xyz;
+        // Screen pixels per world unit on this surface: distance and the seed's
+        // anisotropic factor sqrt(max(n_view.z, clamp)).
+        let to_pixels = settings.pixel_scale / view_depth
+            * sqrt(max(view_normal.z, settings.grazing_clamp));
+        let r = rotation(vec2<f32>(pixel));
+        for (var i = 0u; i < arrayLength(&data.lights); i++) {
+            let sl = data.lights[i];
+            if sl.layer_count == 0u {
+                continue;
+            }
+            let light = lights[i];
+            if light_falloff(light, s.position) <= 0.0 {
+                continue;
+            }
+            current = sl;
+            current_position = light.position;
+            let layer = sl.layer;
+            let w = word_of(layer);
+            // Surfaces facing away are in the light's self-shadow.
+            let l = light_vector(light, s.position);
+            if dot(s.normal, l) <= 0.0 {
+                occluded[w] |= bit_of(layer);
+                continue;
+            }
+            let texel = texel_world(s.position);
+            let p = s.position + s.normal * (settings.normal_offset * texel);
+            let m = project(p);
+            if compare_map(m, false) < 0.5 {
+                occluded[w] |= bit_of(layer);
+            } else if settings.translucent == 1u && m.inside && m.depth > translucent_depth(m) {
+                let size = vec2<i32>(textureDimensions(translucency));
+                let t = clamp(vec2<i32>(m.uv * vec2<f32>(size)), vec2<i32>(0), size - vec2<i32>(1));
+                tinted[w] |= bit_of(layer);
+                textureStore(tint_out, pixel, layer, pack_tint(textureLoad(translucency, t, m.layer, 0).rgb));
+            }
+            let frame = tangent_frame(-l);
+            let width = penumbra_width(p, frame, texel, r);
+            // A disk light's penumbra across a straight edge has a standard deviation of a
+            // quarter of its width: the Gaussian's sigma.
+            var px = 0.25 * width * settings.penumbra_scale * to_pixels;
+            if px < 0.5 {
+                px = 0.0;
+            }
+            sigma[group_of(layer)][layer % 4u] = min(px, settings.max_sigma);
+        }
+    }
+    for (var g = 0u; g < groups; g++) {
+        textureStore(penumbra_out, pixel, g, sigma[g]);
+    }
+    for (var w = 0u; w < words; w++) {
+        textureStore(bits_out, pixel, w, vec4<u32>(occluded[w]));
+        textureStore(bits_out, pixel, words + w, vec4<u32>(tinted[w]));
+    }
+}
