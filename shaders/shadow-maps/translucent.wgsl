@@ -1,7 +1,8 @@
 // Translucent casters seen from one light layer: each texel keeps the smallest transmittance
-// colour (rgb) and the nearest depth (a) of the translucent surfaces in front of the opaque
+// colour (rgb) and the nearest `light_depth` (a) of the translucent surfaces in front of the opaque
 // depth map, by a min blend. Techniques look up the colour behind that depth (coloured
 // shadows) and use the depth as a blocker (soft translucent shadows). Cleared to white, depth 1.
+// The depth carries a slope-scaled bias, so lit translucent surfaces do not tint themselves.
 
 #import "common/frame.wgsl"
 #import "shadow-maps/layers.wgsl"
@@ -10,7 +11,8 @@
 
 struct TranslucentVertex {
     @builtin(position) clip: vec4<f32>,
-    @location(0) @interpolate(flat) object: u32,
+    @location(0) world: vec3<f32>,
+    @location(1) @interpolate(flat) object: u32,
 }
 
 @vertex
@@ -20,11 +22,20 @@ fn vs_translucent(
 ) -> TranslucentVertex {
     var out: TranslucentVertex;
     out.clip = layer_camera.view_proj * vec4<f32>(position, 1.0);
+    out.world = position;
     out.object = object;
     return out;
 }
 
+// Slope-scaled bias of the stored depth, in depth slopes (the depth pass's hardware bias does
+// not apply to a colour channel).
+const TRANSLUCENT_SLOPE_BIAS: f32 = 2.0;
+
+// The depth is `light_depth` (distance over far, or the orthographic depth): linear, so the
+// 16-bit channel keeps a relative precision of 1e-3 at every distance.
 @fragment
 fn fs_translucent(v: TranslucentVertex) -> @location(0) vec4<f32> {
-    return vec4<f32>(objects[v.object].transmittance.rgb, v.clip.z);
+    let d = light_depth(layer_camera, v.world);
+    let slope = max(abs(dpdx(d)), abs(dpdy(d)));
+    return vec4<f32>(objects[v.object].transmittance.rgb, d + TRANSLUCENT_SLOPE_BIAS * slope);
 }

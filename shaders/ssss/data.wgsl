@@ -31,7 +31,8 @@ struct Settings {
     normal_offset: f32,
     // What the debug pass shows (`DEBUG_*` in `ssss/debug.wgsl`).
     debug_mode: u32,
-    _pad: u32,
+    // How blockers are found (`ESTIMATE_*` in `ssss/penumbra.wgsl`).
+    estimate: u32,
 }
 
 // One scene light's maps and layer (indexed like the scene's lights).

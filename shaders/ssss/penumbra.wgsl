@@ -19,6 +19,13 @@
 @group(2) @binding(3) var tint_out: texture_storage_2d_array<rgba16float, write>;
 // Translucent casters per map layer: min transmittance (rgb), nearest depth (a).
 @group(2) @binding(4) var translucency: texture_2d_array<f32>;
+// Min-filtered depth maps (`ssss/min_depth.wgsl`), for the min-filter estimate.
+@group(2) @binding(5) var min_maps: texture_2d_array<f32>;
+
+// Blocker estimates, one per variant of the plugin's `Estimate` parameter (`ESTIMATE_` and its
+// name in capitals).
+const ESTIMATE_BLOCKERSEARCH: u32 = 0u;
+const ESTIMATE_MINFILTER: u32 = 1u;
 
 // The light being looked up, for the filters' map access.
 var<private> current: SsssLight;
@@ -37,14 +44,29 @@ fn linear_depth(d: f32) -> f32 {
     return current.near + d * (current.far - current.near);
 }
 
-// The nearest translucent caster's depth in the texel under `m` (1 where there is none).
-fn translucent_depth(m: MapPoint) -> f32 {
-    if data.settings.translucent == 0u {
-        return 1.0;
-    }
+// The translucency map's texel under `m`: min transmittance (rgb), nearest `light_depth` (a).
+fn translucency_at(m: MapPoint) -> vec4<f32> {
     let size = vec2<i32>(textureDimensions(translucency));
     let texel = clamp(vec2<i32>(m.uv * vec2<f32>(size)), vec2<i32>(0), size - vec2<i32>(1));
-    return textureLoad(translucency, texel, m.layer, 0).a;
+    return textureLoad(translucency, texel, m.layer, 0);
+}
+
+// The nearest translucent caster on the light ray through `p` (which projects to `m`), as a
+// distance along the map's axis like `linear_depth`; very far where there is none.
+fn translucent_depth(m: MapPoint, p: vec3<f32>) -> f32 {
+    if data.settings.translucent == 0u {
+        return 1e30;
+    }
+    let stored = translucency_at(m).a;
+    if stored >= 1.0 {
+        return 1e30;
+    }
+    let eye = layer_cameras[m.layer].camera.eye;
+    if eye.w > 0.0 {
+        // Distance over far along the ray; scaled to the axis like p's own distance.
+        return stored / eye.w * linear_depth(m.depth) / max(length(p - eye.xyz), 1e-6);
+    }
+    return linear_depth(stored);
 }
 
 fn shadow_tap(p: vec3<f32>, linear: bool) -> f32 {
@@ -57,8 +79,8 @@ fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
     if !m.inside {
         return vec3<f32>(0.0);
     }
-    let stored = min(stored_map_depth(m), translucent_depth(m));
-    return vec3<f32>(1.0, linear_depth(m.depth), linear_depth(stored));
+    let stored = min(linear_depth(stored_map_depth(m)), translucent_depth(m, p));
+    return vec3<f32>(1.0, linear_depth(m.depth), stored);
 }
 
 // World size of one map texel at p.
@@ -74,20 +96,31 @@ fn texel_world(p: vec3<f32>) -> f32 {
     return current.texel_scale * length(d);
 }
 
-// Penumbra width in world units on a receiver at p facing the light (0: no blocker found):
-// the PCSS estimate from the average blocker depth, w = 2 R (d_r - d_b) / d_b for lights of
-// radius R, 2 tan(theta) (d_r - d_b) for directional lights of angular radius theta.
-fn penumbra_width(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>) -> f32 {
-    let center = shadow_depths(p);
-    if center.x == 0.0 {
-        return 0.0;
-    }
-    let receiver = center.y;
+// The blocker-search radius in world units for a receiver at `receiver` along the map axis:
+// the light's size projected through the near plane (perspective) or along its rays.
+fn search_radius(receiver: f32, texel: f32) -> f32 {
     var search = current.size * (receiver - current.near);
     if current.perspective == 1u {
         search /= max(current.near, 1e-4);
     }
-    search = clamp(search, texel, data.settings.search_texels * texel);
+    return clamp(search, texel, data.settings.search_texels * texel);
+}
+
+// The penumbra width for blockers at `blocker` and a receiver at `receiver` (along the map
+// axis): w = 2 R (d_r - d_b) / d_b for lights of radius R, 2 tan(theta) (d_r - d_b) for
+// directional lights of angular radius theta (PCSS's estimate).
+fn width_for(receiver: f32, blocker: f32) -> f32 {
+    var width = 2.0 * current.size * (receiver - blocker);
+    if current.perspective == 1u {
+        width /= max(blocker, 1e-4);
+    }
+    return width;
+}
+
+// Penumbra width by a 16-tap blocker search around p (0: no blocker found), averaging the
+// blockers' depths.
+fn width_by_search(p: vec3<f32>, receiver: f32, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>) -> f32 {
+    let search = search_radius(receiver, texel);
     var blockers = 0.0;
     var blocker_sum = 0.0;
     for (var k = 0u; k < 16u; k++) {
@@ -101,16 +134,28 @@ fn penumbra_width(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>) 
     if blockers == 0.0 {
         return 0.0;
     }
-    let blocker = blocker_sum / blockers;
-    var width = 2.0 * current.size * (receiver - blocker);
-    if current.perspective == 1u {
-        width /= max(blocker, 1e-4);
-    }
-    return width;
+    return width_for(receiver, blocker_sum / blockers);
 }
 
-fn pack_tint(c: vec3<f32>) -> vec4<f32> {
-    return vec4<f32>(c, 1.0);
+// Penumbra width from the min-filtered maps (0: no blocker near): the nearest depth over the
+// min texels covering the search radius around `m` (at most 5 x 5 of them).
+fn width_by_min_filter(m: MapPoint, receiver: f32, texel: f32) -> f32 {
+    let size = vec2<i32>(textureDimensions(min_maps));
+    let block = f32(textureDimensions(depth_values).x) / f32(size.x);
+    let reach = clamp(i32(ceil(search_radius(receiver, texel) / (texel * block))), 1, 2);
+    let center = vec2<i32>(m.uv * vec2<f32>(size));
+    var nearest = 1.0;
+    for (var y = -reach; y <= reach; y++) {
+        for (var x = -reach; x <= reach; x++) {
+            let t = clamp(center + vec2<i32>(x, y), vec2<i32>(0), size - vec2<i32>(1));
+            nearest = min(nearest, textureLoad(min_maps, t, m.layer, 0).r);
+        }
+    }
+    let blocker = linear_depth(nearest);
+    if blocker >= receiver - texel {
+        return 0.0;
+    }
+    return width_for(receiver, blocker);
 }
 
 @compute @workgroup_size(8, 8)
@@ -157,16 +202,24 @@ fn cs_penumbra(@builtin(global_invocation_id) id: vec3<u32>) {
             let texel = texel_world(s.position);
             let p = s.position + s.normal * (settings.normal_offset * texel);
             let m = project(p);
-            if compare_map(m, false) < 0.5 {
-                occluded[w] |= bit_of(layer);
-            } else if settings.translucent == 1u && m.inside && m.depth > translucent_depth(m) {
-                let size = vec2<i32>(textureDimensions(translucency));
-                let t = clamp(vec2<i32>(m.uv * vec2<f32>(size)), vec2<i32>(0), size - vec2<i32>(1));
-                tinted[w] |= bit_of(layer);
-                textureStore(tint_out, pixel, layer, pack_tint(textureLoad(translucency, t, m.layer, 0).rgb));
+            if !m.inside {
+                continue;
             }
-            let frame = tangent_frame(-l);
-            let width = penumbra_width(p, frame, texel, r);
+            // The hard test: a nearest-texel comparison (the depth pass's slope bias is in the
+            // stored depth).
+            let receiver = linear_depth(m.depth);
+            if m.depth > stored_map_depth(m) {
+                occluded[w] |= bit_of(layer);
+            } else if receiver > translucent_depth(m, p) + 2.0 * texel {
+                tinted[w] |= bit_of(layer);
+                textureStore(tint_out, pixel, layer, vec4<f32>(translucency_at(m).rgb, 1.0));
+            }
+            var width = 0.0;
+            if settings.estimate == ESTIMATE_MINFILTER {
+                width = width_by_min_filter(m, receiver, texel);
+            } else {
+                width = width_by_search(p, receiver, tangent_frame(-l), texel, r);
+            }
             // A disk light's penumbra across a straight edge has a standard deviation of a
             // quarter of its width: the Gaussian's sigma.
             var px = 0.25 * width * settings.penumbra_scale * to_pixels;

@@ -258,6 +258,23 @@ fn report_md(r: &ReportInputs<'_>) -> String {
         r.reference.lights.first().map_or(0, |l| l.samples),
         r.reference.seconds
     );
+    if r.reference.lights.iter().any(|l| l.color.is_some()) {
+        let opaque: Vec<String> = r
+            .judged
+            .iter()
+            .filter(|j| j.transmittance.iter().all(Option::is_none))
+            .map(|j| format!("`{}`", j.technique))
+            .collect();
+        let _ = writeln!(
+            w,
+            "- Translucent casters: the reference filters light through them by colour; {} treat them as opaque (their visibility is scored against the mean colour that passes)",
+            if opaque.is_empty() {
+                "no technique here".to_string()
+            } else {
+                opaque.join(", ")
+            }
+        );
+    }
     let _ = writeln!(
         w,
         "\nFractions are of the pixels each light reaches. `core` leaves out the one-pixel band around reference shadow boundaries; `mae` and `p95` compare with the area-light reference. Error maps: red = false shadow, blue = false lit, grey = both shadowed.\n"

@@ -23,7 +23,7 @@ pub struct Settings {
     pub penumbra_scale: f32,
     pub normal_offset: f32,
     pub debug_mode: u32,
-    pub _pad: u32,
+    pub estimate: u32,
 }
 
 /// `SsssLight` in `ssss/data.wgsl`.
@@ -242,6 +242,7 @@ impl Passes {
                 storage_texture(2, F::R32Uint, ARRAY),
                 storage_texture(3, rgba16, ARRAY),
                 sampled(4, FLOAT),
+                sampled(5, FLOAT),
             ],
             &[maps.lookup_layout()],
         )?;
@@ -307,6 +308,7 @@ impl Passes {
         data: &wgpu::Buffer,
         targets: &Targets,
         translucency: &wgpu::TextureView,
+        min_maps: &wgpu::TextureView,
     ) {
         let device = &ctx.gpu.device;
         let view = wgpu::BindingResource::TextureView;
@@ -322,6 +324,7 @@ impl Passes {
                 view(&t.bits.view),
                 view(&t.tints.view),
                 view(translucency),
+                view(min_maps),
             ],
         );
         let blur_first = bind_group(
@@ -398,6 +401,137 @@ impl Passes {
             }
             pass.dispatch_workgroups(workgroups.x, workgroups.y, 1);
         }
+        Ok(())
+    }
+}
+
+/// Min-filtered depth maps: each texel the nearest depth of an 8 x 8 block of its map layer
+/// (`ssss/min_depth.wgsl`), for the min-filter penumbra estimate.
+pub struct MinFilter {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    /// (maps, array view, resolution, layers) once made.
+    maps: Option<(wgpu::Texture, wgpu::TextureView, u32, u32)>,
+    kept: Option<wgpu::Buffer>,
+    kept_count: u32,
+    group: Option<wgpu::BindGroup>,
+}
+
+/// Full-resolution texels per min-map texel along each side (`MIN_BLOCK` in the shader).
+pub const MIN_BLOCK: u32 = 8;
+pub const MIN_FILTER_PASS: &str = "SSSS min filter";
+
+impl MinFilter {
+    pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<MinFilter> {
+        let device = &ctx.gpu.device;
+        let module = ctx.shaders.create_module(device, "ssss/min_depth.wgsl")?;
+        let layout = bind_group_layout(
+            device,
+            "ssss min filter layout",
+            &[
+                sampled(0, FLOAT),
+                storage_texture(1, wgpu::TextureFormat::R32Float, ARRAY),
+                kit::storage(2, wgpu::ShaderStages::COMPUTE, true),
+            ],
+        );
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("ssss min filter pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("ssss min filter pipeline"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("cs_min_depth"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Ok(MinFilter {
+            pipeline,
+            layout,
+            maps: None,
+            kept: None,
+            kept_count: 0,
+            group: None,
+        })
+    }
+
+    /// Sizes the min maps to `set`'s depth maps and lists the layers it renders.
+    pub fn prepare(&mut self, ctx: &RenderContext<'_>, set: &ShadowMapSet) {
+        let Some(depth) = set.depth_maps() else {
+            return;
+        };
+        let gpu = ctx.gpu;
+        let resolution = depth.resolution.div_ceil(MIN_BLOCK).max(1);
+        if self
+            .maps
+            .as_ref()
+            .is_none_or(|m| (m.2, m.3) != (resolution, depth.layers))
+        {
+            let layered = Layered::new(
+                gpu,
+                "ssss min-filtered depth",
+                zoo_host::glam::UVec2::splat(resolution),
+                depth.layers,
+                wgpu::TextureFormat::R32Float,
+            );
+            self.maps = Some((layered.texture, layered.view, resolution, depth.layers));
+        }
+        let kept: Vec<u32> = (0..depth.layers).filter(|&l| set.is_kept(l)).collect();
+        let bytes: &[u8] = bytemuck::cast_slice(&kept);
+        let size = (bytes.len() as u64).max(4);
+        if self.kept.as_ref().is_none_or(|b| b.size() < size) {
+            self.kept = Some(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("ssss kept map layers"),
+                size: size.next_power_of_two(),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        let buffer = self.kept.as_ref().expect("created above");
+        gpu.queue.write_buffer(buffer, 0, bytes);
+        self.kept_count = kept.len() as u32;
+        let maps = self.maps.as_ref().expect("created above");
+        self.group = Some(bind_group(
+            &gpu.device,
+            "ssss min filter group",
+            &self.layout,
+            &[
+                wgpu::BindingResource::TextureView(&depth.array_view),
+                wgpu::BindingResource::TextureView(&maps.1),
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(u64::from(self.kept_count.max(1)) * 4),
+                }),
+            ],
+        ));
+    }
+
+    /// Whether [`Self::record`] records its pass (some layer is rendered).
+    pub fn has_work(&self) -> bool {
+        self.group.is_some() && self.kept_count > 0
+    }
+
+    /// The min maps' array view, once prepared.
+    pub fn view(&self) -> Option<&wgpu::TextureView> {
+        self.maps.as_ref().map(|m| &m.1)
+    }
+
+    /// Fills the min maps of the rendered layers.
+    pub fn record(&self, recorder: &mut PassRecorder<'_>) -> TechniqueResult {
+        let (Some(group), Some(maps)) = (&self.group, &self.maps) else {
+            return Err(TechniqueError::not_prepared());
+        };
+        if self.kept_count == 0 {
+            return Ok(());
+        }
+        let mut pass = recorder.compute_pass(MIN_FILTER_PASS);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, group, &[]);
+        let side = maps.2.div_ceil(8);
+        pass.dispatch_workgroups(side, side, self.kept_count);
         Ok(())
     }
 }

@@ -25,13 +25,21 @@ use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::culling::frusta_intersect;
 use zoo_shadow_maps::{DepthState, ShadowMapSet, TRANSLUCENT_FORMAT, TranslucentPass, light_size};
 
-use gpu::{DEBUG_MODE_OFFSET, Passes, Settings, SsssLight, Targets};
+use gpu::{DEBUG_MODE_OFFSET, MinFilter, Passes, Settings, SsssLight, Targets};
 use layers::{Layers, assign_layers};
 
 zoo_host::param_choice! {
     /// Taps of each separable blur pass (the seed's 5, 11 and 23); the kernel always spans
     /// +-2.5 sigma, so more taps sample it more finely rather than widen it.
     pub enum Kernel { Taps5, Taps11, Taps23 }
+}
+
+zoo_host::param_choice! {
+    /// How the penumbra pass finds blockers: a 16-tap search of the shadow map around each
+    /// receiver, averaging the blockers' depths (PCSS), or the nearest depth of the
+    /// min-filtered maps over the search radius (seed 001 §9: fewer, cheaper fetches; the
+    /// nearest blocker rather than the mean, and translucent casters do not count).
+    pub enum Estimate { BlockerSearch, MinFilter }
 }
 
 zoo_host::technique_params! {
@@ -41,6 +49,8 @@ zoo_host::technique_params! {
         map_size: u32 = 1024, range(256, 4096), step(256);
         /// Taps of each blur pass.
         kernel: Kernel = Kernel::Taps11;
+        /// How blockers are found for the penumbra estimate.
+        estimate: Estimate = Estimate::BlockerSearch;
         /// Most screen-space layers; an assignment needing more is refused, naming the lights.
         max_layers: u32 = 64, range(1, 64), step(1);
         /// Scales the estimated penumbra (1: the width the light's size gives).
@@ -93,7 +103,10 @@ struct Gpu {
     data: Option<wgpu::Buffer>,
     /// A white translucency map for scenes without translucent casters.
     placeholder: (wgpu::Texture, wgpu::TextureView),
+    min_filter: MinFilter,
     debug_codes: ChoiceCodes,
+    /// The penumbra shader's value of each `Estimate` (its `ESTIMATE_*` constants).
+    estimate_codes: ChoiceCodes,
 }
 
 impl Gpu {
@@ -111,6 +124,9 @@ impl Gpu {
         let source = ctx.shaders.compose("ssss/debug.wgsl")?.source;
         let debug_codes = ChoiceCodes::read(&source, "DEBUG", &DEBUG_NAMES)
             .map_err(|e| TechniqueError::Other(format!("ssss/debug.wgsl: {e}")))?;
+        let source = ctx.shaders.compose("ssss/penumbra.wgsl")?.source;
+        let estimate_codes = ChoiceCodes::read(&source, "ESTIMATE", Estimate::NAMES)
+            .map_err(|e| TechniqueError::Other(format!("ssss/penumbra.wgsl: {e}")))?;
         Ok(Gpu {
             maps,
             translucent,
@@ -118,7 +134,9 @@ impl Gpu {
             targets: None,
             data: None,
             placeholder: placeholder(ctx.gpu),
+            min_filter: MinFilter::new(ctx)?,
             debug_codes,
+            estimate_codes,
         })
     }
 }
@@ -205,28 +223,29 @@ impl Ssss {
         }
         Ok(layers)
     }
+}
 
-    fn settings(&self, ctx: &RenderContext<'_>) -> Settings {
-        let p = &self.params;
-        let proj = ctx.frame.matrices.proj;
-        Settings {
-            layer_count: self.layers.count.max(1),
-            half_taps: match p.kernel {
-                Kernel::Taps5 => 2,
-                Kernel::Taps11 => 5,
-                Kernel::Taps23 => 11,
-            },
-            translucent: u32::from(has_translucent_casters(ctx.scene)),
-            pixel_scale: proj.y_axis.y * ctx.size.y as f32 * 0.5,
-            depth_threshold: p.depth_threshold,
-            grazing_clamp: p.grazing_clamp,
-            max_sigma: p.max_blur,
-            search_texels: p.search_texels,
-            penumbra_scale: p.penumbra_scale,
-            normal_offset: p.normal_offset,
-            debug_mode: 0,
-            _pad: 0,
-        }
+/// The data buffer's settings for `layer_count` layers; `estimate` is the shader's code for
+/// the blocker estimate.
+fn settings(p: &SsssParams, layer_count: u32, ctx: &RenderContext<'_>, estimate: u32) -> Settings {
+    let proj = ctx.frame.matrices.proj;
+    Settings {
+        layer_count: layer_count.max(1),
+        half_taps: match p.kernel {
+            Kernel::Taps5 => 2,
+            Kernel::Taps11 => 5,
+            Kernel::Taps23 => 11,
+        },
+        translucent: u32::from(has_translucent_casters(ctx.scene)),
+        pixel_scale: proj.y_axis.y * ctx.size.y as f32 * 0.5,
+        depth_threshold: p.depth_threshold,
+        grazing_clamp: p.grazing_clamp,
+        max_sigma: p.max_blur,
+        search_texels: p.search_texels,
+        penumbra_scale: p.penumbra_scale,
+        normal_offset: p.normal_offset,
+        debug_mode: 0,
+        estimate,
     }
 }
 
@@ -249,6 +268,9 @@ impl ShadowTechnique for Ssss {
         if gpu.translucent.is_some() {
             let names = TranslucentPass::pass_names(&gpu.maps, TRANSLUCENT_PASS);
             passes.extend(names.into_iter().map(PassInfo::render));
+        }
+        if self.params.estimate == Estimate::MinFilter && gpu.min_filter.has_work() {
+            passes.push(PassInfo::compute(gpu::MIN_FILTER_PASS));
         }
         passes.extend(
             [
@@ -335,9 +357,11 @@ impl ShadowTechnique for Ssss {
             aspect,
         };
         self.layers = self.layers_for(&request)?;
-        let settings = self.settings(ctx);
-        let p = &self.params;
         let gpu = self.gpu.as_mut().expect("built above");
+        let min_filter = self.params.estimate == Estimate::MinFilter;
+        let code = gpu.estimate_codes.code(self.params.estimate.index());
+        let settings = settings(&self.params, self.layers.count, ctx, code);
+        let p = &self.params;
         let replaced = gpu.maps.prepare(ctx, changes, p.map_size, p.stable_fit);
         let view_proj = ctx.frame.matrices.view_proj;
         if p.cull_maps {
@@ -350,6 +374,9 @@ impl ShadowTechnique for Ssss {
         }
         if let Some(translucent) = &mut gpu.translucent {
             translucent.prepare(ctx, &gpu.maps, replaced);
+        }
+        if min_filter {
+            gpu.min_filter.prepare(ctx, &gpu.maps);
         }
         let translucent = gpu.translucent.is_some();
         let layer_count = settings.layer_count;
@@ -397,8 +424,12 @@ impl ShadowTechnique for Ssss {
         let data = gpu.data.as_ref().expect("created above");
         ctx.gpu.queue.write_buffer(data, 0, &bytes);
         let translucency = gpu::translucency_view(gpu.translucent.as_ref(), &gpu.placeholder.1);
+        let min_maps = match gpu.min_filter.view() {
+            Some(view) if min_filter => view,
+            _ => &gpu.placeholder.1,
+        };
         let targets = gpu.targets.as_ref().expect("created above");
-        gpu.passes.bind(ctx, data, targets, translucency);
+        gpu.passes.bind(ctx, data, targets, translucency, min_maps);
         Ok(())
     }
 
@@ -411,6 +442,9 @@ impl ShadowTechnique for Ssss {
         gpu.maps.record(ctx, recorder, MAP_PASS)?;
         if let Some(translucent) = &gpu.translucent {
             translucent.record(ctx, recorder, &gpu.maps, TRANSLUCENT_PASS)?;
+        }
+        if self.params.estimate == Estimate::MinFilter {
+            gpu.min_filter.record(recorder)?;
         }
         let debug = ctx
             .debug_view
@@ -521,7 +555,7 @@ mod tests {
             penumbra_scale,
             normal_offset,
             debug_mode,
-            _pad
+            estimate
         });
         check_mirror(&source, "Settings", size, &fields, SizeRule::Equal).unwrap();
         let (size, fields) = zoo_host::mirror_fields!(SsssLight {
@@ -535,6 +569,13 @@ mod tests {
             size
         });
         check_mirror(&source, "SsssLight", size, &fields, SizeRule::Equal).unwrap();
+    }
+
+    #[test]
+    fn every_estimate_has_a_distinct_shader_constant() {
+        let source = shader("ssss/penumbra.wgsl");
+        let codes = ChoiceCodes::read(&source, "ESTIMATE", Estimate::NAMES).unwrap();
+        assert_ne!(codes.code(0), codes.code(1));
     }
 
     #[test]

@@ -49,7 +49,18 @@ pub fn run_configuration(
     mut tick: impl FnMut(),
 ) -> anyhow::Result<ConfigResult> {
     let base = plan.scene_path.parent().unwrap_or(Path::new("."));
-    let description = plan.description.with_tessellation(config.tessellation);
+    let mut description = plan.description.with_tessellation(config.tessellation);
+    if let Some(n) = config.lights {
+        if n > description.lights.len() {
+            anyhow::bail!(
+                "{}: scene.lights={n} but the scene has {} lights",
+                plan.scene_path.display(),
+                description.lights.len()
+            );
+        }
+        description.lights.truncate(n);
+        description.paths.lights.retain(|path| path.light < n);
+    }
     let scene = Scene::from_description(&description, &plan.scene_path, base)?;
     let triangles = scene.triangle_count();
     let occluders = plan.flicker.then(|| Occluders::new(&scene));

@@ -17,6 +17,8 @@ pub enum SweepKey {
     Size,
     /// Procedural tessellation factor (`scene.tessellation=0.5,1,2`).
     Tessellation,
+    /// The scene's first N lights (`scene.lights=1,4,16`), for costs per added light.
+    Lights,
     /// A technique parameter (`sm-pcf.map_size=512,1024`).
     Param { technique: String, key: String },
 }
@@ -50,6 +52,18 @@ pub fn parse_sweep(key: &str, values: &[String]) -> anyhow::Result<Sweep> {
             }
             SweepKey::Tessellation
         }
+        "scene.lights" => {
+            for v in values {
+                match v.parse::<usize>() {
+                    Ok(n) if (1..=zoo_host::MAX_LIGHTS).contains(&n) => {}
+                    _ => bail!(
+                        "--sweep scene.lights: `{v}` is not a light count in 1..={}",
+                        zoo_host::MAX_LIGHTS
+                    ),
+                }
+            }
+            SweepKey::Lights
+        }
         other => match other.split_once('.') {
             Some((technique, param)) => {
                 let registration = zoo_host::find_technique(technique)?;
@@ -64,7 +78,9 @@ pub fn parse_sweep(key: &str, values: &[String]) -> anyhow::Result<Sweep> {
                     key: param.to_string(),
                 }
             }
-            None => bail!("--sweep {other}: expected size, scene.tessellation or TECHNIQUE.PARAM"),
+            None => bail!(
+                "--sweep {other}: expected size, scene.tessellation, scene.lights or TECHNIQUE.PARAM"
+            ),
         },
     };
     Ok(Sweep {
@@ -100,6 +116,8 @@ pub struct Configuration {
     pub swept: Vec<(String, String)>,
     pub size: zoo_host::glam::UVec2,
     pub tessellation: f32,
+    /// Only the scene's first lights, when swept.
+    pub lights: Option<usize>,
 }
 
 impl Configuration {
@@ -113,9 +131,15 @@ impl Configuration {
         }
     }
 
-    /// Swept values that apply to every technique (size, tessellation).
+    /// Swept values that apply to every technique (size, tessellation, light count).
     pub(super) fn common_key(&self) -> String {
-        format!("{}x{}@{}", self.size.x, self.size.y, self.tessellation)
+        let lights = self
+            .lights
+            .map_or(String::new(), |n| format!(" {n} lights"));
+        format!(
+            "{}x{}@{}{lights}",
+            self.size.x, self.size.y, self.tessellation
+        )
     }
 }
 
@@ -141,6 +165,7 @@ pub fn expand(plan: &BenchPlan) -> anyhow::Result<Vec<Configuration>> {
             swept: Vec::new(),
             size: plan.size,
             tessellation: 1.0,
+            lights: None,
         }];
         for sweep in &plan.sweeps {
             if let SweepKey::Param { technique: t, .. } = &sweep.key
@@ -157,6 +182,7 @@ pub fn expand(plan: &BenchPlan) -> anyhow::Result<Vec<Configuration>> {
                             c.size = parse_size(value).map_err(|e| anyhow::anyhow!(e))?
                         }
                         SweepKey::Tessellation => c.tessellation = value.parse()?,
+                        SweepKey::Lights => c.lights = Some(value.parse()?),
                         SweepKey::Param { key, .. } => {
                             params::apply_assignments(
                                 &schema,

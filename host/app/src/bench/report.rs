@@ -190,6 +190,52 @@ pub fn suite_ratios(
     out
 }
 
+/// For configurations swept over `scene.lights`: (run, configuration without the light
+/// count, light counts, least-squares slope of the frame median in ms per light).
+pub fn per_light_costs(results: &[ConfigResult]) -> Vec<(String, String, String, f64)> {
+    /// (run, configuration, (light count, frame median) points).
+    type Group = (String, String, Vec<(f64, f64)>);
+    let mut groups: Vec<Group> = Vec::new();
+    for r in results {
+        let Some(n) = r.config.lights else { continue };
+        let mut config = r.config.clone();
+        config.swept.retain(|(k, _)| k != "scene.lights");
+        let key = format!(
+            "{} {}x{}@{}",
+            config.label(),
+            config.size.x,
+            config.size.y,
+            config.tessellation
+        );
+        let point = (n as f64, r.frame_gpu.median);
+        match groups
+            .iter_mut()
+            .find(|(run, k, _)| *run == r.config.run && *k == key)
+        {
+            Some((_, _, points)) => points.push(point),
+            None => groups.push((r.config.run.clone(), key, vec![point])),
+        }
+    }
+    groups
+        .into_iter()
+        .filter(|(_, _, points)| points.len() >= 2)
+        .map(|(run, key, points)| {
+            let count = points.len() as f64;
+            let mean_x = points.iter().map(|p| p.0).sum::<f64>() / count;
+            let mean_y = points.iter().map(|p| p.1).sum::<f64>() / count;
+            let sxy: f64 = points.iter().map(|p| (p.0 - mean_x) * (p.1 - mean_y)).sum();
+            let sxx: f64 = points.iter().map(|p| (p.0 - mean_x).powi(2)).sum();
+            let lights: Vec<String> = points.iter().map(|p| p.0.to_string()).collect();
+            (
+                run,
+                key,
+                lights.join(", "),
+                sxy / sxx.max(f64::MIN_POSITIVE),
+            )
+        })
+        .collect()
+}
+
 /// `bench.md`: readable tables with the environment, ratios and flicker.
 pub fn bench_md(
     plans: &[BenchPlan],
@@ -255,6 +301,18 @@ pub fn bench_md(
             ratio_to_baseline(results, r).map_or("–".into(), |x| format!("{x:.2}")),
             r.flicker.map_or("–".into(), |x| format!("{x:.5}")),
         );
+    }
+    let slopes = per_light_costs(results);
+    if !slopes.is_empty() {
+        let _ = writeln!(
+            w,
+            "\n## Cost per added light\n\nLeast-squares slope of the frame median over the `scene.lights` sweep.\n"
+        );
+        let _ = writeln!(w, "| run | configuration | lights | ms per added light |");
+        let _ = writeln!(w, "|---|---|---|---|");
+        for (run, label, lights, slope) in slopes {
+            let _ = writeln!(w, "| {run} | {label} | {lights} | {slope:.3} |");
+        }
     }
     if let Some(s) = suite {
         let ratios = suite_ratios(s, results);

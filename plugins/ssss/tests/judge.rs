@@ -1,0 +1,183 @@
+//! Layered screen-space soft shadows against the reference judge, with the bounds of the SSSS
+//! issue: the area reference within a mean absolute error of 0.06 per light on many lights and
+//! on one large light, the hard reference's core bounds once the lights shrink to points,
+//! coloured shadows behind translucent casters, and 256 lights rendered with every pass timed.
+
+use zoo_plugin_ssss as _;
+
+use zoo_host::glam::{UVec2, Vec3};
+use zoo_host::gpu::PassOwner;
+use zoo_host::test_support::{JudgeRun, Metric, gpu, judge, judge_scene, scene_path};
+use zoo_host::{Renderer, View};
+
+const SIZE: UVec2 = UVec2::new(256, 256);
+
+fn assert_mae(run: &JudgeRun, bound: f64) {
+    for light in 0..run.loaded.lights.len() {
+        let m = run.metrics(light);
+        eprintln!("{} light {light}: mae {:.4} {m:?}", run.scene, m.mae);
+        run.assert_bounds(light, &m, &[(Metric::Mae, bound)]);
+    }
+}
+
+#[test]
+fn many_lights_agree_with_the_area_reference() {
+    let run = judge("many-lights.ron", "ssss", &[], SIZE);
+    assert_mae(&run, 0.06);
+    // Lights overlap heavily here: far more lights than layers, none merged.
+    assert!(run.judged.slot_count >= 8 && run.judged.slot_count < 64);
+}
+
+#[test]
+fn one_large_light_agrees_with_the_area_reference() {
+    let run = judge("soft.ron", "ssss", &[], SIZE);
+    assert_mae(&run, 0.06);
+}
+
+#[test]
+fn the_min_filter_estimate_agrees_with_the_area_reference() {
+    for scene in ["soft.ron", "many-lights.ron"] {
+        let run = judge(scene, "ssss", &[("estimate", "MinFilter")], SIZE);
+        assert_mae(&run, 0.06);
+        let pass = "SSSS min filter";
+        assert!(
+            run.judged
+                .timings
+                .technique_pass_names()
+                .iter()
+                .any(|n| n == pass)
+        );
+    }
+}
+
+/// Mean |visibility - hard reference| over contributing pixels.
+fn hard_error(run: &JudgeRun) -> f64 {
+    let reference = &run.reference.lights[0];
+    let v = &run.judged.visibility[0];
+    let pixels: Vec<usize> = (0..v.len())
+        .filter(|&i| reference.contributing[i])
+        .collect();
+    pixels
+        .iter()
+        .map(|&i| (v[i] - reference.hard[i]).abs() as f64)
+        .sum::<f64>()
+        / pixels.len() as f64
+}
+
+#[test]
+fn shrinking_the_light_converges_to_the_hard_reference() {
+    let scene = zoo_host::Scene::load(&scene_path("soft.ron")).unwrap();
+    let mut errors = Vec::new();
+    for radius in [0.45, 0.15, 0.05, 0.0] {
+        let mut shrunk = scene.clone();
+        shrunk.lights[0].radius = radius;
+        let run = judge_scene(shrunk, "ssss", &[], SIZE);
+        let error = hard_error(&run);
+        eprintln!("radius {radius}: mean error against the hard reference {error:.4}");
+        errors.push(error);
+        if radius == 0.0 {
+            // A point light: no penumbra, no blur, and the core bounds of sm-pcf.
+            let m = run.metrics(0);
+            run.assert_bounds(
+                0,
+                &m,
+                &[
+                    (Metric::FalseShadowCore, 0.005),
+                    (Metric::FalseLitCore, 0.01),
+                ],
+            );
+        }
+    }
+    for pair in errors.windows(2) {
+        assert!(pair[1] <= pair[0] + 0.001, "not converging: {errors:?}");
+    }
+    assert!(errors[3] < 0.25 * errors[0], "{errors:?}");
+}
+
+#[test]
+fn translucent_casters_cast_coloured_shadows_where_the_reference_does() {
+    let run = judge("translucent.ron", "ssss", &[], SIZE);
+    assert_mae(&run, 0.06);
+    let reference = run.reference.lights[0]
+        .color
+        .as_ref()
+        .expect("translucent casters");
+    let visibility = &run.judged.visibility[0];
+    let transmittance = run.judged.transmittance[0]
+        .as_ref()
+        .expect("ssss writes colour");
+    let contributing = &run.reference.lights[0].contributing;
+    // The light that arrives per pixel: visibility times the colour it keeps.
+    let arrived = |i: usize| {
+        let mean = (transmittance[i].x + transmittance[i].y + transmittance[i].z) / 3.0;
+        transmittance[i] * (visibility[i] / mean.max(1e-3))
+    };
+    let check = |name: &str, tinted: &dyn Fn(Vec3) -> bool| {
+        let pixels: Vec<usize> = (0..reference.len())
+            .filter(|&i| contributing[i] && tinted(reference[i]))
+            .collect();
+        assert!(
+            pixels.len() > 200,
+            "{name}: {} pixels in view",
+            pixels.len()
+        );
+        let agreeing = pixels
+            .iter()
+            .filter(|&&i| {
+                tinted(arrived(i)) && (arrived(i) - reference[i]).abs().max_element() < 0.15
+            })
+            .count();
+        let fraction = agreeing as f64 / pixels.len() as f64;
+        eprintln!("{name}: {} pixels, {fraction:.3} agree", pixels.len());
+        assert!(
+            fraction > 0.9,
+            "{name}: only {fraction:.3} of the pixels agree"
+        );
+    };
+    // The red pole lets (0.5, 0.06, 0.04) through, the blue pane (0.12, 0.33, 0.6).
+    check("red shadow", &|c: Vec3| {
+        c.x > 0.3 && c.x > 4.0 * c.y && c.x > 4.0 * c.z
+    });
+    check("blue shadow", &|c: Vec3| {
+        c.z > 0.4 && c.z > 1.5 * c.y && c.z > 3.0 * c.x
+    });
+}
+
+#[test]
+fn two_hundred_and_fifty_six_lights_render_with_every_pass_timed() {
+    let scene = zoo_host::Scene::load(&scene_path("lights-256.ron")).unwrap();
+    assert_eq!(scene.lights.len(), 256);
+    let mut renderer = Renderer::new(gpu(), scene, UVec2::new(160, 128)).unwrap();
+    renderer.set_technique("ssss", &Default::default()).unwrap();
+    renderer.render(&View::Final).unwrap();
+    let timings = renderer.render(&View::Final).unwrap();
+    let declared = renderer.technique_instance().passes();
+    let recorded = timings.technique_pass_names();
+    let names: Vec<String> = declared.iter().map(|p| p.name.clone()).collect();
+    assert_eq!(recorded, names, "passes() names what is recorded");
+    assert!(recorded.len() > 1024, "{} passes", recorded.len());
+    let technique: Vec<_> = timings
+        .passes
+        .iter()
+        .filter(|p| p.owner == PassOwner::Technique)
+        .collect();
+    let timed = technique.iter().filter(|p| p.milliseconds > 0.0).count();
+    eprintln!(
+        "lights-256: {} technique passes, {timed} timed non-zero, technique {:.1} ms, frame {:.1} ms",
+        technique.len(),
+        timings.total(PassOwner::Technique),
+        timings.frame_total()
+    );
+    assert!(timed as f64 > 0.95 * technique.len() as f64);
+    // Lights shadow something: some light's visibility drops below 1.
+    let shadowed = (0..256).any(|i| renderer.read_visibility(i).iter().any(|v| *v < 0.5));
+    assert!(shadowed);
+    let counters = renderer.wait_for_counters();
+    eprintln!("{counters:?}");
+    let layers = counters
+        .iter()
+        .find(|(n, _)| n == "screen-space layers")
+        .map(|(_, v)| *v)
+        .unwrap();
+    assert!((2.0..=64.0).contains(&layers), "{layers} layers");
+}
