@@ -3,8 +3,8 @@
 // of array layer `l / 4` in the float targets, and bit `l % 32` of array layer `l / 32` in
 // the bit targets (occluded bits; the tinted bits follow in as many layers again).
 
-// Largest layer count the passes handle (the private arrays below are sized by it).
-const MAX_LAYERS: u32 = 64u;
+// Largest layer count the passes handle (64, the plugin's `max_layers` cap): the private
+// arrays of the penumbra pass hold this many groups of four and words of 32.
 const MAX_GROUPS: u32 = 16u;
 const MAX_WORDS: u32 = 2u;
 
@@ -33,6 +33,12 @@ struct Settings {
     debug_mode: u32,
     // How blockers are found (`ESTIMATE_*` in `ssss/penumbra.wgsl`).
     estimate: u32,
+    // 1 when the blur runs at half resolution (its grid pixel covers 2 x 2 screen pixels).
+    half_resolution: u32,
+    // To 64 bytes, where the light array starts (its 16-byte alignment).
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // One scene light's maps and layer (indexed like the scene's lights).
@@ -50,6 +56,14 @@ struct SsssLight {
     texel_scale: f32,
     // Radius (point, spot) or tangent of the angular radius (directional).
     size: f32,
+    // Screen rectangle its influence can reach: x, y, width, height in pixels.
+    scissor: vec4<u32>,
+    // Bit k set when its layer first_layer + k was rendered this frame (culled layers hold
+    // stale depths and are never read).
+    kept_faces: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct SsssData {
@@ -58,6 +72,17 @@ struct SsssData {
 }
 
 @group(2) @binding(0) var<storage, read> data: SsssData;
+
+// Screen pixels per blur-grid pixel along each side.
+fn grid_step() -> i32 {
+    return select(1, 2, data.settings.half_resolution == 1u);
+}
+
+// The blur grid: the screen, or half of it (rounded up).
+fn grid_size() -> vec2<i32> {
+    let step = grid_step();
+    return (vec2<i32>(camera.size) + vec2<i32>(step - 1)) / step;
+}
 
 fn group_of(layer: u32) -> u32 {
     return layer / 4u;

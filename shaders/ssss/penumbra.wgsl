@@ -76,7 +76,9 @@ fn shadow_tap(p: vec3<f32>, linear: bool) -> f32 {
 // (inside, receiver depth, nearest blocker depth: opaque or translucent), along the map axis.
 fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
     let m = project(p);
-    if !m.inside {
+    // Taps in a culled cube face read nothing (no receiver, no blocker).
+    let kept = (current.kept_faces >> (m.layer - current.first_layer)) & 1u;
+    if !m.inside || kept == 0u {
         return vec3<f32>(0.0);
     }
     let stored = min(linear_depth(stored_map_depth(m)), translucent_depth(m, p));
@@ -158,8 +160,42 @@ fn width_by_min_filter(m: MapPoint, receiver: f32, texel: f32) -> f32 {
     return width_for(receiver, blocker);
 }
 
+// Lights whose screen rectangle meets this workgroup's 8 x 8 tile (tiled light culling). When
+// more meet it than the list holds, every light is visited.
+const TILE_LIGHTS: u32 = 256u;
+var<workgroup> tile_lights: array<u32, TILE_LIGHTS>;
+var<workgroup> tile_count: atomic<u32>;
+
+// Lists the shadowed lights whose screen rectangle meets the tile at `origin` (all invocations
+// of the workgroup call it). Returns how many, or more than TILE_LIGHTS when they overflow.
+fn cull_lights(origin: vec2<u32>, index: u32) -> u32 {
+    if index == 0u {
+        atomicStore(&tile_count, 0u);
+    }
+    workgroupBarrier();
+    for (var i = index; i < arrayLength(&data.lights); i += 64u) {
+        let r = data.lights[i].scissor;
+        let meets = r.z > 0u && r.w > 0u && r.x < origin.x + 8u && origin.x < r.x + r.z
+            && r.y < origin.y + 8u && origin.y < r.y + r.w;
+        if data.lights[i].layer_count != 0u && meets {
+            let k = atomicAdd(&tile_count, 1u);
+            if k < TILE_LIGHTS {
+                tile_lights[k] = i;
+            }
+        }
+    }
+    return workgroupUniformLoad(&tile_count);
+}
+
 @compute @workgroup_size(8, 8)
-fn cs_penumbra(@builtin(global_invocation_id) id: vec3<u32>) {
+fn cs_penumbra(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) index: u32,
+    @builtin(workgroup_id) tile: vec3<u32>,
+) {
+    let listed = cull_lights(tile.xy * 8u, index);
+    let visit_all = listed > TILE_LIGHTS;
+    let visits = select(listed, arrayLength(&data.lights), visit_all);
     let size = vec2<u32>(camera.size);
     if id.x >= size.x || id.y >= size.y {
         return;
@@ -180,7 +216,8 @@ fn cs_penumbra(@builtin(global_invocation_id) id: vec3<u32>) {
         let to_pixels = settings.pixel_scale / view_depth
             * sqrt(max(view_normal.z, settings.grazing_clamp));
         let r = rotation(vec2<f32>(pixel));
-        for (var i = 0u; i < arrayLength(&data.lights); i++) {
+        for (var k = 0u; k < visits; k++) {
+            let i = select(tile_lights[k], k, visit_all);
             let sl = data.lights[i];
             if sl.layer_count == 0u {
                 continue;

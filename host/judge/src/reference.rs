@@ -174,10 +174,18 @@ pub fn reference_visibility(
             _ => (false, Vec3::ONE, Vec3::ONE),
         })
         .collect();
+    // Without translucent casters every channel is the same: keep it exactly.
+    let scalar = |c: Vec3| {
+        if occluders.has_translucent() {
+            mean(c)
+        } else {
+            c.x
+        }
+    };
     LightReference {
         contributing: results.iter().map(|r| r.0).collect(),
-        hard: results.iter().map(|r| mean(r.1)).collect(),
-        area: results.iter().map(|r| mean(r.2)).collect(),
+        hard: results.iter().map(|r| scalar(r.1)).collect(),
+        area: results.iter().map(|r| scalar(r.2)).collect(),
         color: occluders
             .has_translucent()
             .then(|| results.iter().map(|r| r.2).collect()),

@@ -382,6 +382,11 @@ impl Scene {
         self.mesh.triangle_count()
     }
 
+    /// Whether any shadow caster is translucent (opacity below 1).
+    pub fn has_translucent_casters(&self) -> bool {
+        self.objects.iter().any(|o| o.transmittance().is_some())
+    }
+
     /// World-space bounds of all geometry.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         mesh::bounds(&self.mesh.positions).unwrap_or((Vec3::ZERO, Vec3::ZERO))

@@ -145,13 +145,9 @@ impl TranslucentPass {
         self.maps.as_ref()
     }
 
-    /// The passes [`Self::record`] records: one per layer `set` renders.
-    pub fn pass_names(set: &ShadowMapSet, base: &str) -> Vec<String> {
-        set.pass_names(base)
-    }
-
     /// Draws the translucent casters into every layer `set` renders (after the set's depth
-    /// passes), one pass each named by [`layer_pass_name`] with `base`.
+    /// passes), one pass each named by [`layer_pass_name`] with `base`, as
+    /// `set.pass_names(base)` lists them.
     pub fn record(
         &self,
         ctx: &RenderContext<'_>,

@@ -24,6 +24,8 @@ pub struct Settings {
     pub normal_offset: f32,
     pub debug_mode: u32,
     pub estimate: u32,
+    pub half_resolution: u32,
+    pub _pad: [u32; 3],
 }
 
 /// `SsssLight` in `ssss/data.wgsl`.
@@ -39,6 +41,9 @@ pub struct SsssLight {
     pub far: f32,
     pub texel_scale: f32,
     pub size: f32,
+    pub scissor: [u32; 4],
+    pub kept_faces: u32,
+    pub _pad: [u32; 3],
 }
 
 /// Byte offset of `debug_mode` in the data buffer.
@@ -94,36 +99,66 @@ pub struct Targets {
     pub size: UVec2,
     pub layer_count: u32,
     pub translucent: bool,
+    pub half_resolution: bool,
     /// Blur sigma in pixels, four layers per texel.
     pub penumbra: Layered,
     /// Occluded then tinted bits, 32 layers per texel.
     pub bits: Layered,
     /// Tint colour per layer (translucent scenes; one dummy layer otherwise).
     pub tints: Layered,
-    /// First blur pass: occlusion, four layers per texel.
-    pub occlusion: Layered,
-    /// First blur pass: colour that arrives per layer (translucent scenes).
-    pub light: Layered,
+    /// Each blur pass's output on the blur grid: occlusion, four layers per texel, and the
+    /// colour that arrives per layer (translucent scenes).
+    pub blurred: [(Layered, Layered); 2],
     /// Debug views.
     pub debug: (wgpu::Texture, wgpu::TextureView),
 }
 
 impl Targets {
-    pub fn new(gpu: &GpuContext, size: UVec2, layer_count: u32, translucent: bool) -> Targets {
+    /// Targets for `layer_count` layers at output `size`, with colour layers when
+    /// `translucent` and the blur grid at half size when `half_resolution`.
+    pub fn new(
+        gpu: &GpuContext,
+        size: UVec2,
+        layer_count: u32,
+        translucent: bool,
+        half_resolution: bool,
+    ) -> Targets {
         let groups = layer_count.div_ceil(4);
         let words = layer_count.div_ceil(32);
         let colored = if translucent { layer_count } else { 1 };
+        let grid = if half_resolution {
+            size.map(|side| side.div_ceil(2))
+        } else {
+            size
+        };
         use wgpu::TextureFormat as F;
-        let layered = |label, layers, format| Layered::new(gpu, label, size, layers, format);
+        let layered =
+            |label: &str, size, layers, format| Layered::new(gpu, label, size, layers, format);
+        let blurred = |pass| {
+            (
+                layered(
+                    &format!("ssss blurred occlusion {pass}"),
+                    grid,
+                    groups,
+                    F::Rgba16Float,
+                ),
+                layered(
+                    &format!("ssss blurred light {pass}"),
+                    grid,
+                    colored,
+                    F::Rgba16Float,
+                ),
+            )
+        };
         Targets {
             size,
             layer_count,
             translucent,
-            penumbra: layered("ssss penumbra", groups, F::Rgba16Float),
-            bits: layered("ssss hard shadow bits", 2 * words, F::R32Uint),
-            tints: layered("ssss tints", colored, F::Rgba16Float),
-            occlusion: layered("ssss blurred occlusion", groups, F::Rgba16Float),
-            light: layered("ssss blurred light", colored, F::Rgba16Float),
+            half_resolution,
+            penumbra: layered("ssss penumbra", size, groups, F::Rgba16Float),
+            bits: layered("ssss hard shadow bits", size, 2 * words, F::R32Uint),
+            tints: layered("ssss tints", size, colored, F::Rgba16Float),
+            blurred: [blurred(1), blurred(2)],
             debug: zoo_host::gpu::render_target(
                 &gpu.device,
                 "ssss debug view",
@@ -135,9 +170,10 @@ impl Targets {
     }
 
     /// Whether these targets serve `layer_count` layers at `size`.
-    pub fn fit(&self, size: UVec2, layer_count: u32, translucent: bool) -> bool {
+    pub fn fit(&self, size: UVec2, layer_count: u32, translucent: bool, half: bool) -> bool {
         self.size == size
             && self.translucent == translucent
+            && self.half_resolution == half
             && self.layer_count.div_ceil(4) == layer_count.div_ceil(4)
             && (!translucent || self.layer_count == layer_count)
             && self.layer_count.div_ceil(32) == layer_count.div_ceil(32)
@@ -177,13 +213,14 @@ impl ComputeStage {
     }
 }
 
-/// The four compute passes and their current bind groups.
+/// The compute passes after the maps and their current bind groups.
 pub struct Passes {
     penumbra: ComputeStage,
     blur_first: ComputeStage,
     blur_second: ComputeStage,
+    resolve: ComputeStage,
     debug: ComputeStage,
-    groups: Option<[wgpu::BindGroup; 4]>,
+    groups: Option<[wgpu::BindGroup; 5]>,
 }
 
 /// Entries of the group every pass starts with: the data buffer.
@@ -221,13 +258,20 @@ const FLOAT: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterab
 const UINT: wgpu::TextureSampleType = wgpu::TextureSampleType::Uint;
 const ARRAY: wgpu::TextureViewDimension = wgpu::TextureViewDimension::D2Array;
 
-/// Pass names, in recording order after the map passes.
+/// The penumbra pass: hard shadows, penumbra sizes and tints of every light.
 pub const PENUMBRA_PASS: &str = "SSSS penumbra";
+/// The first separable blur pass.
 pub const BLUR_FIRST_PASS: &str = "SSSS blur 1";
+/// The second separable blur pass.
 pub const BLUR_SECOND_PASS: &str = "SSSS blur 2";
+/// The pass that writes the host's visibility and transmittance slots.
+pub const RESOLVE_PASS: &str = "SSSS resolve";
+/// The debug-view pass, recorded only while one of its views is shown.
 pub const DEBUG_PASS: &str = "SSSS debug view";
 
 impl Passes {
+    /// Builds every pass's pipeline; the penumbra pass reads `maps` through their lookup
+    /// group.
     pub fn new(ctx: &RenderContext<'_>, maps: &ShadowMapSet) -> TechniqueResult<Passes> {
         use wgpu::TextureFormat as F;
         let rgba16 = F::Rgba16Float;
@@ -275,7 +319,24 @@ impl Passes {
             "ssss/blur_second.wgsl",
             "cs_blur_second",
             [FLOAT, FLOAT],
-            F::Rgba8Unorm,
+            rgba16,
+        )?;
+        let resolve = ComputeStage::new(
+            ctx,
+            "ssss resolve",
+            "ssss/resolve.wgsl",
+            "cs_resolve",
+            &[
+                data_entry(),
+                sampled(1, FLOAT),
+                sampled(2, UINT),
+                sampled(3, FLOAT),
+                sampled(4, FLOAT),
+                sampled(5, FLOAT),
+                storage_texture(6, F::Rgba8Unorm, ARRAY),
+                storage_texture(7, F::Rgba8Unorm, ARRAY),
+            ],
+            &[],
         )?;
         let debug = ComputeStage::new(
             ctx,
@@ -296,6 +357,7 @@ impl Passes {
             penumbra,
             blur_first,
             blur_second,
+            resolve,
             debug,
             groups: None,
         })
@@ -327,6 +389,7 @@ impl Passes {
                 view(min_maps),
             ],
         );
+        let [(occlusion_1, light_1), (occlusion_2, light_2)] = &t.blurred;
         let blur_first = bind_group(
             device,
             "ssss blur 1 group",
@@ -336,8 +399,8 @@ impl Passes {
                 view(&t.penumbra.view),
                 view(&t.bits.view),
                 view(&t.tints.view),
-                view(&t.occlusion.view),
-                view(&t.light.view),
+                view(&occlusion_1.view),
+                view(&light_1.view),
             ],
         );
         let blur_second = bind_group(
@@ -347,8 +410,23 @@ impl Passes {
             &[
                 data.clone(),
                 view(&t.penumbra.view),
-                view(&t.occlusion.view),
-                view(&t.light.view),
+                view(&occlusion_1.view),
+                view(&light_1.view),
+                view(&occlusion_2.view),
+                view(&light_2.view),
+            ],
+        );
+        let resolve = bind_group(
+            device,
+            "ssss resolve group",
+            &self.resolve.layout,
+            &[
+                data.clone(),
+                view(&t.penumbra.view),
+                view(&t.bits.view),
+                view(&t.tints.view),
+                view(&occlusion_2.view),
+                view(&light_2.view),
                 view(&ctx.visibility.array_view),
                 view(&ctx.transmittance.array_view),
             ],
@@ -366,29 +444,37 @@ impl Passes {
                 view(&t.debug.1),
             ],
         );
-        self.groups = Some([penumbra, blur_first, blur_second, debug]);
+        self.groups = Some([penumbra, blur_first, blur_second, resolve, debug]);
     }
 
-    /// Records the penumbra pass and both blur passes, and the debug pass when `debug`.
+    /// Records the penumbra pass, both blur passes (on the half-resolution grid when
+    /// `half_resolution`) and the resolve pass, and the debug pass when `debug`.
     pub fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         maps: &ShadowMapSet,
+        half_resolution: bool,
         debug: bool,
     ) -> TechniqueResult {
         let (Some(groups), Some(lookup)) = (&self.groups, maps.lookup_group()) else {
             return Err(TechniqueError::not_prepared());
         };
-        let workgroups = ctx.size.map(|side| side.div_ceil(8));
+        let full = ctx.size.map(|side| side.div_ceil(8));
+        let grid = if half_resolution {
+            ctx.size.map(|side| side.div_ceil(2).div_ceil(8))
+        } else {
+            full
+        };
         let stages = [
-            (PENUMBRA_PASS, &self.penumbra, Some(lookup)),
-            (BLUR_FIRST_PASS, &self.blur_first, None),
-            (BLUR_SECOND_PASS, &self.blur_second, None),
-            (DEBUG_PASS, &self.debug, None),
+            (PENUMBRA_PASS, &self.penumbra, Some(lookup), full),
+            (BLUR_FIRST_PASS, &self.blur_first, None, grid),
+            (BLUR_SECOND_PASS, &self.blur_second, None, grid),
+            (RESOLVE_PASS, &self.resolve, None, full),
+            (DEBUG_PASS, &self.debug, None, full),
         ];
-        for (k, (name, stage, lookup)) in stages.into_iter().enumerate() {
-            if k == 3 && !debug {
+        for (k, (name, stage, lookup, workgroups)) in stages.into_iter().enumerate() {
+            if name == DEBUG_PASS && !debug {
                 break;
             }
             let mut pass = recorder.compute_pass(name);
@@ -419,9 +505,11 @@ pub struct MinFilter {
 
 /// Full-resolution texels per min-map texel along each side (`MIN_BLOCK` in the shader).
 pub const MIN_BLOCK: u32 = 8;
+/// The pass that fills the min-filtered maps.
 pub const MIN_FILTER_PASS: &str = "SSSS min filter";
 
 impl MinFilter {
+    /// Builds the reduction pipeline.
     pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<MinFilter> {
         let device = &ctx.gpu.device;
         let module = ctx.shaders.create_module(device, "ssss/min_depth.wgsl")?;

@@ -73,10 +73,12 @@ pub fn intersection_bound(a: (Vec3, f32), b: (Vec3, f32)) -> Option<(Vec3, f32)>
     Some((ca + (cb - ca) / d * along, radius))
 }
 
-/// The layer of each light (`None`: culled, its influence is off screen) and the layer count.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// The layer of each light and the layer count.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Layers {
+    /// Per scene light: its layer, or `None` when it is culled (its influence is off screen).
     pub of_light: Vec<Option<u32>>,
+    /// Layers in use.
     pub count: u32,
 }
 

@@ -51,6 +51,10 @@ zoo_host::technique_params! {
         kernel: Kernel = Kernel::Taps11;
         /// How blockers are found for the penumbra estimate.
         estimate: Estimate = Estimate::BlockerSearch;
+        /// Blur on a half-resolution grid (each grid pixel the mean of a 2 x 2 block of the
+        /// full-resolution hard shadows), upsampled with depth-aware weights; pixels without
+        /// penumbra keep their full-resolution hard result.
+        half_resolution: bool = true;
         /// Most screen-space layers; an assignment needing more is refused, naming the lights.
         max_layers: u32 = 64, range(1, 64), step(1);
         /// Scales the estimated penumbra (1: the width the light's size gives).
@@ -89,11 +93,6 @@ const DEBUG_VIEWS: [&str; 5] = [
 ];
 const DEBUG_NAMES: [&str; 5] = ["Layers", "Penumbra", "Hard", "Blurred", "Translucency"];
 
-/// Whether any shadow caster of `scene` is translucent.
-fn has_translucent_casters(scene: &Scene) -> bool {
-    scene.objects.iter().any(|o| o.transmittance().is_some())
-}
-
 /// Maps, passes and targets, built at the first `prepare`.
 struct Gpu {
     maps: ShadowMapSet,
@@ -117,7 +116,9 @@ impl Gpu {
             ..DepthState::default()
         };
         let maps = ShadowMapSet::new(ctx, "ssss shadow maps", state, None)?;
-        let translucent = has_translucent_casters(ctx.scene)
+        let translucent = ctx
+            .scene
+            .has_translucent_casters()
             .then(|| TranslucentPass::new(ctx, "ssss translucency"))
             .transpose()?;
         let passes = Passes::new(ctx, &maps)?;
@@ -200,6 +201,8 @@ pub struct Ssss {
     gpu: Option<Gpu>,
     /// The layers of the current lights and camera (as assigned to the visibility slots).
     layers: Layers,
+    /// Whether the last frame drew a debug view (its pass is then among the passes).
+    debug_drawn: bool,
 }
 
 impl Ssss {
@@ -236,7 +239,7 @@ fn settings(p: &SsssParams, layer_count: u32, ctx: &RenderContext<'_>, estimate:
             Kernel::Taps11 => 5,
             Kernel::Taps23 => 11,
         },
-        translucent: u32::from(has_translucent_casters(ctx.scene)),
+        translucent: u32::from(ctx.scene.has_translucent_casters()),
         pixel_scale: proj.y_axis.y * ctx.size.y as f32 * 0.5,
         depth_threshold: p.depth_threshold,
         grazing_clamp: p.grazing_clamp,
@@ -246,6 +249,8 @@ fn settings(p: &SsssParams, layer_count: u32, ctx: &RenderContext<'_>, estimate:
         normal_offset: p.normal_offset,
         debug_mode: 0,
         estimate,
+        half_resolution: u32::from(p.half_resolution),
+        _pad: [0; 3],
     }
 }
 
@@ -266,7 +271,7 @@ impl ShadowTechnique for Ssss {
             .map(PassInfo::render)
             .collect();
         if gpu.translucent.is_some() {
-            let names = TranslucentPass::pass_names(&gpu.maps, TRANSLUCENT_PASS);
+            let names = gpu.maps.pass_names(TRANSLUCENT_PASS);
             passes.extend(names.into_iter().map(PassInfo::render));
         }
         if self.params.estimate == Estimate::MinFilter && gpu.min_filter.has_work() {
@@ -277,9 +282,13 @@ impl ShadowTechnique for Ssss {
                 gpu::PENUMBRA_PASS,
                 gpu::BLUR_FIRST_PASS,
                 gpu::BLUR_SECOND_PASS,
+                gpu::RESOLVE_PASS,
             ]
             .map(PassInfo::compute),
         );
+        if self.debug_drawn {
+            passes.push(PassInfo::compute(gpu::DEBUG_PASS));
+        }
         passes
     }
 
@@ -299,8 +308,11 @@ impl ShadowTechnique for Ssss {
             ));
         }
         if let Some(t) = &gpu.targets {
-            for name in DEBUG_VIEWS {
-                out.push(ResourceInfo::texture(name, &t.debug.0, true));
+            // One image serves every debug view: count its memory once.
+            for (k, name) in DEBUG_VIEWS.into_iter().enumerate() {
+                let mut info = ResourceInfo::texture(name, &t.debug.0, true);
+                info.bytes *= u64::from(k == 0);
+                out.push(info);
             }
             out.push(ResourceInfo::texture(
                 "layered penumbra",
@@ -317,16 +329,13 @@ impl ShadowTechnique for Ssss {
                 &t.tints.texture,
                 false,
             ));
-            out.push(ResourceInfo::texture(
-                "blurred occlusion",
-                &t.occlusion.texture,
-                false,
-            ));
-            out.push(ResourceInfo::texture(
-                "blurred light",
-                &t.light.texture,
-                false,
-            ));
+            for (k, (occlusion, light)) in t.blurred.iter().enumerate() {
+                let pass = k + 1;
+                let name = format!("blurred occlusion {pass}");
+                out.push(ResourceInfo::texture(name, &occlusion.texture, false));
+                let name = format!("blurred light {pass}");
+                out.push(ResourceInfo::texture(name, &light.texture, false));
+            }
         }
         out
     }
@@ -343,7 +352,7 @@ impl ShadowTechnique for Ssss {
     }
 
     fn writes_transmittance(&self, scene: &Scene) -> bool {
-        has_translucent_casters(scene)
+        scene.has_translucent_casters()
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
@@ -357,6 +366,17 @@ impl ShadowTechnique for Ssss {
             aspect,
         };
         self.layers = self.layers_for(&request)?;
+        // The host colours with the same function: its slots must be these layers.
+        for (light, layer) in self.layers.of_light.iter().enumerate() {
+            if let Some(layer) = layer
+                && ctx.visibility.slots.slot(light) != (layer / 4, layer % 4)
+            {
+                return Err(TechniqueError::Other(format!(
+                    "ssss: light {light} is in layer {layer} but writes visibility slot {:?}",
+                    ctx.visibility.slots.slot(light)
+                )));
+            }
+        }
         let gpu = self.gpu.as_mut().expect("built above");
         let min_filter = self.params.estimate == Estimate::MinFilter;
         let code = gpu.estimate_codes.code(self.params.estimate.index());
@@ -379,13 +399,15 @@ impl ShadowTechnique for Ssss {
             gpu.min_filter.prepare(ctx, &gpu.maps);
         }
         let translucent = gpu.translucent.is_some();
+        let half = p.half_resolution;
         let layer_count = settings.layer_count;
         if !gpu
             .targets
             .as_ref()
-            .is_some_and(|t| t.fit(ctx.size, layer_count, translucent))
+            .is_some_and(|t| t.fit(ctx.size, layer_count, translucent, half))
         {
-            gpu.targets = Some(Targets::new(ctx.gpu, ctx.size, layer_count, translucent));
+            let targets = Targets::new(ctx.gpu, ctx.size, layer_count, translucent, half);
+            gpu.targets = Some(targets);
         }
         // The data buffer: settings, then one record per scene light.
         let resolution = gpu.maps.resolution();
@@ -405,6 +427,11 @@ impl ShadowTechnique for Ssss {
                 far: scale.far,
                 texel_scale: scale.texel_scale,
                 size: light_size(&ctx.lights[maps.light]),
+                scissor: maps.scissor,
+                kept_faces: (0..maps.frustums.len() as u32)
+                    .filter(|&k| gpu.maps.is_kept(maps.first_layer + k))
+                    .fold(0, |bits, k| bits | 1 << k),
+                _pad: [0; 3],
             };
         }
         let mut bytes = bytemuck::bytes_of(&settings).to_vec();
@@ -412,11 +439,12 @@ impl ShadowTechnique for Ssss {
         if gpu
             .data
             .as_ref()
-            .is_none_or(|b| b.size() < bytes.len() as u64)
+            .is_none_or(|b| b.size() != bytes.len() as u64)
         {
+            // Exactly the size of the data: the shaders take the light count from it.
             gpu.data = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("ssss data"),
-                size: (bytes.len() as u64).next_power_of_two(),
+                size: bytes.len() as u64,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }));
@@ -438,6 +466,9 @@ impl ShadowTechnique for Ssss {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
+        self.debug_drawn = ctx
+            .debug_view
+            .is_some_and(|name| DEBUG_VIEWS.contains(&name));
         let gpu = self.gpu.as_ref().ok_or_else(TechniqueError::not_prepared)?;
         gpu.maps.record(ctx, recorder, MAP_PASS)?;
         if let Some(translucent) = &gpu.translucent {
@@ -455,7 +486,9 @@ impl ShadowTechnique for Ssss {
                 .queue
                 .write_buffer(data, DEBUG_MODE_OFFSET, bytemuck::bytes_of(&code));
         }
-        gpu.passes.record(ctx, recorder, &gpu.maps, debug.is_some())
+        let half = self.params.half_resolution;
+        gpu.passes
+            .record(ctx, recorder, &gpu.maps, half, debug.is_some())
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
@@ -463,13 +496,9 @@ impl ShadowTechnique for Ssss {
         if resource == "shadow maps" {
             return gpu.maps.debug_image(self.params.debug_light);
         }
-        DEBUG_VIEWS.contains(&resource).then(|| DebugImage {
-            view: &gpu
-                .targets
-                .as_ref()
-                .expect("targets exist once maps do")
-                .debug
-                .1,
+        let targets = gpu.targets.as_ref()?;
+        DEBUG_VIEWS.contains(&resource).then_some(DebugImage {
+            view: &targets.debug.1,
             mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
         })
     }
@@ -510,10 +539,8 @@ fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn Shado
     Ok(Box::new(Ssss {
         params,
         gpu: None,
-        layers: Layers {
-            of_light: Vec::new(),
-            count: 0,
-        },
+        layers: Layers::default(),
+        debug_drawn: false,
     }))
 }
 
@@ -555,8 +582,14 @@ mod tests {
             penumbra_scale,
             normal_offset,
             debug_mode,
-            estimate
+            estimate,
+            half_resolution
         });
+        assert_eq!(
+            size % 16,
+            0,
+            "the light array starts right after the settings"
+        );
         check_mirror(&source, "Settings", size, &fields, SizeRule::Equal).unwrap();
         let (size, fields) = zoo_host::mirror_fields!(SsssLight {
             first_layer,
@@ -566,7 +599,9 @@ mod tests {
             near,
             far,
             texel_scale,
-            size
+            size,
+            scissor,
+            kept_faces
         });
         check_mirror(&source, "SsssLight", size, &fields, SizeRule::Equal).unwrap();
     }
@@ -576,6 +611,13 @@ mod tests {
         let source = shader("ssss/penumbra.wgsl");
         let codes = ChoiceCodes::read(&source, "ESTIMATE", Estimate::NAMES).unwrap();
         assert_ne!(codes.code(0), codes.code(1));
+    }
+
+    #[test]
+    fn the_min_block_matches_the_shader() {
+        let source = shader("ssss/min_depth.wgsl");
+        let block = zoo_host::gpu::layout::wgsl_integer_constant(&source, "MIN_BLOCK");
+        assert_eq!(block, Ok(i64::from(gpu::MIN_BLOCK)));
     }
 
     #[test]
@@ -630,10 +672,8 @@ mod tests {
         Ssss {
             params: SsssParams::from_values(values).unwrap(),
             gpu: None,
-            layers: Layers {
-                of_light: Vec::new(),
-                count: 0,
-            },
+            layers: Layers::default(),
+            debug_drawn: false,
         }
     }
 }

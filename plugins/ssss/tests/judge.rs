@@ -181,3 +181,39 @@ fn two_hundred_and_fifty_six_lights_render_with_every_pass_timed() {
         .unwrap();
     assert!((2.0..=64.0).contains(&layers), "{layers} layers");
 }
+
+#[test]
+fn resizing_moving_and_dropping_lights_keep_layers_and_slots_together() {
+    let scene = zoo_host::Scene::load(&scene_path("many-lights.ron")).unwrap();
+    let mut renderer = Renderer::new(gpu(), scene.clone(), UVec2::new(96, 96)).unwrap();
+    renderer.set_technique("ssss", &Default::default()).unwrap();
+    renderer.render(&View::Final).unwrap();
+    // A wider output changes the frustum and so the colouring; the technique checks that the
+    // host's slots are its layers and fails the frame otherwise.
+    renderer.set_size(UVec2::new(192, 64)).unwrap();
+    renderer.render(&View::Final).unwrap();
+    let mut camera = scene.camera;
+    camera.position.x += 3.0;
+    renderer.set_camera(camera);
+    renderer.render(&View::Final).unwrap();
+    // Fewer lights: the dropped ones leave no records behind.
+    renderer.set_lights(scene.lights[..10].to_vec());
+    renderer.render(&View::Final).unwrap();
+    assert_eq!(renderer.technique().id, "ssss");
+    // Every debug view renders, and its pass is declared.
+    for view in [
+        "layer assignment",
+        "penumbra sizes",
+        "hard shadows",
+        "blurred shadows",
+    ] {
+        let timings = renderer.render(&View::Resource(view.into())).unwrap();
+        let declared: Vec<String> = renderer
+            .technique_instance()
+            .passes()
+            .into_iter()
+            .map(|p| p.name)
+            .collect();
+        assert_eq!(timings.technique_pass_names(), declared, "{view}");
+    }
+}

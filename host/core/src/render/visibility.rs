@@ -22,7 +22,9 @@ pub const VISIBILITY_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_AT
 /// What a technique assigns visibility slots for ([`crate::ShadowTechnique::assign_slots`]).
 #[derive(Debug, Clone, Copy)]
 pub struct SlotRequest<'a> {
+    /// The current lights.
     pub lights: &'a [Light],
+    /// The current camera.
     pub camera: &'a Camera,
     /// Output width over height.
     pub aspect: f32,
@@ -196,6 +198,7 @@ impl VisibilityTargets {
 /// frame, for techniques that write it ([`crate::ShadowTechnique::writes_transmittance`]);
 /// otherwise a single white texel that every light reads.
 pub struct TransmittanceTargets {
+    /// The array texture (a layer per slot, or one white texel).
     pub texture: wgpu::Texture,
     /// All layers, for the lighting pass.
     pub array_view: wgpu::TextureView,
@@ -233,7 +236,12 @@ impl TransmittanceTargets {
             view_formats: &[],
         });
         // Every layer of the white texel: GL binds the whole texture, spare layers included.
-        for layer in (0..texture.depth_or_array_layers()).filter(|_| !in_use) {
+        let white_layers = if in_use {
+            0
+        } else {
+            texture.depth_or_array_layers()
+        };
+        for layer in 0..white_layers {
             gpu.queue.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     texture: &texture,

@@ -246,12 +246,10 @@ impl Renderer {
     pub fn set_technique(&mut self, id: &str, values: &ParamValues) -> Result<(), TechniqueError> {
         let registration = technique::find_technique(id)?;
         let next = instantiate(&self.gpu, registration, values)?;
+        // Refused slots keep the current technique, as any other failure to switch does.
+        let slots = self.slots_of(&next)?;
         self.technique = next;
-        self.update_slots();
-        if let Some(error) = self.slot_error.take() {
-            self.fallback_later(error.clone());
-            return Err(error);
-        }
+        self.apply_slots(slots);
         Ok(())
     }
 
@@ -306,6 +304,8 @@ impl Renderer {
                 VisibilityTargets::new(&self.gpu, size, self.visibility.slots.clone());
             self.update_transmittance(true);
             self.technique.pending.resolution = true;
+            // The aspect ratio is part of what slots are assigned for.
+            self.update_slots();
         }
         Ok(())
     }
@@ -334,38 +334,65 @@ impl Renderer {
         }
     }
 
-    /// Asks the technique for its slot assignment and resizes the visibility storage when it
-    /// changed. A refusal is kept and reported by the next [`Self::render`].
-    fn update_slots(&mut self) {
+    /// The slots `technique` assigns for the current lights, camera and size, checked against
+    /// the light count and the device's array-layer limit.
+    fn slots_of(&self, technique: &ActiveTechnique) -> Result<SlotAssignment, TechniqueError> {
         let request = SlotRequest {
             lights: &self.lights,
             camera: &self.camera,
             aspect: self.size.x as f32 / self.size.y as f32,
         };
-        let instance = &self.technique.instance;
-        let id = self.technique.registration.id;
-        let slots = match guarded(&self.gpu, id, || instance.assign_slots(&request)) {
-            Ok(slots) if slots.len() == self.lights.len() => slots,
+        let id = technique.registration.id;
+        let instance = &technique.instance;
+        let slots = guarded(&self.gpu, id, || instance.assign_slots(&request))?;
+        if slots.len() != self.lights.len() {
+            return Err(TechniqueError::Other(format!(
+                "{id}: assigned visibility slots to {} lights, the scene has {}",
+                slots.len(),
+                self.lights.len()
+            )));
+        }
+        let max_layers = self.gpu.device.limits().max_texture_array_layers;
+        if slots.slot_count() > max_layers {
+            return Err(TechniqueError::Other(format!(
+                "{id}: {} visibility slots need more texture array layers than the device's {max_layers}",
+                slots.slot_count()
+            )));
+        }
+        Ok(slots)
+    }
+
+    /// Asks the technique for its slot assignment and applies it. A refusal is kept and
+    /// reported by the next [`Self::render`]; meanwhile every light has a slot of its own, so
+    /// the storage always matches the lights.
+    fn update_slots(&mut self) {
+        match self.slots_of(&self.technique) {
             Ok(slots) => {
-                self.slot_error = Some(TechniqueError::Other(format!(
-                    "{id}: assigned visibility slots to {} lights, the scene has {}",
-                    slots.len(),
-                    self.lights.len()
-                )));
-                return;
+                self.slot_error = None;
+                self.apply_slots(slots);
             }
             Err(e) => {
                 self.slot_error = Some(e);
-                return;
+                self.apply_slots(SlotAssignment::one_per_light(self.lights.len()));
             }
-        };
-        self.slot_error = None;
-        let changed = slots != self.visibility.slots;
-        if changed {
-            self.visibility = VisibilityTargets::new(&self.gpu, self.size, slots);
-            self.technique.pending.lights = true;
         }
-        self.update_transmittance(changed);
+    }
+
+    /// Uses `slots`: the storage is kept when it has as many layers (lights only change
+    /// channels), else rebuilt; the technique hears of any change.
+    fn apply_slots(&mut self, slots: SlotAssignment) {
+        if slots == self.visibility.slots {
+            self.update_transmittance(false);
+            return;
+        }
+        let same_storage = slots.layer_count() == self.visibility.slots.layer_count();
+        if same_storage {
+            self.visibility.slots = slots;
+        } else {
+            self.visibility = VisibilityTargets::new(&self.gpu, self.size, slots);
+        }
+        self.technique.pending.lights = true;
+        self.update_transmittance(!same_storage);
     }
 
     /// Fits the transmittance storage to the technique, the slots and the size, and rebuilds
