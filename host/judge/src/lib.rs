@@ -7,11 +7,13 @@
 //! disk (point and spot: a disk of the light's radius facing the surface; directional: the cone
 //! of the light's angular radius) for area visibility.
 
+mod indirect;
 mod metrics;
 mod occluders;
 mod reference;
 mod sampling;
 
+pub use indirect::{ReflectorHit, Reflectors, one_bounce, reflected_direct, relative_rmse};
 pub use metrics::{ErrorClass, Metrics, edge_band, error_class, percentile};
 pub use occluders::Occluders;
 pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, SurfacePoint, reference_visibility};

@@ -21,8 +21,8 @@ const CANONICAL_TMIN: f32 = 2e-4;
 /// 65 ulps of the largest canonical coordinate (512).
 const BOX_PADDING: f32 = 4e-3;
 
-/// Triangles in a BVH, in the canonical frame of their [`Occluders`].
-struct TriangleBvh {
+/// Triangles in a BVH, in a canonical frame ([`CanonicalFrame`]).
+pub(crate) struct TriangleBvh {
     bvh: CwBvh,
     triangles: Vec<Triangle>,
     /// Per kept triangle: the index of the input triangle it came from.
@@ -31,7 +31,7 @@ struct TriangleBvh {
 
 impl TriangleBvh {
     /// Builds the BVH over the non-degenerate ones of `triangles` (already canonical).
-    fn new(triangles: &[Triangle]) -> TriangleBvh {
+    pub(crate) fn new(triangles: &[Triangle]) -> TriangleBvh {
         let (sources, triangles): (Vec<usize>, Vec<Triangle>) = triangles
             .iter()
             .enumerate()
@@ -62,6 +62,23 @@ impl TriangleBvh {
         }
     }
 
+    /// The nearest triangle `ray` hits before its `tmax`: its source index and distance (in
+    /// the ray's frame).
+    pub(crate) fn closest(&self, ray: Ray) -> Option<(usize, f32)> {
+        if self.triangles.is_empty() {
+            return None;
+        }
+        let mut hit = obvhs::ray::RayHit::none();
+        let found = self.bvh.ray_traverse(ray, &mut hit, |ray, id| {
+            let index = self.bvh.primitive_indices[id] as usize;
+            self.triangles[index].intersect(ray)
+        });
+        found.then(|| {
+            let index = self.bvh.primitive_indices[hit.primitive_id as usize] as usize;
+            (self.sources[index], hit.t)
+        })
+    }
+
     /// Whether `ray` hits any triangle before its `tmax`.
     fn any_hit(&self, ray: Ray) -> bool {
         !self.triangles.is_empty()
@@ -87,6 +104,74 @@ impl TriangleBvh {
     }
 }
 
+/// The frame BVHs work in: the scene centred and scaled so that its diagonal is
+/// [`CANONICAL_SIZE`] (obvhs culls nodes that end before a fixed 1e-4, which would otherwise
+/// drop nearby triangles in small scenes).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CanonicalFrame {
+    /// World-space centre.
+    centre: Vec3,
+    /// World to canonical scale.
+    scale: f32,
+}
+
+impl CanonicalFrame {
+    /// The frame of world-space `triangles`.
+    pub(crate) fn of<'a>(triangles: impl Iterator<Item = &'a [Vec3; 3]>) -> CanonicalFrame {
+        let (lo, hi) = triangles
+            .flatten()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(*v), hi.max(*v))
+            });
+        if !lo.is_finite() || !hi.is_finite() {
+            return CanonicalFrame {
+                centre: Vec3::ZERO,
+                scale: 1.0,
+            };
+        }
+        let diagonal = lo.distance(hi);
+        CanonicalFrame {
+            centre: (lo + hi) * 0.5,
+            scale: if diagonal > 0.0 {
+                CANONICAL_SIZE / diagonal
+            } else {
+                1.0
+            },
+        }
+    }
+
+    /// A world triangle in this frame.
+    pub(crate) fn triangle(&self, [a, b, c]: &[Vec3; 3]) -> Triangle {
+        let canonical = |v: Vec3| Vec3A::from((v - self.centre) * self.scale);
+        Triangle {
+            v0: canonical(*a),
+            v1: canonical(*b),
+            v2: canonical(*c),
+        }
+    }
+
+    /// A world ray up to world distance `tmax` in this frame (`None` when not finite).
+    pub(crate) fn ray(&self, origin: Vec3, direction: Vec3, tmax: f32) -> Option<Ray> {
+        if !direction.is_finite() || !origin.is_finite() {
+            return None;
+        }
+        // -0.0 + 0.0 == +0.0; every other value is unchanged.
+        let direction = Vec3A::from(direction) + Vec3A::ZERO;
+        Some(Ray {
+            origin: Vec3A::from((origin - self.centre) * self.scale),
+            direction,
+            inv_direction: direction.map(reciprocal),
+            tmin: CANONICAL_TMIN,
+            tmax: tmax * self.scale,
+        })
+    }
+
+    /// A distance in this frame back in world units.
+    pub(crate) fn world_distance(&self, t: f32) -> f32 {
+        t / self.scale
+    }
+}
+
 /// Translucent shadow casters: their triangles, the object each belongs to, and the colour
 /// each object lets through.
 struct TranslucentCasters {
@@ -106,10 +191,7 @@ struct TranslucentCasters {
 pub struct Occluders {
     opaque: TriangleBvh,
     translucent: Option<TranslucentCasters>,
-    /// World-space centre of the canonical frame.
-    centre: Vec3,
-    /// World to canonical scale.
-    scale: f32,
+    frame: CanonicalFrame,
     epsilon: f32,
 }
 
@@ -150,34 +232,13 @@ impl Occluders {
         translucent: &[(Vec<[Vec3; 3]>, Vec3)],
         scene_size: f32,
     ) -> Occluders {
-        let all = opaque
-            .iter()
-            .chain(translucent.iter().flat_map(|(t, _)| t.iter()));
-        let (lo, hi) = all
-            .clone()
-            .flatten()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(*v), hi.max(*v))
-            });
-        let (centre, scale) = if all.clone().next().is_none() {
-            (Vec3::ZERO, 1.0)
-        } else {
-            let diagonal = lo.distance(hi);
-            let scale = if diagonal > 0.0 {
-                CANONICAL_SIZE / diagonal
-            } else {
-                1.0
-            };
-            ((lo + hi) * 0.5, scale)
-        };
-        let canonical = |v: Vec3| Vec3A::from((v - centre) * scale);
+        let frame = CanonicalFrame::of(
+            opaque
+                .iter()
+                .chain(translucent.iter().flat_map(|(t, _)| t.iter())),
+        );
         let to_canonical = |tris: &mut dyn Iterator<Item = &[Vec3; 3]>| -> Vec<Triangle> {
-            tris.map(|[a, b, c]| Triangle {
-                v0: canonical(*a),
-                v1: canonical(*b),
-                v2: canonical(*c),
-            })
-            .collect()
+            tris.map(|t| frame.triangle(t)).collect()
         };
         let translucent = (!translucent.is_empty()).then(|| TranslucentCasters {
             bvh: TriangleBvh::new(&to_canonical(
@@ -193,8 +254,7 @@ impl Occluders {
         Occluders {
             opaque: TriangleBvh::new(&to_canonical(&mut opaque.iter())),
             translucent,
-            centre,
-            scale,
+            frame,
             epsilon: (scene_size * 2e-5).max(1e-5),
         }
     }
@@ -261,18 +321,10 @@ impl Occluders {
 
     /// The query as a ray in the canonical frame (`None` when nothing can be hit).
     fn canonical_ray(&self, origin: Vec3, direction: Vec3, tmax: f32) -> Option<Ray> {
-        if self.is_empty() || !direction.is_finite() || !origin.is_finite() {
+        if self.is_empty() {
             return None;
         }
-        // -0.0 + 0.0 == +0.0; every other value is unchanged.
-        let direction = Vec3A::from(direction) + Vec3A::ZERO;
-        Some(Ray {
-            origin: Vec3A::from((origin - self.centre) * self.scale),
-            direction,
-            inv_direction: direction.map(reciprocal),
-            tmin: CANONICAL_TMIN,
-            tmax: tmax * self.scale,
-        })
+        self.frame.ray(origin, direction, tmax)
     }
 }
 

@@ -50,7 +50,7 @@ zoo_host::technique_params! {
         /// Taps of each blur pass.
         kernel: Kernel = Kernel::Taps11;
         /// How blockers are found for the penumbra estimate.
-        estimate: Estimate = Estimate::BlockerSearch;
+        estimate: Estimate = Estimate::MinFilter;
         /// Blur on a half-resolution grid (each grid pixel the mean of a 2 x 2 block of the
         /// full-resolution hard shadows), upsampled with depth-aware weights; pixels without
         /// penumbra keep their full-resolution hard result.

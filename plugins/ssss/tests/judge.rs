@@ -35,18 +35,19 @@ fn one_large_light_agrees_with_the_area_reference() {
 }
 
 #[test]
-fn the_min_filter_estimate_agrees_with_the_area_reference() {
+fn the_blocker_search_and_full_resolution_variants_agree_with_the_area_reference() {
     for scene in ["soft.ron", "many-lights.ron"] {
-        let run = judge(scene, "ssss", &[("estimate", "MinFilter")], SIZE);
-        assert_mae(&run, 0.06);
-        let pass = "SSSS min filter";
-        assert!(
-            run.judged
-                .timings
-                .technique_pass_names()
-                .iter()
-                .any(|n| n == pass)
-        );
+        let variants = [
+            [("estimate", "BlockerSearch"), ("half_resolution", "true")],
+            [("estimate", "MinFilter"), ("half_resolution", "false")],
+        ];
+        for params in variants {
+            let run = judge(scene, "ssss", &params, SIZE);
+            assert_mae(&run, 0.06);
+            let names = run.judged.timings.technique_pass_names();
+            let min_filter = names.iter().any(|n| n == "SSSS min filter");
+            assert_eq!(min_filter, params[0].1 == "MinFilter", "{params:?}");
+        }
     }
 }
 
