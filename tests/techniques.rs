@@ -152,12 +152,14 @@ fn every_technique_renders_lit_and_finite() {
         assert_eq!(renderer.technique().id, id, "{id} fell back to unshadowed");
         let image = renderer.read_output();
         let raw = image.as_raw();
-        // Shadows only take direct light away: never brighter than the unshadowed frame.
+        // Shadows only take direct light away: never brighter than the unshadowed frame, unless
+        // the technique adds light (which `tests/indirect_light.rs` checks against the CPU
+        // mirror instead).
         let brighter = (0..raw.len())
             .filter(|&k| k % 4 != 3 && raw[k] as i32 > baseline.as_raw()[k] as i32 + 2)
             .count();
-        assert_eq!(
-            brighter, 0,
+        assert!(
+            brighter == 0 || registration.adds_light,
             "{id}: {brighter} channels brighter than unshadowed"
         );
         // Most of planar-room is lit by some light.

@@ -12,7 +12,12 @@ struct ViewParams {
     far: f32,
     // Alpha of the output: 1 full screen, less when blended over the final image.
     opacity: f32,
-    _pad: f32,
+    // 3D sources: the axis across which the slice is taken (0 x, 1 y, 2 z) and its texel.
+    slice_axis: u32,
+    slice_index: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: ViewParams;
@@ -20,6 +25,7 @@ struct ViewParams {
 // A depth texture bound as unfilterable float (GLSL cannot fetch texels of depth textures).
 @group(0) @binding(2) var source_depth: texture_2d<f32>;
 @group(0) @binding(3) var source_uint: texture_2d<u32>;
+@group(0) @binding(4) var source_volume: texture_3d<f32>;
 
 // The output is sRGB-encoded on write; views show their values as they are, so they are
 // decoded first.
@@ -68,4 +74,31 @@ fn fs_uint(in: FullscreenOut) -> @location(0) vec4<f32> {
     let h = fract(f32(v) * 0.618034);
     let c = saturate(abs(fract(vec3<f32>(h) + vec3<f32>(0.0, 2.0 / 3.0, 1.0 / 3.0)) * 6.0 - 3.0) - 1.0);
     return display(c);
+}
+
+// A slice of a 3D texture: across x shows z across and y up; across y, x across and z up;
+// across z, x across and y up.
+@fragment
+fn fs_volume(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let size = vec3<i32>(textureDimensions(source_volume));
+    let axis = min(params.slice_axis, 2u);
+    let index = min(i32(params.slice_index), size[axis] - 1);
+    let across = vec2<f32>(in.uv.x, 1.0 - in.uv.y);
+    var texel: vec3<i32>;
+    switch axis {
+        case 0u: {
+            texel = vec3<i32>(index, i32(across.y * f32(size.y)), i32(across.x * f32(size.z)));
+        }
+        case 1u: {
+            texel = vec3<i32>(i32(across.x * f32(size.x)), index, i32(across.y * f32(size.z)));
+        }
+        default: {
+            texel = vec3<i32>(i32(across.x * f32(size.x)), i32(across.y * f32(size.y)), index);
+        }
+    }
+    let value = textureLoad(source_volume, clamp(texel, vec3<i32>(0), size - vec3<i32>(1)), 0);
+    if params.mode == 1u {
+        return display(vec3<f32>(remap(value[params.channel])));
+    }
+    return display(vec3<f32>(remap(value.r), remap(value.g), remap(value.b)));
 }

@@ -101,7 +101,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             .expect("valid template"),
     );
     bar.set_message("reference");
-    let reference = SceneReference::compute(&mut renderer, args.samples, |_| bar.inc(1))?;
+    let mut reference = SceneReference::compute(&mut renderer, args.samples, |_| bar.inc(1))?;
     let mut judged = Vec::new();
     let mut failures = Vec::new();
     for (technique, values) in techniques.iter().zip(&params) {
@@ -136,6 +136,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             .with_context(|| format!("cannot write {}", path.display()))?;
         }
     }
+    let indirect = judge_indirect(&judged, &mut reference, &renderer, args)?;
     let report = report_md(&ReportInputs {
         scene: &scene_name,
         scene_path: &args.scene,
@@ -145,6 +146,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         adapter: &adapter,
         reference: &reference,
         judged: &judged,
+        indirect: &indirect,
         failures: &failures,
     });
     let report_path = args.out.join("report.md");
@@ -226,6 +228,51 @@ fn summary_table(judged: &[Judged]) -> String {
     out
 }
 
+/// Scores the indirect light of the techniques that add light against the one-bounce
+/// reference (traced once, with the area samples per pixel), writes `indirect.csv` and an
+/// error map per technique, and returns (technique, relative RMSE).
+fn judge_indirect(
+    judged: &[Judged],
+    reference: &mut SceneReference,
+    renderer: &Renderer,
+    args: &CompareArgs,
+) -> anyhow::Result<Vec<(String, f64)>> {
+    let mut scores = Vec::new();
+    let (scene, lights) = (renderer.scene(), renderer.lights());
+    for j in judged {
+        let (Some(estimate), Some(rmse)) = (
+            &j.indirect,
+            j.indirect_rmse(reference, scene, lights, args.samples),
+        ) else {
+            continue;
+        };
+        let (width, height) = reference.size();
+        let expected = reference.indirect(scene, lights, args.samples);
+        let map = image::RgbaImage::from_fn(width as u32, height as u32, |x, y| {
+            let i = y as usize * width + x as usize;
+            let error = (estimate[i] - expected[i]).length() / expected[i].length().max(1e-3);
+            let v = (error.min(1.0) * 255.0) as u8;
+            image::Rgba([v, v, v, 255])
+        });
+        let path = args.out.join(format!("{}-indirect-error.png", j.technique));
+        map.save(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        scores.push((j.technique.clone(), rmse));
+    }
+    if !scores.is_empty() {
+        let mut csv = String::from("scene,technique,indirect_rmse\n");
+        for (technique, rmse) in &scores {
+            writeln!(csv, "{},{technique},{rmse:.6}", scene.name).expect("write to string");
+        }
+        let path = args.out.join("indirect.csv");
+        std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
+        for (technique, rmse) in &scores {
+            println!("  {technique:16} indirect_rmse {rmse:.4}");
+        }
+    }
+    Ok(scores)
+}
+
 struct ReportInputs<'a> {
     scene: &'a str,
     scene_path: &'a Path,
@@ -235,6 +282,8 @@ struct ReportInputs<'a> {
     adapter: &'a str,
     reference: &'a SceneReference,
     judged: &'a [Judged],
+    /// (technique, relative RMSE) of the techniques that add light.
+    indirect: &'a [(String, f64)],
     failures: &'a [(&'static str, String)],
 }
 
@@ -315,6 +364,17 @@ fn report_md(r: &ReportInputs<'_>) -> String {
                     );
                 }
             }
+        }
+    }
+    if !r.indirect.is_empty() {
+        let _ = writeln!(
+            w,
+            "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more).\n"
+        );
+        let _ = writeln!(w, "| technique | indirect_rmse |");
+        let _ = writeln!(w, "|---|---|");
+        for (technique, rmse) in r.indirect {
+            let _ = writeln!(w, "| {technique} | {rmse:.4} |");
         }
     }
     let _ = writeln!(w, "\n## Parameters\n");

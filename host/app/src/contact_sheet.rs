@@ -180,8 +180,8 @@ pub fn build(
         ),
     ];
     let mut images = vec![
-        shade_on_cpu(renderer, gbuffer, &hard, &background),
-        shade_on_cpu(renderer, gbuffer, &area, &background),
+        shade_on_cpu(renderer, gbuffer, &hard, None, &background),
+        shade_on_cpu(renderer, gbuffer, &area, None, &background),
     ];
     for (registration, values) in techniques {
         progress(registration.id);

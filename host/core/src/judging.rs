@@ -7,14 +7,14 @@ use std::time::Instant;
 
 use image::{Rgba, RgbaImage};
 use zoo_judge::{
-    DEFAULT_AREA_SAMPLES, ErrorClass, LightReference, Metrics, Occluders, SurfacePoint,
-    error_class, reference_visibility,
+    DEFAULT_AREA_SAMPLES, ErrorClass, LightReference, Metrics, Occluders, Reflectors, SurfacePoint,
+    error_class, one_bounce, reference_visibility, relative_rmse,
 };
 
 use crate::gpu::{FrameTimings, PassOwner};
 use crate::params::ParamValues;
 use crate::render::{GBufferData, RenderError, Renderer, View};
-use crate::scene::LightKind;
+use crate::scene::{Light, LightKind, Scene};
 
 /// The judge's verdict about one view of a scene, shared by every technique.
 pub struct SceneReference {
@@ -26,6 +26,8 @@ pub struct SceneReference {
     pub occluder_triangles: usize,
     /// Seconds spent building the BVH and tracing.
     pub seconds: f64,
+    /// The one-bounce indirect reference per pixel, once [`Self::indirect`] computed it.
+    indirect: Option<Vec<glam::Vec3>>,
 }
 
 impl SceneReference {
@@ -57,7 +59,29 @@ impl SceneReference {
             lights,
             occluder_triangles: occluders.len(),
             seconds: start.elapsed().as_secs_f64(),
+            indirect: None,
         })
+    }
+
+    /// The one-bounce diffuse reference for this view (irradiance over π per pixel, the
+    /// quantity of the indirect target), traced with `samples` rays per pixel the first time
+    /// it is asked for (it costs a BVH of every surface and a shadow ray per light and hit).
+    pub fn indirect(&mut self, scene: &Scene, lights: &[Light], samples: u32) -> &[glam::Vec3] {
+        if self.indirect.is_none() {
+            let start = Instant::now();
+            let occluders = Occluders::new(scene);
+            let reflectors = Reflectors::new(scene);
+            let points = surface_points(&self.gbuffer);
+            let traced = one_bounce(&occluders, &reflectors, lights, &points, samples);
+            self.seconds += start.elapsed().as_secs_f64();
+            self.indirect = Some(traced);
+        }
+        self.indirect.as_deref().expect("computed above")
+    }
+
+    /// The pixels with a surface.
+    pub fn surface_mask(&self) -> Vec<bool> {
+        self.gbuffer.positions.iter().map(|p| p.w > 0.5).collect()
     }
 
     /// Output width and height.
@@ -107,6 +131,25 @@ pub struct Judged {
     pub transmittance: Vec<Option<Vec<glam::Vec3>>>,
     /// Visibility slots the lights shared (fewer than lights when the technique packs them).
     pub slot_count: u32,
+    /// The indirect light it added per pixel, for techniques that add light.
+    pub indirect: Option<Vec<glam::Vec3>>,
+}
+
+impl Judged {
+    /// Relative RMSE of its indirect light against `reference`'s one-bounce reference
+    /// (`None` for techniques that add no light). Traces the reference on first use.
+    pub fn indirect_rmse(
+        &self,
+        reference: &mut SceneReference,
+        scene: &Scene,
+        lights: &[Light],
+        samples: u32,
+    ) -> Option<f64> {
+        let estimate = self.indirect.as_ref()?;
+        let mask = reference.surface_mask();
+        let expected = reference.indirect(scene, lights, samples);
+        Some(relative_rmse(expected, estimate, &mask))
+    }
 }
 
 /// Switches `renderer` to technique `id` with `params`, renders the current view and scores it
@@ -160,6 +203,7 @@ pub fn judge_technique(
         visibility,
         transmittance,
         slot_count: renderer.slots().slot_count(),
+        indirect: registration.adds_light.then(|| renderer.read_indirect()),
     })
 }
 
@@ -181,18 +225,23 @@ pub fn error_map(reference: &LightReference, visibility: &[f32], scene: &RgbaIma
     out
 }
 
-/// The deferred lighting evaluated on the CPU (the mirror of `shaders/host/lighting.wgsl`
-/// without indirect light) from a G-buffer and one visibility per light, for example the
-/// reference's. Background pixels keep the colour they have in `background`.
+/// The deferred lighting evaluated on the CPU (the mirror of `shaders/host/lighting.wgsl`)
+/// from a G-buffer, one visibility per light (for example the reference's) and, for light
+/// that a technique adds, the indirect light per pixel, which replaces the scene's ambient as
+/// it does on the GPU. Background pixels keep the colour they have in `background`.
 pub fn shade_on_cpu(
     renderer: &Renderer,
     gbuffer: &GBufferData,
     visibility: &[&[f32]],
+    indirect: Option<&[glam::Vec3]>,
     background: &RgbaImage,
 ) -> RgbaImage {
     use crate::scene::shading;
     let eye = renderer.camera().position;
-    let ambient = renderer.scene().ambient;
+    let ambient = match indirect {
+        Some(_) => glam::Vec3::ZERO,
+        None => renderer.scene().ambient,
+    };
     let mut out = background.clone();
     for (i, pixel) in out.pixels_mut().enumerate() {
         let p = gbuffer.positions[i];
@@ -203,6 +252,9 @@ pub fn shade_on_cpu(
         let position = p.truncate();
         let view_dir = (eye - position).normalize_or_zero();
         let mut c = ambient * m.albedo;
+        if let Some(indirect) = indirect {
+            c += indirect[i] * m.albedo;
+        }
         for (light, v) in renderer.lights().iter().zip(visibility) {
             if v[i] > 0.0 {
                 c += v[i] * shading::direct_light(light, position, gbuffer.normals[i], view_dir, m);

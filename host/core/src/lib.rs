@@ -24,8 +24,9 @@ pub use params::{ParamSpec, ParamValue, ParamValues, TechniqueParams};
 pub use render::{Renderer, View};
 pub use scene::{Camera, Light, LightKind, MAX_LIGHTS, Scene};
 pub use technique::{
-    Changes, DebugImage, ParamUpdate, PassInfo, RenderContext, ResourceInfo, ShadowTechnique,
-    TechniqueError, TechniqueRegistration, TechniqueResult, ViewMapping, find_technique, registry,
+    Changes, DebugImage, DebugVolume, ParamUpdate, PassInfo, RenderContext, ResourceInfo,
+    ShadowTechnique, TechniqueError, TechniqueRegistration, TechniqueResult, ViewMapping,
+    VolumeAxis, VolumeSlice, find_technique, registry,
 };
 
 /// What a technique's crate usually needs: `use zoo_host::prelude::*;`.

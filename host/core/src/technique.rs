@@ -31,6 +31,12 @@ pub struct TechniqueRegistration {
     pub source: &'static str,
     /// Light kinds it computes visibility for; others are reported as unsupported.
     pub light_kinds: &'static [LightKind],
+    /// Whether it adds light (indirect illumination into [`RenderContext::indirect`]) besides
+    /// the lights' visibility. The scene's constant ambient stands in for indirect light, so
+    /// the host drops it while such a technique is active; such a technique may be brighter
+    /// than `unshadowed`, and the judge scores its indirect light against a one-bounce
+    /// reference.
+    pub adds_light: bool,
     /// Device features it cannot run without.
     pub required_features: fn() -> wgpu::Features,
     /// Device features it uses when present.
@@ -67,6 +73,7 @@ impl TechniqueRegistration {
         description: "",
         source: "",
         light_kinds: &[],
+        adds_light: false,
         required_features: wgpu::Features::empty,
         optional_features: wgpu::Features::empty,
         required_limits: wgpu::Limits::downlevel_defaults,
@@ -340,6 +347,31 @@ pub struct DebugImage<'a> {
     pub mapping: ViewMapping,
 }
 
+/// An axis of a 3D texture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VolumeAxis {
+    X,
+    Y,
+    Z,
+}
+
+/// A slice of a 3D texture across `axis` at texel `index` (clamped to the volume), shown with
+/// the other two axes across and up the screen (X: z, y; Y: x, z; Z: x, y).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct VolumeSlice {
+    pub axis: VolumeAxis,
+    pub index: u32,
+}
+
+/// A slice of a 3D texture offered for display (light propagation volumes, voxel grids).
+pub struct DebugVolume<'a> {
+    /// A 3D view of a float texture.
+    pub view: &'a wgpu::TextureView,
+    /// How to show its values (`Color` or `Channel`).
+    pub mapping: ViewMapping,
+    pub slice: VolumeSlice,
+}
+
 /// What changed since the last [`ShadowTechnique::prepare`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Changes {
@@ -392,7 +424,7 @@ pub struct RenderContext<'a> {
     /// The colour each light keeps through translucent casters: one layer per visibility slot,
     /// cleared to white, when the technique [writes it](ShadowTechnique::writes_transmittance).
     pub transmittance: &'a TransmittanceTargets,
-    /// Additive indirect radiance (for global-illumination techniques).
+    /// Indirect light for techniques that add light (see [`IndirectTarget`]), cleared to 0.
     pub indirect: &'a IndirectTarget,
     /// The current camera (may differ from the scene's when animated).
     pub camera: &'a Camera,
@@ -451,6 +483,12 @@ pub trait ShadowTechnique: Send {
 
     /// A viewable resource by name, for the debug view.
     fn debug_view(&self, _resource: &str) -> Option<DebugImage<'_>> {
+        None
+    }
+
+    /// A slice of a viewable 3D resource by name, for the debug view (asked when
+    /// [`Self::debug_view`] has no 2D image of that name).
+    fn debug_volume(&self, _resource: &str) -> Option<DebugVolume<'_>> {
         None
     }
 

@@ -9,7 +9,9 @@ use crate::render::gbuffer::{
     ALBEDO_FORMAT, DEPTH_FORMAT, GBUFFER_USAGE, NORMAL_FORMAT, VIEW_DEPTH_FORMAT,
 };
 use crate::render::lighting::{OUTPUT_FORMAT, OUTPUT_USAGE};
-use crate::render::visibility::{INDIRECT_FORMAT, VISIBILITY_FORMAT, VISIBILITY_USAGE};
+use crate::render::visibility::{
+    INDIRECT_FORMAT, INDIRECT_USAGE, VISIBILITY_FORMAT, VISIBILITY_USAGE,
+};
 
 /// Downlevel capabilities the host's own passes rely on (storage buffers of per-frame data
 /// read in vertex shaders). Techniques declare what they need beyond this.
@@ -18,14 +20,13 @@ pub const HOST_DOWNLEVEL_FLAGS: wgpu::DownlevelFlags = wgpu::DownlevelFlags::VER
 /// Usages the host creates each of its texture formats with (the constants its textures are
 /// created from, so the check cannot drift from the code).
 pub fn host_formats() -> [(wgpu::TextureFormat, wgpu::TextureUsages); 7] {
-    let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
     [
         (VIEW_DEPTH_FORMAT, GBUFFER_USAGE),
         (NORMAL_FORMAT, GBUFFER_USAGE),
         (ALBEDO_FORMAT, GBUFFER_USAGE),
         (DEPTH_FORMAT, GBUFFER_USAGE),
         (VISIBILITY_FORMAT, VISIBILITY_USAGE),
-        (INDIRECT_FORMAT, attachment),
+        (INDIRECT_FORMAT, INDIRECT_USAGE),
         (OUTPUT_FORMAT, OUTPUT_USAGE),
     ]
 }

@@ -3,7 +3,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
-use crate::technique::ViewMapping;
+use crate::technique::{ViewMapping, VolumeAxis, VolumeSlice};
 
 /// `ViewParams` in `host/debug_view.wgsl`.
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
@@ -16,7 +16,9 @@ struct ViewParams {
     near: f32,
     far: f32,
     opacity: f32,
-    _pad: f32,
+    slice_axis: u32,
+    slice_index: u32,
+    _pad: [u32; 3],
 }
 
 /// The sampled type of the texture being shown.
@@ -33,6 +35,8 @@ pub struct DebugSource<'a> {
     pub mapping: ViewMapping,
     /// Linearise perspective depth with these (near, far) planes.
     pub linearize: Option<(f32, f32)>,
+    /// For a 3D view: the slice to show.
+    pub slice: Option<VolumeSlice>,
 }
 
 /// Pipelines of the debug view, one per source kind.
@@ -40,6 +44,7 @@ pub struct DebugViewPass {
     float: wgpu::RenderPipeline,
     depth: wgpu::RenderPipeline,
     uint: wgpu::RenderPipeline,
+    volume: wgpu::RenderPipeline,
     params: wgpu::Buffer,
 }
 
@@ -104,6 +109,7 @@ impl DebugViewPass {
             float: pipeline("fs_float", None),
             depth: pipeline("fs_depth", Some(&depth_layout)),
             uint: pipeline("fs_uint", None),
+            volume: pipeline("fs_volume", None),
             params: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("debug view params"),
                 size: size_of::<ViewParams>() as u64,
@@ -135,6 +141,14 @@ impl DebugViewPass {
             ViewMapping::Integer => (SourceKind::Uint, (4, 0, 0.0, 1.0)),
         };
         let (near, far) = source.linearize.unwrap_or((0.0, 1.0));
+        let (slice_axis, slice_index) = source.slice.map_or((0, 0), |slice| {
+            let axis = match slice.axis {
+                VolumeAxis::X => 0,
+                VolumeAxis::Y => 1,
+                VolumeAxis::Z => 2,
+            };
+            (axis, slice.index)
+        });
         let values = ViewParams {
             mode: params.0,
             channel: params.1,
@@ -143,14 +157,17 @@ impl DebugViewPass {
             near,
             far,
             opacity: overlay_opacity.unwrap_or(1.0).clamp(0.0, 1.0),
-            _pad: 0.0,
+            slice_axis,
+            slice_index,
+            _pad: [0; 3],
         };
         gpu.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&values));
-        let (pipeline, binding) = match kind {
-            SourceKind::Float => (&self.float, 1),
-            SourceKind::Depth => (&self.depth, 2),
-            SourceKind::Uint => (&self.uint, 3),
+        let (pipeline, binding) = match (kind, source.slice) {
+            (SourceKind::Float, Some(_)) => (&self.volume, 4),
+            (SourceKind::Float, None) => (&self.float, 1),
+            (SourceKind::Depth, _) => (&self.depth, 2),
+            (SourceKind::Uint, _) => (&self.uint, 3),
         };
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("debug view bind group"),
@@ -197,7 +214,8 @@ mod tests {
             near,
             far,
             opacity,
-            _pad
+            slice_axis,
+            slice_index
         });
         check_mirror(&source, "ViewParams", size, &fields, SizeRule::Equal).unwrap();
     }

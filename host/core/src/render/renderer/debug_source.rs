@@ -29,6 +29,7 @@ impl Renderer {
                         max: 1.0,
                     },
                     linearize: None,
+                    slice: None,
                 }
             }
             View::Normals => DebugSource {
@@ -38,11 +39,13 @@ impl Renderer {
                     max: 1.0,
                 },
                 linearize: None,
+                slice: None,
             },
             View::Albedo => DebugSource {
                 view: &self.gbuffer.albedo_view,
                 mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
                 linearize: None,
+                slice: None,
             },
             View::Depth => DebugSource {
                 view: &self.gbuffer.depth_sample_view,
@@ -51,8 +54,19 @@ impl Renderer {
                     max: farthest.min(self.camera.far),
                 },
                 linearize: Some((self.camera.near, self.camera.far)),
+                slice: None,
             },
             View::Resource(name) => {
+                if self.technique.instance.debug_view(name).is_none()
+                    && let Some(volume) = self.technique.instance.debug_volume(name)
+                {
+                    return Ok(DebugSource {
+                        view: volume.view,
+                        mapping: volume.mapping,
+                        linearize: None,
+                        slice: Some(volume.slice),
+                    });
+                }
                 let image = self.technique.instance.debug_view(name).ok_or_else(|| {
                     let viewable: Vec<String> = self
                         .technique
@@ -75,6 +89,7 @@ impl Renderer {
                     view: image.view,
                     mapping: image.mapping,
                     linearize: None,
+                    slice: None,
                 }
             }
         })

@@ -200,6 +200,16 @@ impl Renderer {
         &self.camera
     }
 
+    /// The constant ambient light the lighting pass adds: the scene's, which stands in for
+    /// indirect light, or none while the technique adds indirect light itself.
+    pub fn ambient(&self) -> glam::Vec3 {
+        if self.technique.registration.adds_light {
+            glam::Vec3::ZERO
+        } else {
+            self.scene.ambient
+        }
+    }
+
     /// The active technique's registration.
     pub fn technique(&self) -> &'static TechniqueRegistration {
         self.technique.registration
@@ -445,7 +455,7 @@ impl Renderer {
         self.frame.update(
             &self.gpu,
             &self.camera,
-            self.scene.ambient,
+            self.ambient(),
             &self.lights,
             &self.visibility.slots,
             self.size,

@@ -67,6 +67,21 @@ impl Renderer {
             .collect()
     }
 
+    /// The indirect light per pixel (irradiance over π; zero unless the technique adds light).
+    pub fn read_indirect(&self) -> Vec<glam::Vec3> {
+        let bytes = readback::read_texture(
+            &self.gpu,
+            &self.indirect.texture,
+            0,
+            wgpu::TextureAspect::All,
+            8,
+        );
+        readback::f16s(&bytes)
+            .chunks_exact(4)
+            .map(|c| glam::Vec3::new(c[0], c[1], c[2]))
+            .collect()
+    }
+
     /// World positions and normals per pixel.
     pub fn read_gbuffer(&self) -> GBufferData {
         let depths = readback::f32s(&readback::read_texture(
