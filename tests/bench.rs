@@ -26,6 +26,7 @@ fn plan(techniques: &[&str], path: PathMode, frames: u32, set: &[(&str, &str, &s
             .map(|(a, b, c)| (a.to_string(), b.to_string(), c.to_string()))
             .collect(),
         flicker: true,
+        cpu_timing: false,
     }
 }
 

@@ -44,6 +44,7 @@ fn stabilised_splits_flicker_less_along_the_vista_walk() {
         sweeps: vec![parse_sweep("pssm.stabilise", &["true".into(), "false".into()]).unwrap()],
         set: vec![("pssm".into(), "map_size".into(), "1024".into())],
         flicker: true,
+        cpu_timing: false,
     };
     let gpu = gpu();
     let mut flicker = std::collections::HashMap::new();

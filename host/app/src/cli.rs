@@ -65,6 +65,10 @@ pub struct BenchArgs {
     /// Skip the flicker index (it traces the reference for every measured frame).
     #[arg(long)]
     pub no_flicker: bool,
+    /// Time every pass on the CPU clock, submitted on its own, instead of with GPU timestamps
+    /// (for CPU drivers such as lavapipe, whose timestamps miss compute work).
+    #[arg(long)]
+    pub cpu_timing: bool,
     /// Folder for bench.csv, summary.csv, bench.md and the plots.
     #[arg(long)]
     pub out: PathBuf,

@@ -120,6 +120,25 @@ pub fn spot_frustum(light: &Light) -> LightFrustum {
     )
 }
 
+/// An orthographic frustum along `direction` holding the whole box `bounds` (a light's view of
+/// the entire scene, as reflective shadow maps need: every lit surface, not only what the
+/// camera sees).
+pub fn directional_frustum_over(direction: Vec3, bounds: Aabb) -> LightFrustum {
+    let (lo, hi) = bounds;
+    let centre = (lo + hi) * 0.5;
+    let radius = (lo.distance(hi) * 0.5).max(1e-3);
+    let eye = centre - direction * (radius * 1.01);
+    let view = look_to_mat4(eye, direction, up_for(direction));
+    LightFrustum::new(
+        view,
+        Projection::Orthographic {
+            extent: radius * 2.02,
+            near: 0.0,
+            far: radius * 2.02,
+        },
+    )
+}
+
 /// Cube face directions and up vectors, in array-layer order +X, -X, +Y, -Y, +Z, -Z.
 pub const CUBE_FACES: [(Vec3, Vec3); 6] = [
     (Vec3::X, Vec3::NEG_Y),

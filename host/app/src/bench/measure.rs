@@ -66,7 +66,8 @@ pub fn run_configuration(
     let occluders = plan.flicker.then(|| Occluders::new(&scene));
     let mut renderer = Renderer::new(gpu.clone(), scene.clone(), config.size)?;
     renderer.set_technique(config.technique.id, &config.params)?;
-    renderer.set_pipeline_statistics(true);
+    renderer.set_pipeline_statistics(!plan.cpu_timing);
+    renderer.set_cpu_timing(plan.cpu_timing);
     let (t0, t1) = paths::duration(&scene.paths);
     let mut pass_samples: Vec<PassSamples> = Vec::new();
     let (mut frame_gpu, mut technique_gpu, mut frame_cpu) = (Vec::new(), Vec::new(), Vec::new());

@@ -108,6 +108,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                         set: split_sets(&run.set, &techniques)?,
                         techniques,
                         flicker: !args.no_flicker,
+                        cpu_timing: args.cpu_timing,
                     })
                 })
                 .collect::<anyhow::Result<Vec<_>>>()

@@ -104,6 +104,8 @@ pub struct BenchPlan {
     /// Fixed parameters as (technique, key, value).
     pub set: Vec<(String, String, String)>,
     pub flicker: bool,
+    /// Time passes on the CPU clock ([`zoo_host::Renderer::set_cpu_timing`]).
+    pub cpu_timing: bool,
 }
 
 /// One measured configuration.
@@ -234,6 +236,7 @@ pub fn plan_from_args(args: &BenchArgs, scene: &Path) -> anyhow::Result<BenchPla
         sweeps,
         set,
         flicker: !args.no_flicker,
+        cpu_timing: args.cpu_timing,
     })
 }
 

@@ -302,6 +302,18 @@ impl Renderer {
         self.statistics.is_some()
     }
 
+    /// Times passes on the CPU clock, each submitted on its own and waited for, instead of
+    /// with GPU timestamps (when `enabled`; timestamps are used again where the device has
+    /// them otherwise). CPU drivers such as lavapipe run compute dispatches outside the span
+    /// their timestamps measure.
+    pub fn set_cpu_timing(&mut self, enabled: bool) {
+        self.timestamps = if enabled {
+            None
+        } else {
+            TimestampQueries::new(&self.gpu)
+        };
+    }
+
     /// Changes the output size.
     pub fn set_size(&mut self, size: UVec2) -> Result<(), RenderError> {
         check_size(size)?;

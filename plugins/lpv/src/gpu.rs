@@ -1,0 +1,527 @@
+//! The GPU side of the light propagation volumes: the reflective shadow maps and the pass that
+//! fills them, the grids' buffers and the compute passes over them.
+
+use zoo_host::glam::{UVec2, Vec3};
+use zoo_host::kit::{self, UniformSlots, bind_group_layout, pipeline_layout};
+use zoo_host::prelude::*;
+use zoo_host::render::Vertex;
+use zoo_shadow_maps::light_space::LightFrustum;
+
+use crate::cascades::Grid;
+
+/// Most grids (`MAX_CASCADES` in `lpv/volume.wgsl`).
+pub const MAX_CASCADES: usize = 4;
+
+/// `LpvSettings` in `lpv/volume.wgsl`.
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+pub struct LpvSettings {
+    pub grid_size: u32,
+    pub cascade_count: u32,
+    pub light_scale: f32,
+    pub occluder_scale: f32,
+    pub occlusion: u32,
+    pub damping: f32,
+    pub intensity: f32,
+    pub camera_occluders: u32,
+    pub blend_cells: f32,
+    pub debug_cascade: u32,
+    pub debug_source: u32,
+    pub _pad: u32,
+}
+
+/// `Cascade` in `lpv/volume.wgsl`.
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+pub struct GpuCascade {
+    pub min: [f32; 3],
+    pub cell: f32,
+}
+
+/// `LpvData` in `lpv/volume.wgsl`.
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+pub struct LpvData {
+    pub settings: LpvSettings,
+    pub origin: [f32; 4],
+    pub cascades: [GpuCascade; MAX_CASCADES],
+}
+
+impl LpvData {
+    /// The data for `settings` and `grids`, with map positions relative to `origin`.
+    pub fn new(settings: LpvSettings, origin: Vec3, grids: &[Grid]) -> LpvData {
+        let mut cascades = [GpuCascade::default(); MAX_CASCADES];
+        for (slot, grid) in cascades.iter_mut().zip(grids) {
+            *slot = GpuCascade {
+                min: grid.min.to_array(),
+                cell: grid.cell,
+            };
+        }
+        LpvData {
+            settings,
+            origin: origin.extend(1.0).to_array(),
+            cascades,
+        }
+    }
+}
+
+/// `RsmCamera` in `lpv/rsm.wgsl`.
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+pub struct RsmCamera {
+    pub view_proj: [[f32; 4]; 4],
+    pub eye: [f32; 4],
+    pub axis: [f32; 4],
+    pub origin: [f32; 4],
+    pub light: u32,
+    pub _pad: [u32; 3],
+}
+
+impl RsmCamera {
+    /// The camera of `frustum` for light `light` at `resolution` texels a side, storing
+    /// positions relative to `origin`.
+    pub fn new(frustum: &LightFrustum, light: usize, resolution: u32, origin: Vec3) -> RsmCamera {
+        use zoo_shadow_maps::light_space::Projection;
+        let inverse = frustum.view.inverse();
+        let eye = inverse.w_axis.truncate();
+        let axis = -inverse.z_axis.truncate().normalize();
+        let (perspective, texel) = match frustum.projection {
+            Projection::Perspective { tan_half_fov, .. } => {
+                (1.0, 2.0 * tan_half_fov / resolution as f32)
+            }
+            Projection::Orthographic { extent, .. } => (0.0, extent / resolution as f32),
+            Projection::Warped => (0.0, 0.0),
+        };
+        RsmCamera {
+            view_proj: frustum.view_proj.to_cols_array_2d(),
+            eye: eye.extend(perspective).to_array(),
+            axis: axis.extend(texel).to_array(),
+            origin: origin.extend(1.0).to_array(),
+            light: light as u32,
+            _pad: [0; 3],
+        }
+    }
+}
+
+/// The reflective shadow maps (flux, normal and area, position; a layer per light) and the
+/// pass that renders them.
+pub struct Rsm {
+    pipeline: wgpu::RenderPipeline,
+    cameras: UniformSlots<RsmCamera>,
+    /// (flux, normal, position, depth) arrays, once sized.
+    pub targets: Option<RsmTargets>,
+}
+
+/// The maps of [`Rsm`].
+pub struct RsmTargets {
+    pub resolution: u32,
+    pub layers: u32,
+    pub flux: (wgpu::Texture, wgpu::TextureView),
+    pub normal: (wgpu::Texture, wgpu::TextureView),
+    pub position: (wgpu::Texture, wgpu::TextureView),
+    depth: wgpu::Texture,
+    /// Per layer: views of the three colour maps and the depth.
+    layer_views: Vec<[wgpu::TextureView; 4]>,
+}
+
+/// Formats of the flux, normal and position maps.
+pub const RSM_FORMATS: [wgpu::TextureFormat; 3] = [
+    wgpu::TextureFormat::Rgba16Float,
+    wgpu::TextureFormat::Rgba16Float,
+    wgpu::TextureFormat::Rgba16Float,
+];
+
+fn array_texture(
+    gpu: &GpuContext,
+    label: &str,
+    resolution: u32,
+    layers: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: resolution,
+            height: resolution,
+            depth_or_array_layers: zoo_host::gpu::array_layers(gpu, resolution, resolution, layers),
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
+}
+
+fn layer_view(texture: &wgpu::Texture, label: &str, layer: u32) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some(label),
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
+}
+
+fn array_view(texture: &wgpu::Texture, label: &str, layers: u32) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some(label),
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        array_layer_count: Some(layers),
+        ..Default::default()
+    })
+}
+
+impl RsmTargets {
+    fn new(gpu: &GpuContext, resolution: u32, layers: u32) -> RsmTargets {
+        let layers = layers.max(1);
+        let names = ["lpv rsm flux", "lpv rsm normal", "lpv rsm position"];
+        let maps: Vec<wgpu::Texture> = names
+            .iter()
+            .zip(RSM_FORMATS)
+            .map(|(name, format)| array_texture(gpu, name, resolution, layers, format))
+            .collect();
+        let depth = array_texture(
+            gpu,
+            "lpv rsm depth",
+            resolution,
+            layers,
+            wgpu::TextureFormat::Depth32Float,
+        );
+        let layer_views = (0..layers)
+            .map(|l| {
+                [
+                    layer_view(&maps[0], "lpv rsm flux layer", l),
+                    layer_view(&maps[1], "lpv rsm normal layer", l),
+                    layer_view(&maps[2], "lpv rsm position layer", l),
+                    layer_view(&depth, "lpv rsm depth layer", l),
+                ]
+            })
+            .collect();
+        let with_view = |t: &wgpu::Texture, name: &str| (t.clone(), array_view(t, name, layers));
+        RsmTargets {
+            resolution,
+            layers,
+            flux: with_view(&maps[0], "lpv rsm flux (array)"),
+            normal: with_view(&maps[1], "lpv rsm normal (array)"),
+            position: with_view(&maps[2], "lpv rsm position (array)"),
+            depth,
+            layer_views,
+        }
+    }
+
+    /// The layer-0 view of map `k` (0 flux, 1 normal, 2 position), for debug views.
+    pub fn first_layer(&self, k: usize) -> &wgpu::TextureView {
+        &self.layer_views[0][k]
+    }
+
+    /// Bytes of GPU memory.
+    pub fn bytes(&self) -> u64 {
+        let texels = u64::from(self.resolution).pow(2) * u64::from(self.layers);
+        texels * (8 + 8 + 8 + 4)
+    }
+
+    /// The depth array (for the memory table).
+    pub fn depth(&self) -> &wgpu::Texture {
+        &self.depth
+    }
+}
+
+/// Pass names.
+pub const RSM_PASS: &str = "LPV RSM";
+pub const INJECT_PASS: &str = "LPV injection";
+pub const CAMERA_OCCLUDERS_PASS: &str = "LPV camera occluders";
+pub const RESOLVE_PASS: &str = "LPV resolve";
+pub const PROPAGATE_PASS: &str = "LPV propagation";
+pub const LOOKUP_PASS: &str = "LPV lookup";
+pub const DEBUG_VOLUME_PASS: &str = "LPV debug volume";
+pub const DEBUG_BOUNDS_PASS: &str = "LPV debug bounds";
+
+impl Rsm {
+    pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Rsm> {
+        let device = &ctx.gpu.device;
+        let module = ctx.shaders.create_module(device, "lpv/rsm.wgsl")?;
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let cameras = UniformSlots::new(ctx.gpu, "lpv rsm cameras", 1, stages);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lpv rsm pipeline layout"),
+            bind_group_layouts: &[Some(&ctx.frame.layout), Some(cameras.layout())],
+            immediate_size: 0,
+        });
+        let targets: Vec<Option<wgpu::ColorTargetState>> = RSM_FORMATS
+            .iter()
+            .map(|format| {
+                Some(wgpu::ColorTargetState {
+                    format: *format,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })
+            })
+            .collect();
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("lpv rsm pipeline"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_rsm"),
+                compilation_options: Default::default(),
+                buffers: &[Some(Vertex::LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_rsm"),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Ok(Rsm {
+            pipeline,
+            cameras,
+            targets: None,
+        })
+    }
+
+    /// Sizes the maps and uploads one camera per layer.
+    pub fn prepare(&mut self, ctx: &RenderContext<'_>, resolution: u32, cameras: &[RsmCamera]) {
+        let layers = cameras.len() as u32;
+        if self
+            .targets
+            .as_ref()
+            .is_none_or(|t| (t.resolution, t.layers) != (resolution, layers.max(1)))
+        {
+            self.targets = Some(RsmTargets::new(ctx.gpu, resolution, layers));
+        }
+        self.cameras.write(ctx.gpu, cameras);
+    }
+
+    /// Renders every layer: one pass per light, `"LPV RSM: light {l}"`.
+    pub fn record(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        lights: &[usize],
+    ) -> TechniqueResult {
+        let targets = self
+            .targets
+            .as_ref()
+            .ok_or_else(TechniqueError::not_prepared)?;
+        for (layer, light) in lights.iter().enumerate() {
+            let views = &targets.layer_views[layer];
+            let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
+            let colors: Vec<_> = views[..3]
+                .iter()
+                .map(|v| zoo_host::gpu::color_attachment(v, clear))
+                .collect();
+            let label = kit::light_pass_name(RSM_PASS, *light);
+            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(&label),
+                color_attachments: &colors,
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &views[3],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+            pass.set_bind_group(1, self.cameras.bind_group(), &[self.cameras.offset(layer)]);
+            ctx.scene_buffers.draw_objects(&mut pass, ctx.scene, false);
+        }
+        Ok(())
+    }
+}
+
+/// The grids' buffers: fixed-point injection sums, two propagation steps and the accumulated
+/// light.
+pub struct Volumes {
+    pub cells: u64,
+    pub light_sums: wgpu::Buffer,
+    pub occluder_sums: wgpu::Buffer,
+    pub steps: [wgpu::Buffer; 2],
+    pub accumulated: wgpu::Buffer,
+}
+
+impl Volumes {
+    pub fn new(gpu: &GpuContext, cells: u64) -> Volumes {
+        let buffer = |label: &str, size: u64| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let light = cells * 3 * 16;
+        Volumes {
+            cells,
+            light_sums: buffer("lpv light sums", cells * 12 * 4),
+            occluder_sums: buffer("lpv occluder sums", 2 * cells * 4 * 4),
+            steps: [buffer("lpv step a", light), buffer("lpv step b", light)],
+            accumulated: buffer("lpv accumulated light", light),
+        }
+    }
+
+    /// Bytes of GPU memory.
+    pub fn bytes(&self) -> u64 {
+        self.cells * (12 * 4 + 2 * 4 * 4 + 3 * 3 * 16)
+    }
+}
+
+/// A compute pipeline with its own bind group layout, after the host's groups when `host`.
+pub struct Stage {
+    pipeline: wgpu::ComputePipeline,
+    pub layout: wgpu::BindGroupLayout,
+}
+
+impl Stage {
+    pub fn new(
+        ctx: &RenderContext<'_>,
+        shader: &str,
+        entry: &str,
+        entries: &[wgpu::BindGroupLayoutEntry],
+        host: bool,
+    ) -> TechniqueResult<Stage> {
+        let device = &ctx.gpu.device;
+        let module = ctx.shaders.create_module(device, shader)?;
+        let layout = bind_group_layout(device, &format!("{shader} layout"), entries);
+        let label = format!("{shader} pipeline layout");
+        let pipeline_layout = if host {
+            pipeline_layout(ctx, &label, &[&layout])
+        } else {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(&label),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            })
+        };
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(&format!("{shader} {entry}")),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Ok(Stage { pipeline, layout })
+    }
+
+    /// Records one dispatch named `name` with `group` (at group 2 after the host's groups when
+    /// the stage has them, else at 0).
+    pub fn dispatch(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        name: &str,
+        group: &wgpu::BindGroup,
+        host: bool,
+        workgroups: [u32; 3],
+    ) {
+        let mut pass = recorder.compute_pass(name);
+        pass.set_pipeline(&self.pipeline);
+        if host {
+            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+            pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
+            pass.set_bind_group(2, group, &[]);
+        } else {
+            pass.set_bind_group(0, group, &[]);
+        }
+        pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
+    }
+}
+
+pub fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    kit::storage(binding, wgpu::ShaderStages::COMPUTE, read_only)
+}
+
+pub fn texture_array(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    kit::texture(
+        binding,
+        wgpu::ShaderStages::COMPUTE,
+        wgpu::TextureSampleType::Float { filterable: false },
+        wgpu::TextureViewDimension::D2Array,
+    )
+}
+
+pub fn storage_texture(
+    binding: u32,
+    format: wgpu::TextureFormat,
+    dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: dimension,
+        },
+        count: None,
+    }
+}
+
+/// The debug images: one grid as a volume, and the grid bounds on screen.
+pub struct DebugTargets {
+    pub volume: (wgpu::Texture, wgpu::TextureView),
+    pub bounds: (wgpu::Texture, wgpu::TextureView),
+}
+
+impl DebugTargets {
+    pub fn new(gpu: &GpuContext, grid: u32, size: UVec2) -> DebugTargets {
+        let volume = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("lpv debug volume"),
+            size: wgpu::Extent3d {
+                width: grid,
+                height: grid,
+                depth_or_array_layers: grid,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let volume_view = volume.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("lpv debug volume view"),
+            ..Default::default()
+        });
+        let bounds = zoo_host::gpu::render_target(
+            &gpu.device,
+            "lpv debug bounds",
+            size,
+            wgpu::TextureFormat::Rgba8Unorm,
+            wgpu::TextureUsages::STORAGE_BINDING,
+        );
+        DebugTargets {
+            volume: (volume, volume_view),
+            bounds,
+        }
+    }
+}
+
+/// The largest channel of a colour.
+pub fn brightest(c: Vec3) -> f32 {
+    c.max_element().max(0.0)
+}

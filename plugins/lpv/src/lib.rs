@@ -1,0 +1,859 @@
+//! Cascaded light propagation volumes fed by reflective shadow maps (seed 002: Kaplanyan and
+//! Dachsbacher 2010, Dachsbacher and Stamminger 2005): one-bounce diffuse indirect light.
+//!
+//! Each directional light (and spot light, as an option) renders a reflective shadow map of
+//! the whole scene: per texel the light its surface reflects, its normal and area, and its
+//! position. Every texel is a virtual point light whose clamped-cosine lobe goes, as two-band
+//! spherical harmonics, into the cell of each cascaded grid it lies in (moved half a cell along
+//! its normal); its surfel, and every G-buffer pixel's, adds blocking potential to a geometry
+//! volume offset by half a cell. Light then spreads cell to cell through the faces of each
+//! grid for a number of iterations, attenuated by the geometry volume, and the accumulated
+//! light is looked up at every pixel into the host's indirect target. Direct shadows come from
+//! the shadow-map library (3 x 3 PCF).
+
+pub mod cascades;
+pub mod gpu;
+pub mod sh;
+
+use zoo_host::glam::Vec3;
+use zoo_host::kit::{FullscreenLightPass, light_pass_name};
+use zoo_host::prelude::*;
+use zoo_host::technique::{
+    DebugImage, DebugVolume, ResourceInfo, ViewMapping, VolumeAxis, VolumeSlice,
+};
+use zoo_shadow_maps::light_space::{directional_frustum_over, spot_frustum};
+use zoo_shadow_maps::{DepthState, ShadowMapSet, object_bounds};
+
+use gpu::{
+    DebugTargets, LpvData, LpvSettings, Rsm, RsmCamera, Stage, Volumes, storage, storage_texture,
+    texture_array,
+};
+
+zoo_host::param_choice! {
+    /// The axis the volume debug views cut across.
+    pub enum SliceAxis { X, Y, Z }
+}
+
+zoo_host::technique_params! {
+    /// Parameters of cascaded light propagation volumes.
+    pub struct LpvParams {
+        /// Cascaded grids, cell sizes doubling from the finest.
+        cascades: u32 = 3, range(1, 4), step(1);
+        /// Cells along each side of a grid.
+        grid_size: u32 = 32, range(8, 64), step(8);
+        /// Propagation steps (light travels one cell a step).
+        iterations: u32 = 8, range(0, 64), step(1);
+        /// Reflective-shadow-map resolution: its texels are the virtual point lights.
+        rsm_size: u32 = 256, range(64, 1024), step(64);
+        /// Block propagation with the geometry volume.
+        occlusion: bool = true;
+        /// Add the camera's G-buffer surfels to the geometry volume.
+        camera_occluders: bool = true;
+        /// Lookups move this fraction of a cell along the normal (against self-bleeding).
+        damping: f32 = 0.5, range(0.0, 1.0), step(0.05);
+        /// Multiplies the indirect light.
+        intensity: f32 = 1.0, range(0.0, 10.0), step(0.1);
+        /// Finest cell size in world units (0: the coarsest grid spans the scene's diagonal).
+        finest_cell: f32 = 0.0, range(0.0, 100.0), step(0.05);
+        /// Cells over which a finer grid fades into the next at its border.
+        blend_cells: f32 = 2.0, range(0.0, 8.0), step(0.5);
+        /// Spot lights also render reflective shadow maps (directional lights always do).
+        spot_lights: bool = false;
+        /// Direct shadow-map resolution.
+        map_size: u32 = 2048, range(256, 8192), step(256);
+        /// Grid the volume debug views show (0 the finest).
+        debug_cascade: u32 = 0, range(0, 3), step(1);
+        /// Axis the volume debug views cut across.
+        slice_axis: SliceAxis = SliceAxis::Y;
+        /// Cell index of the volume debug views' slice.
+        slice_index: u32 = 8, range(0, 63), step(1);
+    }
+}
+
+/// `LpvShadow` in `lpv/visibility.wgsl`.
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+struct LpvShadow {
+    first_layer: u32,
+    layer_count: u32,
+    light: u32,
+    perspective: u32,
+    texel_scale: f32,
+    normal_offset: f32,
+    _pad0: f32,
+    _pad1: f32,
+}
+
+const MAP_PASS: &str = "LPV shadow map";
+const SHADOW_PASS: &str = "LPV shadows";
+const VOLUME_VIEWS: [&str; 2] = ["light volume", "geometry volume"];
+const RSM_VIEWS: [&str; 3] = ["RSM flux", "RSM normals", "RSM positions"];
+
+/// The compute stages.
+struct Stages {
+    inject: Stage,
+    camera_occluders: Stage,
+    resolve: Stage,
+    propagate: Stage,
+    lookup: Stage,
+    debug_volume: Stage,
+    debug_bounds: Stage,
+}
+
+impl Stages {
+    fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Stages> {
+        use wgpu::TextureFormat as F;
+        use wgpu::TextureViewDimension as D;
+        Ok(Stages {
+            inject: Stage::new(
+                ctx,
+                "lpv/inject.wgsl",
+                "cs_inject",
+                &[
+                    storage(0, true),
+                    texture_array(1),
+                    texture_array(2),
+                    texture_array(3),
+                    storage(4, false),
+                    storage(5, false),
+                ],
+                false,
+            )?,
+            camera_occluders: Stage::new(
+                ctx,
+                "lpv/inject_camera.wgsl",
+                "cs_inject_camera",
+                &[storage(0, true), storage(1, false)],
+                true,
+            )?,
+            resolve: Stage::new(
+                ctx,
+                "lpv/resolve.wgsl",
+                "cs_resolve",
+                &[
+                    storage(0, true),
+                    storage(1, true),
+                    storage(2, false),
+                    storage(3, false),
+                ],
+                false,
+            )?,
+            propagate: Stage::new(
+                ctx,
+                "lpv/propagate.wgsl",
+                "cs_propagate",
+                &[
+                    storage(0, true),
+                    storage(1, true),
+                    storage(2, false),
+                    storage(3, false),
+                    storage(4, true),
+                ],
+                false,
+            )?,
+            lookup: Stage::new(
+                ctx,
+                "lpv/lookup.wgsl",
+                "cs_lookup",
+                &[
+                    storage(0, true),
+                    storage(1, true),
+                    storage_texture(2, F::Rgba16Float, D::D2),
+                ],
+                true,
+            )?,
+            debug_volume: Stage::new(
+                ctx,
+                "lpv/debug.wgsl",
+                "cs_volume",
+                &[
+                    storage(0, true),
+                    storage(1, true),
+                    storage(2, true),
+                    storage_texture(3, F::Rgba16Float, D::D3),
+                    storage_texture(4, F::Rgba8Unorm, D::D2),
+                ],
+                true,
+            )?,
+            debug_bounds: Stage::new(
+                ctx,
+                "lpv/debug.wgsl",
+                "cs_bounds",
+                &[
+                    storage(0, true),
+                    storage(1, true),
+                    storage(2, true),
+                    storage_texture(3, F::Rgba16Float, D::D3),
+                    storage_texture(4, F::Rgba8Unorm, D::D2),
+                ],
+                true,
+            )?,
+        })
+    }
+}
+
+/// Bind groups over the current buffers and targets.
+struct Groups {
+    inject: wgpu::BindGroup,
+    camera_occluders: wgpu::BindGroup,
+    resolve: wgpu::BindGroup,
+    /// Step a to b, and b to a.
+    propagate: [wgpu::BindGroup; 2],
+    lookup: wgpu::BindGroup,
+    debug: wgpu::BindGroup,
+}
+
+/// Everything built at the first `prepare`.
+struct Gpu {
+    maps: ShadowMapSet,
+    shadows: FullscreenLightPass<LpvShadow>,
+    rsm: Rsm,
+    stages: Stages,
+    volumes: Option<Volumes>,
+    data: wgpu::Buffer,
+    debug: Option<DebugTargets>,
+    groups: Option<Groups>,
+    /// Lights with a reflective shadow map, one per layer.
+    rsm_lights: Vec<usize>,
+    /// What the debug pass draws this frame: the volume (true) or the bounds (false).
+    debug_pass: Option<bool>,
+}
+
+impl Gpu {
+    fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Gpu> {
+        let state = DepthState {
+            slope_bias: 1.5,
+            ..DepthState::default()
+        };
+        let maps = ShadowMapSet::new(ctx, "lpv shadow maps", state, None)?;
+        let shadows = FullscreenLightPass::new(
+            ctx,
+            "lpv/visibility.wgsl",
+            "fs_visibility",
+            &[maps.lookup_layout()],
+        )?;
+        let data = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lpv data"),
+            size: size_of::<LpvData>() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Gpu {
+            maps,
+            shadows,
+            rsm: Rsm::new(ctx)?,
+            stages: Stages::new(ctx)?,
+            volumes: None,
+            data,
+            debug: None,
+            groups: None,
+            rsm_lights: Vec::new(),
+            debug_pass: None,
+        })
+    }
+}
+
+/// Cascaded light propagation volumes.
+pub struct Lpv {
+    params: LpvParams,
+    gpu: Option<Gpu>,
+}
+
+impl Lpv {
+    /// The lights that render a reflective shadow map.
+    fn rsm_lights(&self, lights: &[zoo_host::Light]) -> Vec<usize> {
+        (0..lights.len())
+            .filter(|&i| match lights[i].kind {
+                LightKind::Directional => true,
+                LightKind::Spot => self.params.spot_lights,
+                LightKind::Point => false,
+            })
+            .collect()
+    }
+}
+
+/// The fixed-point scale of the injected light: all the light every virtual point light of
+/// `resolution`² texels can carry (radiance × the texel's area across the light's rays, which
+/// for spot lights the falloff bounds by the texel's solid angle), times the lobe's largest
+/// coefficient, fits in 2^30.
+fn light_scale(
+    lights: &[zoo_host::Light],
+    rsm: &[usize],
+    cameras: &[RsmCamera],
+    resolution: u32,
+) -> f32 {
+    let most: f32 = rsm
+        .iter()
+        .zip(cameras)
+        .map(|(&l, c)| {
+            let texel = c.axis[3];
+            gpu::brightest(lights[l].radiance) * texel * texel * (resolution as f32).powi(2)
+        })
+        .sum();
+    1.0e9 / (most.max(1e-12) * sh::COS1)
+}
+
+impl ShadowTechnique for Lpv {
+    fn passes(&self) -> Vec<PassInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut passes: Vec<PassInfo> = gpu
+            .maps
+            .pass_names(MAP_PASS)
+            .into_iter()
+            .map(PassInfo::render)
+            .collect();
+        passes.extend(
+            gpu.rsm_lights
+                .iter()
+                .map(|&l| PassInfo::render(light_pass_name(gpu::RSM_PASS, l))),
+        );
+        passes.push(PassInfo::compute(gpu::INJECT_PASS));
+        if self.params.occlusion && self.params.camera_occluders {
+            passes.push(PassInfo::compute(gpu::CAMERA_OCCLUDERS_PASS));
+        }
+        passes.push(PassInfo::compute(gpu::RESOLVE_PASS));
+        for i in 0..self.params.iterations {
+            passes.push(PassInfo::compute(format!(
+                "{} {}",
+                gpu::PROPAGATE_PASS,
+                i + 1
+            )));
+        }
+        passes.push(PassInfo::compute(gpu::LOOKUP_PASS));
+        passes.extend(gpu.shadows.passes(SHADOW_PASS));
+        match gpu.debug_pass {
+            Some(true) => passes.push(PassInfo::compute(gpu::DEBUG_VOLUME_PASS)),
+            Some(false) => passes.push(PassInfo::compute(gpu::DEBUG_BOUNDS_PASS)),
+            None => {}
+        }
+        passes
+    }
+
+    fn resources(&self) -> Vec<ResourceInfo> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        if let Some(t) = &gpu.rsm.targets {
+            for (k, name) in RSM_VIEWS.into_iter().enumerate() {
+                let texture = [&t.flux.0, &t.normal.0, &t.position.0][k];
+                out.push(ResourceInfo::texture(name, texture, true));
+            }
+            out.push(ResourceInfo::texture("RSM depth", t.depth(), false));
+        }
+        if let Some(v) = &gpu.volumes {
+            out.push(ResourceInfo::buffer(
+                "light sums",
+                &v.light_sums,
+                "i32 x 12",
+            ));
+            out.push(ResourceInfo::buffer(
+                "occluder sums",
+                &v.occluder_sums,
+                "i32 x 4 x 2",
+            ));
+            out.push(ResourceInfo::buffer(
+                "propagation step a",
+                &v.steps[0],
+                "vec4 x 3",
+            ));
+            out.push(ResourceInfo::buffer(
+                "propagation step b",
+                &v.steps[1],
+                "vec4 x 3",
+            ));
+            out.push(ResourceInfo::buffer(
+                "accumulated light",
+                &v.accumulated,
+                "vec4 x 3",
+            ));
+        }
+        if let Some(d) = &gpu.debug {
+            for (k, name) in VOLUME_VIEWS.into_iter().enumerate() {
+                let mut info = ResourceInfo::texture(name, &d.volume.0, true);
+                info.bytes *= u64::from(k == 0);
+                out.push(info);
+            }
+            out.push(ResourceInfo::texture("cascade bounds", &d.bounds.0, true));
+        }
+        if let Some(maps) = gpu.maps.maps() {
+            out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
+        }
+        out
+    }
+
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
+        if self.gpu.is_none() || changes.scene {
+            self.gpu = Some(Gpu::new(ctx)?);
+        }
+        let rsm_lights = self.rsm_lights(ctx.lights);
+        let p = self.params.clone();
+        let gpu = self.gpu.as_mut().expect("built above");
+        let replaced = gpu.maps.prepare(ctx, changes, p.map_size, true);
+        // Reflective shadow maps over the whole scene.
+        let objects = object_bounds(ctx.scene, false);
+        let bounds = objects.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
+        );
+        let origin = (bounds.0 + bounds.1) * 0.5;
+        let cameras: Vec<RsmCamera> = rsm_lights
+            .iter()
+            .map(|&l| {
+                let light = &ctx.lights[l];
+                let frustum = match light.kind {
+                    LightKind::Spot => spot_frustum(light),
+                    _ => directional_frustum_over(light.direction, bounds),
+                };
+                RsmCamera::new(&frustum, l, p.rsm_size, origin)
+            })
+            .collect();
+        gpu.rsm.prepare(ctx, p.rsm_size, &cameras);
+        gpu.rsm_lights = rsm_lights.clone();
+        // The grids, in front of the camera.
+        let diagonal = bounds.0.distance(bounds.1);
+        let finest = if p.finest_cell > 0.0 {
+            p.finest_cell
+        } else {
+            cascades::finest_cell(diagonal, p.grid_size, p.cascades)
+        };
+        let view = (ctx.camera.target - ctx.camera.position).normalize_or(Vec3::NEG_Z);
+        let grids = cascades::place(ctx.camera.position, view, p.grid_size, p.cascades, finest);
+        let cells = u64::from(p.cascades) * u64::from(p.grid_size).pow(3);
+        let new_volumes = gpu.volumes.as_ref().is_none_or(|v| v.cells != cells);
+        if new_volumes {
+            gpu.volumes = Some(Volumes::new(ctx.gpu, cells));
+        }
+        let new_debug = gpu.debug.as_ref().is_none_or(|d| {
+            d.volume.0.width() != p.grid_size
+                || (d.bounds.0.width(), d.bounds.0.height()) != (ctx.size.x, ctx.size.y)
+        });
+        if new_debug {
+            gpu.debug = Some(DebugTargets::new(ctx.gpu, p.grid_size, ctx.size));
+        }
+        let settings = LpvSettings {
+            grid_size: p.grid_size,
+            cascade_count: p.cascades,
+            light_scale: light_scale(ctx.lights, &rsm_lights, &cameras, p.rsm_size),
+            occluder_scale: 1.0e6,
+            occlusion: u32::from(p.occlusion),
+            damping: p.damping,
+            intensity: p.intensity,
+            camera_occluders: u32::from(p.camera_occluders),
+            blend_cells: p.blend_cells,
+            debug_cascade: p.debug_cascade.min(p.cascades - 1),
+            debug_source: 0,
+            _pad: 0,
+        };
+        let data = LpvData::new(settings, origin, &grids);
+        ctx.gpu
+            .queue
+            .write_buffer(&gpu.data, 0, bytemuck::bytes_of(&data));
+        let _ = replaced;
+        gpu.groups = Some(bind(ctx, gpu));
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> TechniqueResult {
+        let p = self.params.clone();
+        let gpu = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        let (Some(groups), Some(volumes), Some(targets)) =
+            (&gpu.groups, &gpu.volumes, &gpu.rsm.targets)
+        else {
+            return Err(TechniqueError::not_prepared());
+        };
+        gpu.maps.record(ctx, recorder, MAP_PASS)?;
+        gpu.rsm.record(ctx, recorder, &gpu.rsm_lights)?;
+        let encoder = recorder.encoder();
+        encoder.clear_buffer(&volumes.light_sums, 0, None);
+        encoder.clear_buffer(&volumes.occluder_sums, 0, None);
+        let s = &gpu.stages;
+        let rsm_groups = targets.resolution.div_ceil(8);
+        let layers = gpu.rsm_lights.len() as u32;
+        if layers > 0 {
+            s.inject.dispatch(
+                ctx,
+                recorder,
+                gpu::INJECT_PASS,
+                &groups.inject,
+                false,
+                [rsm_groups, rsm_groups, layers],
+            );
+        } else {
+            drop(recorder.compute_pass(gpu::INJECT_PASS));
+        }
+        let screen = [ctx.size.x.div_ceil(8), ctx.size.y.div_ceil(8), 1];
+        if p.occlusion && p.camera_occluders {
+            s.camera_occluders.dispatch(
+                ctx,
+                recorder,
+                gpu::CAMERA_OCCLUDERS_PASS,
+                &groups.camera_occluders,
+                true,
+                screen,
+            );
+        }
+        let entries = (volumes.cells * 3) as u32;
+        s.resolve.dispatch(
+            ctx,
+            recorder,
+            gpu::RESOLVE_PASS,
+            &groups.resolve,
+            false,
+            [entries.div_ceil(64), 1, 1],
+        );
+        let n = p.grid_size.div_ceil(4);
+        for i in 0..p.iterations {
+            let name = format!("{} {}", gpu::PROPAGATE_PASS, i + 1);
+            let group = &groups.propagate[(i % 2) as usize];
+            s.propagate
+                .dispatch(ctx, recorder, &name, group, false, [n, n, n * p.cascades]);
+        }
+        s.lookup.dispatch(
+            ctx,
+            recorder,
+            gpu::LOOKUP_PASS,
+            &groups.lookup,
+            true,
+            screen,
+        );
+        let Some(lookup_group) = gpu.maps.lookup_group() else {
+            return Err(TechniqueError::not_prepared());
+        };
+        let lights = gpu.maps.lights().to_vec();
+        let resolution = gpu.maps.resolution();
+        let shadow = |light: usize| {
+            let maps = &lights[light];
+            let scale = maps.scale(resolution);
+            LpvShadow {
+                first_layer: maps.first_layer,
+                layer_count: maps.frustums.len() as u32,
+                light: light as u32,
+                perspective: u32::from(scale.perspective),
+                texel_scale: scale.texel_scale,
+                normal_offset: 1.5,
+                _pad0: 0.0,
+                _pad1: 0.0,
+            }
+        };
+        let bind = |_, pass: &mut wgpu::RenderPass<'_>| pass.set_bind_group(3, lookup_group, &[]);
+        gpu.shadows
+            .record_with(ctx, recorder, SHADOW_PASS, shadow, bind);
+        // Debug views.
+        let shown = ctx.debug_view;
+        gpu.debug_pass = None;
+        if let Some(name) = shown {
+            let volume = VOLUME_VIEWS.iter().position(|v| *v == name);
+            if let Some(source) = volume {
+                let offset = std::mem::offset_of!(LpvSettings, debug_source) as u64;
+                let code = source as u32;
+                ctx.gpu
+                    .queue
+                    .write_buffer(&gpu.data, offset, bytemuck::bytes_of(&code));
+                let g = p.grid_size.div_ceil(4);
+                let stage = &gpu.stages.debug_volume;
+                stage.dispatch(
+                    ctx,
+                    recorder,
+                    gpu::DEBUG_VOLUME_PASS,
+                    &groups.debug,
+                    true,
+                    [g, g, g],
+                );
+                gpu.debug_pass = Some(true);
+            } else if name == "cascade bounds" {
+                let stage = &gpu.stages.debug_bounds;
+                stage.dispatch(
+                    ctx,
+                    recorder,
+                    gpu::DEBUG_BOUNDS_PASS,
+                    &groups.debug,
+                    true,
+                    screen,
+                );
+                gpu.debug_pass = Some(false);
+            }
+        }
+        Ok(())
+    }
+
+    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let gpu = self.gpu.as_ref()?;
+        if resource == "shadow maps" {
+            return gpu.maps.debug_image(0);
+        }
+        if resource == "cascade bounds" {
+            return Some(DebugImage {
+                view: &gpu.debug.as_ref()?.bounds.1,
+                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
+            });
+        }
+        let k = RSM_VIEWS.iter().position(|v| *v == resource)?;
+        let targets = gpu.rsm.targets.as_ref()?;
+        let mapping = match k {
+            // Flux: scaled so a texel of the sun's brightness shows.
+            0 => ViewMapping::Color {
+                min: 0.0,
+                max: 1e-3,
+            },
+            1 => ViewMapping::Color {
+                min: -1.0,
+                max: 1.0,
+            },
+            _ => ViewMapping::Color {
+                min: -20.0,
+                max: 20.0,
+            },
+        };
+        Some(DebugImage {
+            view: targets.first_layer(k),
+            mapping,
+        })
+    }
+
+    fn debug_volume(&self, resource: &str) -> Option<DebugVolume<'_>> {
+        let source = VOLUME_VIEWS.iter().position(|v| *v == resource)?;
+        let gpu = self.gpu.as_ref()?;
+        let axis = match self.params.slice_axis {
+            SliceAxis::X => VolumeAxis::X,
+            SliceAxis::Y => VolumeAxis::Y,
+            SliceAxis::Z => VolumeAxis::Z,
+        };
+        let max = if source == 0 { 0.05 } else { 0.5 };
+        Some(DebugVolume {
+            view: &gpu.debug.as_ref()?.volume.1,
+            mapping: ViewMapping::Color { min: 0.0, max },
+            slice: VolumeSlice {
+                axis,
+                index: self.params.slice_index,
+            },
+        })
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+        // Buffers and maps follow the parameters at the next `prepare`.
+        self.params = LpvParams::from_values(values)?;
+        Ok(ParamUpdate::Applied)
+    }
+
+    fn counters(&self) -> Vec<(String, f64)> {
+        let Some(gpu) = &self.gpu else {
+            return Vec::new();
+        };
+        let mut counters = gpu.maps.counters();
+        let vpls = gpu.rsm.targets.as_ref().map_or(0, |t| {
+            u64::from(t.resolution).pow(2) * gpu.rsm_lights.len() as u64
+        });
+        counters.push(("virtual point lights".into(), vpls as f64));
+        let cells = gpu.volumes.as_ref().map_or(0, |v| v.cells);
+        counters.push(("grid cells".into(), cells as f64));
+        counters
+    }
+}
+
+/// Bind groups over the current data, buffers and maps.
+fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
+    let device = &ctx.gpu.device;
+    let v = gpu.volumes.as_ref().expect("made in prepare");
+    let t = gpu.rsm.targets.as_ref().expect("made in prepare");
+    let d = gpu.debug.as_ref().expect("made in prepare");
+    let s = &gpu.stages;
+    fn buffer(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+        b.as_entire_binding()
+    }
+    let view = wgpu::BindingResource::TextureView;
+    let data = buffer(&gpu.data);
+    let propagate = |from: usize| {
+        zoo_host::kit::bind_group(
+            device,
+            "lpv propagate group",
+            &s.propagate.layout,
+            &[
+                data.clone(),
+                buffer(&v.steps[from]),
+                buffer(&v.steps[1 - from]),
+                buffer(&v.accumulated),
+                buffer(&v.occluder_sums),
+            ],
+        )
+    };
+    Groups {
+        inject: zoo_host::kit::bind_group(
+            device,
+            "lpv inject group",
+            &s.inject.layout,
+            &[
+                data.clone(),
+                view(&t.flux.1),
+                view(&t.normal.1),
+                view(&t.position.1),
+                buffer(&v.light_sums),
+                buffer(&v.occluder_sums),
+            ],
+        ),
+        camera_occluders: zoo_host::kit::bind_group(
+            device,
+            "lpv camera occluders group",
+            &s.camera_occluders.layout,
+            &[data.clone(), buffer(&v.occluder_sums)],
+        ),
+        resolve: zoo_host::kit::bind_group(
+            device,
+            "lpv resolve group",
+            &s.resolve.layout,
+            &[
+                data.clone(),
+                buffer(&v.light_sums),
+                buffer(&v.steps[0]),
+                buffer(&v.accumulated),
+            ],
+        ),
+        propagate: [propagate(0), propagate(1)],
+        lookup: zoo_host::kit::bind_group(
+            device,
+            "lpv lookup group",
+            &s.lookup.layout,
+            &[
+                data.clone(),
+                buffer(&v.accumulated),
+                view(&ctx.indirect.view),
+            ],
+        ),
+        debug: zoo_host::kit::bind_group(
+            device,
+            "lpv debug group",
+            &s.debug_volume.layout,
+            &[
+                data,
+                buffer(&v.accumulated),
+                buffer(&v.occluder_sums),
+                view(&d.volume.1),
+                view(&d.bounds.1),
+            ],
+        ),
+    }
+}
+
+fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    let params = LpvParams::from_values(values)?;
+    Ok(Box::new(Lpv { params, gpu: None }))
+}
+
+zoo_host::register_technique! {
+    id: "lpv",
+    name: "Light propagation volumes",
+    description: "Reflective shadow maps injected into cascaded SH grids, propagated cell to cell with a geometry volume's occlusion: one diffuse bounce; direct shadows from shadow maps",
+    source: "seed 002 (Kaplanyan and Dachsbacher 2010; Dachsbacher and Stamminger 2005)",
+    light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
+    adds_light: true,
+    required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS,
+    required_limits: || wgpu::Limits {
+        max_storage_buffers_per_shader_stage: 8,
+        ..wgpu::Limits::downlevel_defaults()
+    },
+    params: LpvParams::schema,
+    create: create,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    fn shader(name: &str) -> String {
+        zoo_host::ShaderLibrary::embedded()
+            .compose(name)
+            .unwrap()
+            .source
+    }
+
+    #[test]
+    fn structs_mirror_the_shaders() {
+        let source = shader("lpv/propagate.wgsl");
+        let (size, fields) = zoo_host::mirror_fields!(LpvSettings {
+            grid_size,
+            cascade_count,
+            light_scale,
+            occluder_scale,
+            occlusion,
+            damping,
+            intensity,
+            camera_occluders,
+            blend_cells,
+            debug_cascade,
+            debug_source
+        });
+        check_mirror(&source, "LpvSettings", size, &fields, SizeRule::Equal).unwrap();
+        let (size, fields) = zoo_host::mirror_fields!(LpvData {
+            settings,
+            origin,
+            cascades
+        });
+        check_mirror(&source, "LpvData", size, &fields, SizeRule::Equal).unwrap();
+        let (size, fields) = zoo_host::mirror_fields!(RsmCamera {
+            view_proj,
+            eye,
+            axis,
+            origin,
+            light
+        });
+        check_mirror(
+            &shader("lpv/rsm.wgsl"),
+            "RsmCamera",
+            size,
+            &fields,
+            SizeRule::Equal,
+        )
+        .unwrap();
+        let (size, fields) = zoo_host::mirror_fields!(LpvShadow {
+            first_layer,
+            layer_count,
+            light,
+            perspective,
+            texel_scale,
+            normal_offset
+        });
+        check_mirror(
+            &shader("lpv/visibility.wgsl"),
+            "LpvShadow",
+            size,
+            &fields,
+            SizeRule::Equal,
+        )
+        .unwrap();
+        let cascades = zoo_host::gpu::layout::wgsl_integer_constant(&source, "MAX_CASCADES");
+        assert_eq!(cascades, Ok(gpu::MAX_CASCADES as i64));
+    }
+
+    #[test]
+    fn the_sh_constants_match_the_shader() {
+        let source = shader("lpv/volume.wgsl");
+        for (name, value) in [
+            ("SH_Y0", sh::Y0),
+            ("SH_Y1", sh::Y1),
+            ("SH_COS0", sh::COS0),
+            ("SH_COS1", sh::COS1),
+        ] {
+            let line = source
+                .lines()
+                .find(|l| l.starts_with(&format!("const {name}:")))
+                .unwrap();
+            let number: f32 = line
+                .split('=')
+                .nth(1)
+                .unwrap()
+                .trim()
+                .trim_end_matches(';')
+                .parse()
+                .unwrap();
+            assert!((number - value).abs() < 1e-6, "{name}");
+        }
+    }
+}

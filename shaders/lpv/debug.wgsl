@@ -1,0 +1,66 @@
+// Debug views: one grid as a 3D image (the accumulated light's mean intensity per channel, or
+// the occluders' mean blocking potential), and the grid bounds on screen.
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "lpv/volume.wgsl"
+
+@group(2) @binding(0) var<storage, read> lpv: LpvData;
+@group(2) @binding(1) var<storage, read> accumulated: array<vec4<f32>>;
+@group(2) @binding(2) var<storage, read> occluder_sums: array<i32>;
+@group(2) @binding(3) var volume_out: texture_storage_3d<rgba16float, write>;
+@group(2) @binding(4) var bounds_out: texture_storage_2d<rgba8unorm, write>;
+
+// The mean of an SH4 over the sphere is its band-0 coefficient times y00.
+@compute @workgroup_size(4, 4, 4)
+fn cs_volume(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = lpv.settings.grid_size;
+    if any(id >= vec3<u32>(n)) {
+        return;
+    }
+    let k = min(lpv.settings.debug_cascade, lpv.settings.cascade_count - 1u);
+    let cell = cell_index(k, vec3<i32>(id));
+    var value = vec3<f32>(0.0);
+    if lpv.settings.debug_source == 0u {
+        let i = cell * 3u;
+        value = SH_Y0 * vec3<f32>(accumulated[i].x, accumulated[i + 1u].x, accumulated[i + 2u].x);
+    } else {
+        let total = cells_per_grid() * lpv.settings.cascade_count;
+        let light_view = f32(occluder_sums[cell * 4u]);
+        let camera_view = f32(occluder_sums[(total + cell) * 4u]);
+        value = vec3<f32>(SH_Y0 * max(light_view, camera_view) / lpv.settings.occluder_scale);
+    }
+    textureStore(volume_out, vec3<i32>(id), vec4<f32>(value, 1.0));
+}
+
+// Which grid is used at each pixel: red the finest, green the next, blue the third, grey the
+// fourth, darker where a grid fades into the next.
+@compute @workgroup_size(8, 8, 1)
+fn cs_bounds(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(camera.size);
+    if id.x >= size.x || id.y >= size.y {
+        return;
+    }
+    let pixel = vec2<i32>(id.xy);
+    let s = load_surface(pixel);
+    var color = vec3<f32>(0.0);
+    if s.valid {
+        let palette = array<vec3<f32>, 4>(
+            vec3<f32>(1.0, 0.25, 0.2),
+            vec3<f32>(0.25, 0.9, 0.3),
+            vec3<f32>(0.25, 0.4, 1.0),
+            vec3<f32>(0.7, 0.7, 0.7),
+        );
+        for (var j = 0u; j < lpv.settings.cascade_count; j++) {
+            let k = lpv.settings.cascade_count - 1u - j;
+            let g = lpv.cascades[k];
+            let u = (s.position - g.min) / g.cell;
+            let n = f32(lpv.settings.grid_size);
+            if all(u >= vec3<f32>(0.0)) && all(u <= vec3<f32>(n)) {
+                color = palette[k];
+            }
+        }
+        color *= 0.4 + 0.6 * abs((camera.view * vec4<f32>(s.normal, 0.0)).z);
+    }
+    textureStore(bounds_out, pixel, vec4<f32>(color, 1.0));
+}

@@ -1,0 +1,85 @@
+// The lookup (seed 002 §5.4): the accumulated light at every pixel's surface, trilinear in
+// each grid and faded from a finer grid into the next over its border. The cells hold the
+// intensity of light flowing through them; taken as radiance over the cell's cross-section
+// (I / s^2), the irradiance on a surface with normal n is the SH product with the clamped
+// cosine lobe around -n (light flowing towards the surface). The indirect target gets
+// irradiance over pi. Lookups move `damping` cells along the normal, so a surface does not
+// read the light it injected itself.
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "lpv/volume.wgsl"
+
+@group(2) @binding(0) var<storage, read> lpv: LpvData;
+@group(2) @binding(1) var<storage, read> accumulated: array<vec4<f32>>;
+@group(2) @binding(2) var indirect_out: texture_storage_2d<rgba16float, write>;
+
+struct Sample {
+    red: vec4<f32>,
+    green: vec4<f32>,
+    blue: vec4<f32>,
+}
+
+// Trilinear SH of grid k at p (cells outside the grid count as dark).
+fn sample_grid(k: u32, p: vec3<f32>) -> Sample {
+    let g = lpv.cascades[k];
+    let u = (p - g.min) / g.cell - vec3<f32>(0.5);
+    let base = vec3<i32>(floor(u));
+    let f = u - floor(u);
+    var out: Sample;
+    for (var corner = 0u; corner < 8u; corner++) {
+        let o = vec3<i32>(i32(corner & 1u), i32((corner >> 1u) & 1u), i32((corner >> 2u) & 1u));
+        let c = base + o;
+        if !inside_grid(c) {
+            continue;
+        }
+        let w = mix(1.0 - f.x, f.x, f32(o.x)) * mix(1.0 - f.y, f.y, f32(o.y))
+            * mix(1.0 - f.z, f.z, f32(o.z));
+        let i = cell_index(k, c) * 3u;
+        out.red += w * accumulated[i];
+        out.green += w * accumulated[i + 1u];
+        out.blue += w * accumulated[i + 2u];
+    }
+    return out;
+}
+
+// How much of grid k to use at p: 1 inside, fading to 0 over its last `blend_cells` cells.
+fn grid_weight(k: u32, p: vec3<f32>) -> f32 {
+    let g = lpv.cascades[k];
+    let n = f32(lpv.settings.grid_size);
+    let u = (p - g.min) / g.cell;
+    let border = min(min(u, vec3<f32>(n) - u), vec3<f32>(n));
+    let nearest = min(border.x, min(border.y, border.z));
+    return clamp((nearest - 0.5) / max(lpv.settings.blend_cells, 1e-3), 0.0, 1.0);
+}
+
+// Irradiance over pi on a surface at p with normal n, from grid k.
+fn irradiance(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let g = lpv.cascades[k];
+    let s = sample_grid(k, p + n * (lpv.settings.damping * g.cell));
+    let lobe = sh_cosine_lobe(-n);
+    let e = vec3<f32>(dot(s.red, lobe), dot(s.green, lobe), dot(s.blue, lobe));
+    return max(e, vec3<f32>(0.0)) / (g.cell * g.cell * 3.14159265);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn cs_lookup(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(camera.size);
+    if id.x >= size.x || id.y >= size.y {
+        return;
+    }
+    let pixel = vec2<i32>(id.xy);
+    let s = load_surface(pixel);
+    var light = vec3<f32>(0.0);
+    if s.valid {
+        // From the coarsest grid in, each finer grid replaces what it covers.
+        for (var j = 0u; j < lpv.settings.cascade_count; j++) {
+            let k = lpv.settings.cascade_count - 1u - j;
+            let w = grid_weight(k, s.position);
+            if w > 0.0 {
+                light = mix(light, irradiance(k, s.position, s.normal), w);
+            }
+        }
+    }
+    textureStore(indirect_out, pixel, vec4<f32>(light * lpv.settings.intensity, 1.0));
+}

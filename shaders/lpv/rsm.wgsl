@@ -1,0 +1,76 @@
+// Reflective shadow map (seed 002 §4): every texel a virtual point light. Writes, from one
+// light's view, the light the visible surface reflects (rgb: albedo x radiance x falloff x the
+// texel's area across the light's rays, so a texel's intensity is that times the cosine to
+// its normal, zero where the surface faces away), its normal and area (w), and its position
+// (relative to the scene's centre: 16-bit floats keep 1e-3 of the scene's size, and every
+// backend renders them).
+
+#import "common/frame.wgsl"
+#import "common/lighting.wgsl"
+
+struct RsmCamera {
+    view_proj: mat4x4<f32>,
+    // The light's position (perspective maps) and 1 when perspective.
+    eye: vec4<f32>,
+    // The map's axis, and the texel's world size per unit of distance along it
+    // (perspective) or absolute (orthographic).
+    axis: vec4<f32>,
+    // Positions are stored relative to this point (the scene's centre), for 16-bit floats.
+    origin: vec4<f32>,
+    light: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(1) @binding(0) var<uniform> rsm_camera: RsmCamera;
+
+struct RsmVertex {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) object: u32,
+}
+
+@vertex
+fn vs_rsm(
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @builtin(instance_index) object: u32,
+) -> RsmVertex {
+    var out: RsmVertex;
+    out.clip = rsm_camera.view_proj * vec4<f32>(position, 1.0);
+    out.world = position;
+    out.normal = normal;
+    out.object = object;
+    return out;
+}
+
+struct RsmTexel {
+    @location(0) flux: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) position: vec4<f32>,
+}
+
+@fragment
+fn fs_rsm(v: RsmVertex, @builtin(front_facing) front: bool) -> RsmTexel {
+    let light = lights[rsm_camera.light];
+    var n = normalize(v.normal);
+    let l = light_vector(light, v.world);
+    // Two-sided: the side that faces the light reflects.
+    if dot(n, l) < 0.0 && !front {
+        n = -n;
+    }
+    let cosine = max(dot(n, l), 0.0);
+    var texel = rsm_camera.axis.w;
+    if rsm_camera.eye.w > 0.0 {
+        texel *= dot(v.world - rsm_camera.eye.xyz, rsm_camera.axis.xyz);
+    }
+    let across = texel * texel;
+    let albedo = objects[v.object].color.rgb;
+    var out: RsmTexel;
+    out.flux = vec4<f32>(select(vec3<f32>(0.0), albedo * light.radiance * light_falloff(light, v.world) * across, cosine > 0.0), 1.0);
+    out.normal = vec4<f32>(n, across / max(cosine, 0.05));
+    out.position = vec4<f32>(v.world - rsm_camera.origin.xyz, 1.0);
+    return out;
+}

@@ -1,0 +1,68 @@
+// Direct shadows of the light propagation volumes technique: each light's visibility from its
+// shadow maps (the shadow-map library's maps, filtered by 3 x 3 PCF).
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "common/lighting.wgsl"
+#import "common/fullscreen.wgsl"
+#import "shadow-maps/filters.wgsl"
+#import "shadow-maps/depth_lookup.wgsl"
+
+struct LpvShadow {
+    first_layer: u32,
+    // 1 (spot, directional) or 6 (point: cube faces).
+    layer_count: u32,
+    light: u32,
+    perspective: u32,
+    // World size of a texel: per unit of distance along the face axis (perspective) or
+    // absolute (orthographic).
+    texel_scale: f32,
+    normal_offset: f32,
+    _pad0: f32,
+    _pad1: f32,
+}
+
+@group(2) @binding(0) var<uniform> shadow: LpvShadow;
+
+var<private> light_position: vec3<f32>;
+
+fn shadow_tap(p: vec3<f32>, linear: bool) -> f32 {
+    let layer = light_layer(shadow.first_layer, shadow.layer_count, light_position, p);
+    return compare_map(map_point(layer, p), linear);
+}
+
+fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(0.0);
+}
+
+fn texel_world(p: vec3<f32>, light: Light) -> f32 {
+    if shadow.perspective == 0u {
+        return shadow.texel_scale;
+    }
+    let d = p - light.position;
+    if shadow.layer_count == 6u {
+        let a = abs(d);
+        return shadow.texel_scale * max(a.x, max(a.y, a.z));
+    }
+    return shadow.texel_scale * length(d);
+}
+
+@fragment
+fn fs_visibility(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let s = load_surface(vec2<i32>(in.position.xy));
+    if !s.valid {
+        discard;
+    }
+    let light = lights[shadow.light];
+    if light_falloff(light, s.position) <= 0.0 {
+        discard;
+    }
+    light_position = light.position;
+    let texel = texel_world(s.position, light);
+    let p = s.position + s.normal * (shadow.normal_offset * texel);
+    var direction = light.direction;
+    if light.kind != LIGHT_DIRECTIONAL {
+        direction = normalize(p - light.position);
+    }
+    return vec4<f32>(grid_pcf(p, tangent_frame(direction), texel, 3));
+}
