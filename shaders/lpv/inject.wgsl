@@ -36,7 +36,8 @@ fn add_occluder(source: u32, p: vec3<f32>, n: vec3<f32>, area: f32) {
         if !inside_grid(c) {
             continue;
         }
-        let b = min(area / (g.cell * g.cell), 1.0) * sh_cosine_lobe(n);
+        let share = 1.0 / f32(max(lpv.settings.map_count, 1u));
+        let b = share * min(area / (g.cell * g.cell), 1.0) * sh_cosine_lobe(n);
         let base = (source * total + cell_index(k, c)) * 4u;
         let scaled = vec4<i32>(round(b * lpv.settings.occluder_scale));
         for (var j = 0u; j < 4u; j++) {

@@ -48,15 +48,20 @@ fn grid_weight(k: u32, p: vec3<f32>) -> f32 {
     let g = lpv.cascades[k];
     let n = f32(lpv.settings.grid_size);
     let u = (p - g.min) / g.cell;
-    let border = min(min(u, vec3<f32>(n) - u), vec3<f32>(n));
+    let border = min(u, vec3<f32>(n) - u);
     let nearest = min(border.x, min(border.y, border.z));
     return clamp((nearest - 0.5) / max(lpv.settings.blend_cells, 1e-3), 0.0, 1.0);
 }
 
-// Irradiance over pi on a surface at p with normal n, from grid k.
-fn irradiance(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// Where grid k is read for a surface at p with normal n: `damping` cells along the normal.
+fn lookup_point(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return p + n * (lpv.settings.damping * lpv.cascades[k].cell);
+}
+
+// Irradiance over pi on a surface with normal n, read from grid k at q.
+fn irradiance(k: u32, q: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let g = lpv.cascades[k];
-    let s = sample_grid(k, p + n * (lpv.settings.damping * g.cell));
+    let s = sample_grid(k, q);
     let lobe = sh_cosine_lobe(-n);
     let e = vec3<f32>(dot(s.red, lobe), dot(s.green, lobe), dot(s.blue, lobe));
     return max(e, vec3<f32>(0.0)) / (g.cell * g.cell * 3.14159265);
@@ -75,9 +80,10 @@ fn cs_lookup(@builtin(global_invocation_id) id: vec3<u32>) {
         // From the coarsest grid in, each finer grid replaces what it covers.
         for (var j = 0u; j < lpv.settings.cascade_count; j++) {
             let k = lpv.settings.cascade_count - 1u - j;
-            let w = grid_weight(k, s.position);
+            let q = lookup_point(k, s.position, s.normal);
+            let w = grid_weight(k, q);
             if w > 0.0 {
-                light = mix(light, irradiance(k, s.position, s.normal), w);
+                light = mix(light, irradiance(k, q, s.normal), w);
             }
         }
     }

@@ -30,10 +30,13 @@ const AXES: array<vec3<i32>, 6> = array<vec3<i32>, 6>(
 );
 
 // The occluder SH of `source` (0 light's view, 1 camera's) at occluder cell `c` of cascade k.
-fn occluders(k: u32, source: u32, c: vec3<i32>) -> vec4<f32> {
-    if !inside_grid(c) {
+// Corners on the grid's far planes (index n) are stored with the nearest inner ones.
+fn occluders(k: u32, source: u32, corner: vec3<i32>) -> vec4<f32> {
+    let n = i32(lpv.settings.grid_size);
+    if any(corner < vec3<i32>(0)) || any(corner > vec3<i32>(n)) {
         return vec4<f32>(0.0);
     }
+    let c = min(corner, vec3<i32>(n - 1));
     let total = cells_per_grid() * lpv.settings.cascade_count;
     let base = (source * total + cell_index(k, c)) * 4u;
     return vec4<f32>(

@@ -67,7 +67,7 @@ fn fs_rsm(v: RsmVertex, @builtin(front_facing) front: bool) -> RsmTexel {
         texel *= dot(v.world - rsm_camera.eye.xyz, rsm_camera.axis.xyz);
     }
     let across = texel * texel;
-    let albedo = objects[v.object].color.rgb;
+    let albedo = saturate(objects[v.object].color.rgb);
     var out: RsmTexel;
     out.flux = vec4<f32>(select(vec3<f32>(0.0), albedo * light.radiance * light_falloff(light, v.world) * across, cosine > 0.0), 1.0);
     out.normal = vec4<f32>(n, across / max(cosine, 0.05));

@@ -25,7 +25,9 @@ struct LpvSettings {
     // The grid and volume the debug volume view shows (0 light, 1 occluders).
     debug_cascade: u32,
     debug_source: u32,
-    _pad: u32,
+    // Reflective shadow maps injected (each sees the same surfaces: their surfels count
+    // once between them).
+    map_count: u32,
 }
 
 struct Cascade {

@@ -26,8 +26,9 @@ pub struct SceneReference {
     pub occluder_triangles: usize,
     /// Seconds spent building the BVH and tracing.
     pub seconds: f64,
-    /// The one-bounce indirect reference per pixel, once [`Self::indirect`] computed it.
-    indirect: Option<Vec<glam::Vec3>>,
+    /// The one-bounce indirect reference per pixel, once [`Self::indirect`] computed it, with
+    /// the samples and lights it was traced for.
+    indirect: Option<(u32, Vec<Light>, Vec<glam::Vec3>)>,
 }
 
 impl SceneReference {
@@ -64,19 +65,24 @@ impl SceneReference {
     }
 
     /// The one-bounce diffuse reference for this view (irradiance over π per pixel, the
-    /// quantity of the indirect target), traced with `samples` rays per pixel the first time
-    /// it is asked for (it costs a BVH of every surface and a shadow ray per light and hit).
+    /// quantity of the indirect target), traced with `samples` rays per pixel when first asked
+    /// for with these samples and lights (it costs a BVH of every surface and a shadow ray
+    /// per light and hit).
     pub fn indirect(&mut self, scene: &Scene, lights: &[Light], samples: u32) -> &[glam::Vec3] {
-        if self.indirect.is_none() {
+        let current = self
+            .indirect
+            .as_ref()
+            .is_some_and(|(s, l, _)| *s == samples && l.as_slice() == lights);
+        if !current {
             let start = Instant::now();
             let occluders = Occluders::new(scene);
             let reflectors = Reflectors::new(scene);
             let points = surface_points(&self.gbuffer);
             let traced = one_bounce(&occluders, &reflectors, lights, &points, samples);
             self.seconds += start.elapsed().as_secs_f64();
-            self.indirect = Some(traced);
+            self.indirect = Some((samples, lights.to_vec(), traced));
         }
-        self.indirect.as_deref().expect("computed above")
+        &self.indirect.as_ref().expect("computed above").2
     }
 
     /// The pixels with a surface.

@@ -350,8 +350,11 @@ pub struct DebugImage<'a> {
 /// An axis of a 3D texture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VolumeAxis {
+    /// Across x: z runs across the screen, y up.
     X,
+    /// Across y: x runs across the screen, z up.
     Y,
+    /// Across z: x runs across the screen, y up.
     Z,
 }
 
@@ -359,7 +362,9 @@ pub enum VolumeAxis {
 /// the other two axes across and up the screen (X: z, y; Y: x, z; Z: x, y).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct VolumeSlice {
+    /// The axis the slice is taken across.
     pub axis: VolumeAxis,
+    /// The texel along that axis.
     pub index: u32,
 }
 
@@ -369,6 +374,7 @@ pub struct DebugVolume<'a> {
     pub view: &'a wgpu::TextureView,
     /// How to show its values (`Color` or `Channel`).
     pub mapping: ViewMapping,
+    /// The slice to show.
     pub slice: VolumeSlice,
 }
 

@@ -28,7 +28,7 @@ pub struct LpvSettings {
     pub blend_cells: f32,
     pub debug_cascade: u32,
     pub debug_source: u32,
-    pub _pad: u32,
+    pub map_count: u32,
 }
 
 /// `Cascade` in `lpv/volume.wgsl`.
@@ -232,17 +232,25 @@ impl RsmTargets {
     }
 }
 
-/// Pass names.
+/// The reflective shadow map passes (one per light, `"LPV RSM: light {l}"`).
 pub const RSM_PASS: &str = "LPV RSM";
+/// The injection of virtual point lights and their surfels.
 pub const INJECT_PASS: &str = "LPV injection";
+/// The injection of the camera's surfels into the geometry volume.
 pub const CAMERA_OCCLUDERS_PASS: &str = "LPV camera occluders";
+/// The pass that turns the fixed-point sums into the first step.
 pub const RESOLVE_PASS: &str = "LPV resolve";
+/// The propagation steps (`"LPV propagation {i}"`).
 pub const PROPAGATE_PASS: &str = "LPV propagation";
+/// The lookup into the indirect target.
 pub const LOOKUP_PASS: &str = "LPV lookup";
+/// The pass that draws a grid into the debug volume.
 pub const DEBUG_VOLUME_PASS: &str = "LPV debug volume";
+/// The pass that draws the grid bounds.
 pub const DEBUG_BOUNDS_PASS: &str = "LPV debug bounds";
 
 impl Rsm {
+    /// Builds the pipeline (MRT: flux, normal and area, position; depth).
     pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Rsm> {
         let device = &ctx.gpu.device;
         let module = ctx.shaders.create_module(device, "lpv/rsm.wgsl")?;
@@ -364,6 +372,7 @@ pub struct Volumes {
 }
 
 impl Volumes {
+    /// Buffers for `cells` cells over all grids.
     pub fn new(gpu: &GpuContext, cells: u64) -> Volumes {
         let buffer = |label: &str, size: u64| {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -396,6 +405,8 @@ pub struct Stage {
 }
 
 impl Stage {
+    /// Builds entry `entry` of `shader` with one group of `entries` (after the host's frame
+    /// and G-buffer groups when `host`).
     pub fn new(
         ctx: &RenderContext<'_>,
         shader: &str,
@@ -451,10 +462,12 @@ impl Stage {
     }
 }
 
+/// A compute storage buffer at `binding`.
 pub fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     kit::storage(binding, wgpu::ShaderStages::COMPUTE, read_only)
 }
 
+/// An unfilterable float 2D array texture at `binding`, for compute.
 pub fn texture_array(binding: u32) -> wgpu::BindGroupLayoutEntry {
     kit::texture(
         binding,
@@ -464,6 +477,7 @@ pub fn texture_array(binding: u32) -> wgpu::BindGroupLayoutEntry {
     )
 }
 
+/// A write-only storage texture at `binding`, for compute.
 pub fn storage_texture(
     binding: u32,
     format: wgpu::TextureFormat,
@@ -488,6 +502,7 @@ pub struct DebugTargets {
 }
 
 impl DebugTargets {
+    /// A `grid`³ volume and a `size` image.
     pub fn new(gpu: &GpuContext, grid: u32, size: UVec2) -> DebugTargets {
         let volume = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("lpv debug volume"),

@@ -392,7 +392,7 @@ impl ShadowTechnique for Lpv {
         let rsm_lights = self.rsm_lights(ctx.lights);
         let p = self.params.clone();
         let gpu = self.gpu.as_mut().expect("built above");
-        let replaced = gpu.maps.prepare(ctx, changes, p.map_size, true);
+        gpu.maps.prepare(ctx, changes, p.map_size, true);
         // Reflective shadow maps over the whole scene.
         let objects = object_bounds(ctx.scene, false);
         let bounds = objects.iter().fold(
@@ -446,13 +446,12 @@ impl ShadowTechnique for Lpv {
             blend_cells: p.blend_cells,
             debug_cascade: p.debug_cascade.min(p.cascades - 1),
             debug_source: 0,
-            _pad: 0,
+            map_count: rsm_lights.len() as u32,
         };
         let data = LpvData::new(settings, origin, &grids);
         ctx.gpu
             .queue
             .write_buffer(&gpu.data, 0, bytemuck::bytes_of(&data));
-        let _ = replaced;
         gpu.groups = Some(bind(ctx, gpu));
         Ok(())
     }
@@ -788,7 +787,8 @@ mod tests {
             camera_occluders,
             blend_cells,
             debug_cascade,
-            debug_source
+            debug_source,
+            map_count
         });
         check_mirror(&source, "LpvSettings", size, &fields, SizeRule::Equal).unwrap();
         let (size, fields) = zoo_host::mirror_fields!(LpvData {

@@ -340,3 +340,74 @@ impl IndirectTarget {
         IndirectTarget { texture, view }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(x: f32, range: f32) -> Light {
+        Light {
+            kind: LightKind::Point,
+            position: Vec3::new(x, 1.0, 0.0),
+            direction: Vec3::NEG_Y,
+            radiance: Vec3::ONE,
+            range,
+            spot_angle: 0.0,
+            spot_softness: 0.0,
+            radius: 0.0,
+        }
+    }
+
+    #[test]
+    fn one_per_light_fills_channels_then_layers() {
+        let s = SlotAssignment::one_per_light(6);
+        assert_eq!(s.slot(0), (0, 0));
+        assert_eq!(s.slot(3), (0, 3));
+        assert_eq!(s.slot(5), (1, 1));
+        assert_eq!(s.layer_count(), 2);
+        assert_eq!(SlotAssignment::one_per_light(0).layer_count(), 1);
+    }
+
+    #[test]
+    fn distant_lights_share_slots_and_overlapping_ones_do_not() {
+        // A row of 64 lights 10 apart with range 4: neighbours never overlap.
+        let lights: Vec<Light> = (0..64).map(|i| point(i as f32 * 10.0, 4.0)).collect();
+        let s = SlotAssignment::packed(&lights);
+        assert_eq!(s.slot_count(), 1);
+        assert_eq!(s.layer_count(), 1);
+
+        // Range 6: neighbours (10 apart) overlap, next-but-one (20 apart) do not.
+        let lights: Vec<Light> = (0..64).map(|i| point(i as f32 * 10.0, 6.0)).collect();
+        let s = SlotAssignment::packed(&lights);
+        assert_eq!(s.slot_count(), 2);
+        for slot in 0..s.slot_count() {
+            let members: Vec<_> = s.lights_in_slot(slot).collect();
+            for (k, &a) in members.iter().enumerate() {
+                for &b in &members[k + 1..] {
+                    assert!(!influences_overlap(&lights[a], &lights[b]));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn directional_lights_are_never_packed() {
+        let mut lights = vec![point(0.0, 1.0), point(100.0, 1.0)];
+        lights.push(Light {
+            kind: LightKind::Directional,
+            ..point(0.0, f32::INFINITY)
+        });
+        let s = SlotAssignment::packed(&lights);
+        assert_eq!(s.slot(0), s.slot(1));
+        assert_ne!(s.slot(2), s.slot(0));
+        assert_eq!(s.slot_count(), 2);
+    }
+
+    #[test]
+    fn overlapping_many_lights_need_many_slots() {
+        let lights: Vec<Light> = (0..256).map(|i| point(i as f32 * 0.01, 5.0)).collect();
+        let s = SlotAssignment::packed(&lights);
+        assert_eq!(s.slot_count(), 256);
+        assert_eq!(s.layer_count(), 64);
+    }
+}
