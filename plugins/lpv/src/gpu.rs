@@ -2,7 +2,7 @@
 //! fills them, the grids' buffers and the compute passes over them.
 
 use zoo_host::glam::{UVec2, Vec3};
-use zoo_host::kit::{self, UniformSlots, bind_group_layout, pipeline_layout};
+use zoo_host::kit::{self, UniformSlots};
 use zoo_host::prelude::*;
 use zoo_host::render::Vertex;
 use zoo_shadow_maps::light_space::LightFrustum;
@@ -398,70 +398,6 @@ impl Volumes {
     }
 }
 
-/// A compute pipeline with its own bind group layout, after the host's groups when `host`.
-pub struct Stage {
-    pipeline: wgpu::ComputePipeline,
-    pub layout: wgpu::BindGroupLayout,
-}
-
-impl Stage {
-    /// Builds entry `entry` of `shader` with one group of `entries` (after the host's frame
-    /// and G-buffer groups when `host`).
-    pub fn new(
-        ctx: &RenderContext<'_>,
-        shader: &str,
-        entry: &str,
-        entries: &[wgpu::BindGroupLayoutEntry],
-        host: bool,
-    ) -> TechniqueResult<Stage> {
-        let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, shader)?;
-        let layout = bind_group_layout(device, &format!("{shader} layout"), entries);
-        let label = format!("{shader} pipeline layout");
-        let pipeline_layout = if host {
-            pipeline_layout(ctx, &label, &[&layout])
-        } else {
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(&label),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            })
-        };
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(&format!("{shader} {entry}")),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        Ok(Stage { pipeline, layout })
-    }
-
-    /// Records one dispatch named `name` with `group` (at group 2 after the host's groups when
-    /// the stage has them, else at 0).
-    pub fn dispatch(
-        &self,
-        ctx: &RenderContext<'_>,
-        recorder: &mut PassRecorder<'_>,
-        name: &str,
-        group: &wgpu::BindGroup,
-        host: bool,
-        workgroups: [u32; 3],
-    ) {
-        let mut pass = recorder.compute_pass(name);
-        pass.set_pipeline(&self.pipeline);
-        if host {
-            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
-            pass.set_bind_group(2, group, &[]);
-        } else {
-            pass.set_bind_group(0, group, &[]);
-        }
-        pass.dispatch_workgroups(workgroups[0], workgroups[1], workgroups[2]);
-    }
-}
-
 /// A compute storage buffer at `binding`.
 pub fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     kit::storage(binding, wgpu::ShaderStages::COMPUTE, read_only)
@@ -483,16 +419,7 @@ pub fn storage_texture(
     format: wgpu::TextureFormat,
     dimension: wgpu::TextureViewDimension,
 ) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: dimension,
-        },
-        count: None,
-    }
+    kit::storage_texture(binding, wgpu::ShaderStages::COMPUTE, format, dimension)
 }
 
 /// The debug images: one grid as a volume, and the grid bounds on screen.

@@ -16,7 +16,7 @@ pub mod gpu;
 pub mod sh;
 
 use zoo_host::glam::Vec3;
-use zoo_host::kit::{FullscreenLightPass, light_pass_name};
+use zoo_host::kit::{ComputeStage, FullscreenLightPass, StageGroups, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::technique::{
     DebugImage, DebugVolume, ResourceInfo, ViewMapping, VolumeAxis, VolumeSlice,
@@ -25,7 +25,7 @@ use zoo_shadow_maps::light_space::{directional_frustum_over, spot_frustum};
 use zoo_shadow_maps::{DepthState, ShadowMapSet, object_bounds};
 
 use gpu::{
-    DebugTargets, LpvData, LpvSettings, Rsm, RsmCamera, Stage, Volumes, storage, storage_texture,
+    DebugTargets, LpvData, LpvSettings, Rsm, RsmCamera, Volumes, storage, storage_texture,
     texture_array,
 };
 
@@ -92,13 +92,13 @@ const RSM_VIEWS: [&str; 3] = ["RSM flux", "RSM normals", "RSM positions"];
 
 /// The compute stages.
 struct Stages {
-    inject: Stage,
-    camera_occluders: Stage,
-    resolve: Stage,
-    propagate: Stage,
-    lookup: Stage,
-    debug_volume: Stage,
-    debug_bounds: Stage,
+    inject: ComputeStage,
+    camera_occluders: ComputeStage,
+    resolve: ComputeStage,
+    propagate: ComputeStage,
+    lookup: ComputeStage,
+    debug_volume: ComputeStage,
+    debug_bounds: ComputeStage,
 }
 
 impl Stages {
@@ -106,7 +106,7 @@ impl Stages {
         use wgpu::TextureFormat as F;
         use wgpu::TextureViewDimension as D;
         Ok(Stages {
-            inject: Stage::new(
+            inject: ComputeStage::new(
                 ctx,
                 "lpv/inject.wgsl",
                 "cs_inject",
@@ -118,16 +118,18 @@ impl Stages {
                     storage(4, false),
                     storage(5, false),
                 ],
-                false,
+                StageGroups::Alone,
+                &[],
             )?,
-            camera_occluders: Stage::new(
+            camera_occluders: ComputeStage::new(
                 ctx,
                 "lpv/inject_camera.wgsl",
                 "cs_inject_camera",
                 &[storage(0, true), storage(1, false)],
-                true,
+                StageGroups::AfterHost,
+                &[],
             )?,
-            resolve: Stage::new(
+            resolve: ComputeStage::new(
                 ctx,
                 "lpv/resolve.wgsl",
                 "cs_resolve",
@@ -137,9 +139,10 @@ impl Stages {
                     storage(2, false),
                     storage(3, false),
                 ],
-                false,
+                StageGroups::Alone,
+                &[],
             )?,
-            propagate: Stage::new(
+            propagate: ComputeStage::new(
                 ctx,
                 "lpv/propagate.wgsl",
                 "cs_propagate",
@@ -150,9 +153,10 @@ impl Stages {
                     storage(3, false),
                     storage(4, true),
                 ],
-                false,
+                StageGroups::Alone,
+                &[],
             )?,
-            lookup: Stage::new(
+            lookup: ComputeStage::new(
                 ctx,
                 "lpv/lookup.wgsl",
                 "cs_lookup",
@@ -161,9 +165,10 @@ impl Stages {
                     storage(1, true),
                     storage_texture(2, F::Rgba16Float, D::D2),
                 ],
-                true,
+                StageGroups::AfterHost,
+                &[],
             )?,
-            debug_volume: Stage::new(
+            debug_volume: ComputeStage::new(
                 ctx,
                 "lpv/debug.wgsl",
                 "cs_volume",
@@ -174,9 +179,10 @@ impl Stages {
                     storage_texture(3, F::Rgba16Float, D::D3),
                     storage_texture(4, F::Rgba8Unorm, D::D2),
                 ],
-                true,
+                StageGroups::AfterHost,
+                &[],
             )?,
-            debug_bounds: Stage::new(
+            debug_bounds: ComputeStage::new(
                 ctx,
                 "lpv/debug.wgsl",
                 "cs_bounds",
@@ -187,7 +193,8 @@ impl Stages {
                     storage_texture(3, F::Rgba16Float, D::D3),
                     storage_texture(4, F::Rgba8Unorm, D::D2),
                 ],
-                true,
+                StageGroups::AfterHost,
+                &[],
             )?,
         })
     }
@@ -482,7 +489,7 @@ impl ShadowTechnique for Lpv {
                 recorder,
                 gpu::INJECT_PASS,
                 &groups.inject,
-                false,
+                &[],
                 [rsm_groups, rsm_groups, layers],
             );
         } else {
@@ -495,7 +502,7 @@ impl ShadowTechnique for Lpv {
                 recorder,
                 gpu::CAMERA_OCCLUDERS_PASS,
                 &groups.camera_occluders,
-                true,
+                &[],
                 screen,
             );
         }
@@ -505,7 +512,7 @@ impl ShadowTechnique for Lpv {
             recorder,
             gpu::RESOLVE_PASS,
             &groups.resolve,
-            false,
+            &[],
             [entries.div_ceil(64), 1, 1],
         );
         let n = p.grid_size.div_ceil(4);
@@ -513,16 +520,10 @@ impl ShadowTechnique for Lpv {
             let name = format!("{} {}", gpu::PROPAGATE_PASS, i + 1);
             let group = &groups.propagate[(i % 2) as usize];
             s.propagate
-                .dispatch(ctx, recorder, &name, group, false, [n, n, n * p.cascades]);
+                .dispatch(ctx, recorder, &name, group, &[], [n, n, n * p.cascades]);
         }
-        s.lookup.dispatch(
-            ctx,
-            recorder,
-            gpu::LOOKUP_PASS,
-            &groups.lookup,
-            true,
-            screen,
-        );
+        s.lookup
+            .dispatch(ctx, recorder, gpu::LOOKUP_PASS, &groups.lookup, &[], screen);
         let Some(lookup_group) = gpu.maps.lookup_group() else {
             return Err(TechniqueError::not_prepared());
         };
@@ -563,7 +564,7 @@ impl ShadowTechnique for Lpv {
                     recorder,
                     gpu::DEBUG_VOLUME_PASS,
                     &groups.debug,
-                    true,
+                    &[],
                     [g, g, g],
                 );
                 gpu.debug_pass = Some(true);
@@ -574,7 +575,7 @@ impl ShadowTechnique for Lpv {
                     recorder,
                     gpu::DEBUG_BOUNDS_PASS,
                     &groups.debug,
-                    true,
+                    &[],
                     screen,
                 );
                 gpu.debug_pass = Some(false);

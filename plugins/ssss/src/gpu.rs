@@ -3,7 +3,7 @@
 
 use zoo_host::glam::UVec2;
 use zoo_host::gpu::array_layers;
-use zoo_host::kit::{self, bind_group, bind_group_layout, pipeline_layout};
+use zoo_host::kit::{self, ComputeStage, StageGroups, bind_group};
 use zoo_host::prelude::*;
 use zoo_shadow_maps::{ShadowMapSet, TranslucentPass};
 
@@ -180,39 +180,6 @@ impl Targets {
     }
 }
 
-/// One compute pass: its pipeline and the layout of its group 2.
-struct ComputeStage {
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
-}
-
-impl ComputeStage {
-    fn new(
-        ctx: &RenderContext<'_>,
-        label: &str,
-        shader: &str,
-        entry: &str,
-        entries: &[wgpu::BindGroupLayoutEntry],
-        more: &[&wgpu::BindGroupLayout],
-    ) -> TechniqueResult<ComputeStage> {
-        let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, shader)?;
-        let layout = bind_group_layout(device, &format!("{label} layout"), entries);
-        let mut groups = vec![&layout];
-        groups.extend_from_slice(more);
-        let pipeline_layout = pipeline_layout(ctx, &format!("{label} pipeline layout"), &groups);
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(&format!("{label} pipeline")),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        Ok(ComputeStage { pipeline, layout })
-    }
-}
-
 /// The compute passes after the maps and their current bind groups.
 pub struct Passes {
     penumbra: ComputeStage,
@@ -237,21 +204,13 @@ fn sampled(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGrou
     )
 }
 
+/// A write-only storage texture at `binding`, for compute.
 fn storage_texture(
     binding: u32,
     format: wgpu::TextureFormat,
     dimension: wgpu::TextureViewDimension,
 ) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: dimension,
-        },
-        count: None,
-    }
+    kit::storage_texture(binding, wgpu::ShaderStages::COMPUTE, format, dimension)
 }
 
 const FLOAT: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: false };
@@ -277,7 +236,6 @@ impl Passes {
         let rgba16 = F::Rgba16Float;
         let penumbra = ComputeStage::new(
             ctx,
-            "ssss penumbra",
             "ssss/penumbra.wgsl",
             "cs_penumbra",
             &[
@@ -288,12 +246,12 @@ impl Passes {
                 sampled(4, FLOAT),
                 sampled(5, FLOAT),
             ],
+            StageGroups::AfterHost,
             &[maps.lookup_layout()],
         )?;
-        let blur = |label, shader, entry, inputs: [wgpu::TextureSampleType; 2], output| {
+        let blur = |shader, entry, inputs: [wgpu::TextureSampleType; 2], output| {
             ComputeStage::new(
                 ctx,
-                label,
                 shader,
                 entry,
                 &[
@@ -304,18 +262,17 @@ impl Passes {
                     storage_texture(4, output, ARRAY),
                     storage_texture(5, output, ARRAY),
                 ],
+                StageGroups::AfterHost,
                 &[],
             )
         };
         let blur_first = blur(
-            "ssss blur 1",
             "ssss/blur_first.wgsl",
             "cs_blur_first",
             [UINT, FLOAT],
             rgba16,
         )?;
         let blur_second = blur(
-            "ssss blur 2",
             "ssss/blur_second.wgsl",
             "cs_blur_second",
             [FLOAT, FLOAT],
@@ -323,7 +280,6 @@ impl Passes {
         )?;
         let resolve = ComputeStage::new(
             ctx,
-            "ssss resolve",
             "ssss/resolve.wgsl",
             "cs_resolve",
             &[
@@ -336,11 +292,11 @@ impl Passes {
                 storage_texture(6, F::Rgba8Unorm, ARRAY),
                 storage_texture(7, F::Rgba8Unorm, ARRAY),
             ],
+            StageGroups::AfterHost,
             &[],
         )?;
         let debug = ComputeStage::new(
             ctx,
-            "ssss debug view",
             "ssss/debug.wgsl",
             "cs_debug",
             &[
@@ -351,6 +307,7 @@ impl Passes {
                 sampled(4, FLOAT),
                 storage_texture(5, F::Rgba8Unorm, wgpu::TextureViewDimension::D2),
             ],
+            StageGroups::AfterHost,
             &[],
         )?;
         Ok(Passes {
@@ -477,15 +434,15 @@ impl Passes {
             if name == DEBUG_PASS && !debug {
                 break;
             }
-            let mut pass = recorder.compute_pass(name);
-            pass.set_pipeline(&stage.pipeline);
-            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
-            pass.set_bind_group(2, &groups[k], &[]);
-            if let Some(lookup) = lookup {
-                pass.set_bind_group(3, lookup, &[]);
-            }
-            pass.dispatch_workgroups(workgroups.x, workgroups.y, 1);
+            let more: Vec<&wgpu::BindGroup> = lookup.into_iter().collect();
+            stage.dispatch(
+                ctx,
+                recorder,
+                name,
+                &groups[k],
+                &more,
+                [workgroups.x, workgroups.y, 1],
+            );
         }
         Ok(())
     }
@@ -494,8 +451,7 @@ impl Passes {
 /// Min-filtered depth maps: each texel the nearest depth of an 8 x 8 block of its map layer
 /// (`ssss/min_depth.wgsl`), for the min-filter penumbra estimate.
 pub struct MinFilter {
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    stage: ComputeStage,
     /// (maps, array view, resolution, layers) once made.
     maps: Option<(wgpu::Texture, wgpu::TextureView, u32, u32)>,
     kept: Option<wgpu::Buffer>,
@@ -511,33 +467,20 @@ pub const MIN_FILTER_PASS: &str = "SSSS min filter";
 impl MinFilter {
     /// Builds the reduction pipeline.
     pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<MinFilter> {
-        let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, "ssss/min_depth.wgsl")?;
-        let layout = bind_group_layout(
-            device,
-            "ssss min filter layout",
+        let stage = ComputeStage::new(
+            ctx,
+            "ssss/min_depth.wgsl",
+            "cs_min_depth",
             &[
                 sampled(0, FLOAT),
                 storage_texture(1, wgpu::TextureFormat::R32Float, ARRAY),
                 kit::storage(2, wgpu::ShaderStages::COMPUTE, true),
             ],
-        );
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("ssss min filter pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("ssss min filter pipeline"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("cs_min_depth"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+            StageGroups::Alone,
+            &[],
+        )?;
         Ok(MinFilter {
-            pipeline,
-            layout,
+            stage,
             maps: None,
             kept: None,
             kept_count: 0,
@@ -584,7 +527,7 @@ impl MinFilter {
         self.group = Some(bind_group(
             &gpu.device,
             "ssss min filter group",
-            &self.layout,
+            &self.stage.layout,
             &[
                 wgpu::BindingResource::TextureView(&depth.array_view),
                 wgpu::BindingResource::TextureView(&maps.1),
@@ -608,18 +551,21 @@ impl MinFilter {
     }
 
     /// Fills the min maps of the rendered layers.
-    pub fn record(&self, recorder: &mut PassRecorder<'_>) -> TechniqueResult {
+    pub fn record(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> TechniqueResult {
         let (Some(group), Some(maps)) = (&self.group, &self.maps) else {
             return Err(TechniqueError::not_prepared());
         };
         if self.kept_count == 0 {
             return Ok(());
         }
-        let mut pass = recorder.compute_pass(MIN_FILTER_PASS);
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, group, &[]);
         let side = maps.2.div_ceil(8);
-        pass.dispatch_workgroups(side, side, self.kept_count);
+        let workgroups = [side, side, self.kept_count];
+        self.stage
+            .dispatch(ctx, recorder, MIN_FILTER_PASS, group, &[], workgroups);
         Ok(())
     }
 }

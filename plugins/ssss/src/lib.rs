@@ -475,7 +475,7 @@ impl ShadowTechnique for Ssss {
             translucent.record(ctx, recorder, &gpu.maps, TRANSLUCENT_PASS)?;
         }
         if self.params.estimate == Estimate::MinFilter {
-            gpu.min_filter.record(recorder)?;
+            gpu.min_filter.record(ctx, recorder)?;
         }
         let debug = ctx
             .debug_view

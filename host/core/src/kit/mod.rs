@@ -8,18 +8,23 @@
 //!   layouts that put the frame (group 0) and G-buffer (group 1) layouts first.
 //! - [`light_pass`]: a full-screen fragment shader run once per light into its slot, with
 //!   per-light uniforms.
+//! - [`compute`]: a compute pass with the technique's own group, after the host's groups or
+//!   alone.
 //!
 //! Shader modules from inline WGSL with `#import`s come from
 //! [`ShaderLibrary::create_module_from_source`](crate::ShaderLibrary::create_module_from_source).
 
+pub mod compute;
 pub mod layouts;
 pub mod light_pass;
 pub mod slot;
 pub mod uniforms;
 
+pub use compute::{ComputeStage, StageGroups};
 pub use layouts::{
     SlotPipeline, bind_group, bind_group_layout, diagnostics_pipelines, pipeline_layout, sampler,
-    slot_fullscreen_pipeline, slot_fullscreen_pipeline_with, storage, texture, uniform,
+    slot_fullscreen_pipeline, slot_fullscreen_pipeline_with, storage, storage_texture, texture,
+    uniform,
 };
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use slot::{LightSlot, slot_target};
