@@ -1,10 +1,16 @@
 // The lookup (seed 002 §5.4): the accumulated light at every pixel's surface, trilinear in
-// each grid and faded from a finer grid into the next over its border. The cells hold the
-// intensity of light flowing through them; taken as radiance over the cell's cross-section
-// (I / s^2), the irradiance on a surface with normal n is the SH product with the clamped
-// cosine lobe around -n (light flowing towards the surface). The indirect target gets
-// irradiance over pi. Lookups move `damping` cells along the normal, so a surface does not
-// read the light it injected itself.
+// each grid. The cells hold the intensity of light flowing through them; taken as radiance over
+// the cell's cross-section (I / s^2), the irradiance on a surface with normal n is the SH
+// product with the clamped cosine lobe around -n (light flowing towards the surface). The
+// indirect target gets irradiance over pi. Lookups move `damping` cells along the normal, so a
+// surface does not read the light it injected itself.
+//
+// Grids combine from the coarsest in. A grid of cell s after N steps holds light that travelled
+// up to N s. With `coarse_far_light`, the next finer grid (cell s/2, N steps) carries the light
+// within N s/2 in finer detail, so at a point it covers it replaces the coarser grid's first
+// N/2 steps and the coarser grid adds only the rest: E = E_fine + E_coarse - E_coarse,near.
+// Without it, a finer grid replaces the coarser one outright. Either way a finer grid fades in
+// over `blend_cells` from its border.
 
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
@@ -13,6 +19,7 @@
 @group(2) @binding(0) var<storage, read> lpv: LpvData;
 @group(2) @binding(1) var<storage, read> accumulated: array<vec4<f32>>;
 @group(2) @binding(2) var indirect_out: texture_storage_2d<rgba16float, write>;
+@group(2) @binding(3) var<storage, read> near: array<vec4<f32>>;
 
 struct Sample {
     red: vec4<f32>,
@@ -20,8 +27,9 @@ struct Sample {
     blue: vec4<f32>,
 }
 
-// Trilinear SH of grid k at p (cells outside the grid count as dark).
-fn sample_grid(k: u32, p: vec3<f32>) -> Sample {
+// Trilinear SH of grid k at p (cells outside the grid count as dark): the accumulated light,
+// or with `within_half` the light after half the steps.
+fn sample_grid(k: u32, p: vec3<f32>, within_half: bool) -> Sample {
     let g = lpv.cascades[k];
     let u = (p - g.min) / g.cell - vec3<f32>(0.5);
     let base = vec3<i32>(floor(u));
@@ -36,9 +44,15 @@ fn sample_grid(k: u32, p: vec3<f32>) -> Sample {
         let w = mix(1.0 - f.x, f.x, f32(o.x)) * mix(1.0 - f.y, f.y, f32(o.y))
             * mix(1.0 - f.z, f.z, f32(o.z));
         let i = cell_index(k, c) * 3u;
-        out.red += w * accumulated[i];
-        out.green += w * accumulated[i + 1u];
-        out.blue += w * accumulated[i + 2u];
+        if within_half {
+            out.red += w * near[i];
+            out.green += w * near[i + 1u];
+            out.blue += w * near[i + 2u];
+        } else {
+            out.red += w * accumulated[i];
+            out.green += w * accumulated[i + 1u];
+            out.blue += w * accumulated[i + 2u];
+        }
     }
     return out;
 }
@@ -58,13 +72,14 @@ fn lookup_point(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return p + n * (lpv.settings.damping * lpv.cascades[k].cell);
 }
 
-// Irradiance over pi on a surface with normal n, read from grid k at q.
-fn irradiance(k: u32, q: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// Irradiance over pi on a surface with normal n, read from grid k at its lookup point for p
+// (not clamped: grids combine before the clamp).
+fn irradiance(k: u32, p: vec3<f32>, n: vec3<f32>, within_half: bool) -> vec3<f32> {
     let g = lpv.cascades[k];
-    let s = sample_grid(k, q);
+    let s = sample_grid(k, lookup_point(k, p, n), within_half);
     let lobe = sh_cosine_lobe(-n);
     let e = vec3<f32>(dot(s.red, lobe), dot(s.green, lobe), dot(s.blue, lobe));
-    return max(e, vec3<f32>(0.0)) / (g.cell * g.cell * 3.14159265);
+    return e / (g.cell * g.cell * 3.14159265);
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -77,15 +92,24 @@ fn cs_lookup(@builtin(global_invocation_id) id: vec3<u32>) {
     let s = load_surface(pixel);
     var light = vec3<f32>(0.0);
     if s.valid {
-        // From the coarsest grid in, each finer grid replaces what it covers.
-        for (var j = 0u; j < lpv.settings.cascade_count; j++) {
-            let k = lpv.settings.cascade_count - 1u - j;
-            let q = lookup_point(k, s.position, s.normal);
-            let w = grid_weight(k, q);
-            if w > 0.0 {
-                light = mix(light, irradiance(k, q, s.normal), w);
+        let count = lpv.settings.cascade_count;
+        let coarsest = count - 1u;
+        light = grid_weight(coarsest, lookup_point(coarsest, s.position, s.normal))
+            * irradiance(coarsest, s.position, s.normal, false);
+        for (var j = 1u; j < count; j++) {
+            let k = coarsest - j;
+            let w = grid_weight(k, lookup_point(k, s.position, s.normal));
+            if w <= 0.0 {
+                continue;
+            }
+            let fine = irradiance(k, s.position, s.normal, false);
+            if lpv.settings.coarse_far_light != 0u {
+                light += w * (fine - irradiance(k + 1u, s.position, s.normal, true));
+            } else {
+                light = mix(light, fine, w);
             }
         }
     }
+    light = max(light, vec3<f32>(0.0));
     textureStore(indirect_out, pixel, vec4<f32>(light * lpv.settings.intensity, 1.0));
 }

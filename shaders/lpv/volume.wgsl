@@ -28,6 +28,12 @@ struct LpvSettings {
     // Reflective shadow maps injected (each sees the same surfaces: their surfels count
     // once between them).
     map_count: u32,
+    // 1 when a coarser grid adds only the light that travelled beyond the next finer grid's
+    // reach (its steps past half the iterations); 0 when a finer grid replaces it.
+    coarse_far_light: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct Cascade {

@@ -6,6 +6,7 @@ use std::io::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, bail};
+use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use zoo_host::judging::{Judged, SceneReference, error_map, judge_technique};
 use zoo_host::params::{self, ParamValues};
@@ -257,6 +258,14 @@ fn judge_indirect(
         let path = args.out.join(format!("{}-indirect-error.png", j.technique));
         map.save(&path)
             .with_context(|| format!("cannot write {}", path.display()))?;
+        save_radiance(
+            &args.out.join(format!("{}-indirect.hdr", j.technique)),
+            estimate,
+            width,
+        )?;
+        if scores.is_empty() {
+            save_radiance(&args.out.join("reference-indirect.hdr"), &expected, width)?;
+        }
         scores.push((j.technique.clone(), rmse));
     }
     if !scores.is_empty() {
@@ -271,6 +280,18 @@ fn judge_indirect(
         }
     }
     Ok(scores)
+}
+
+/// Writes linear RGB values, row by row from the top, as a Radiance HDR image.
+fn save_radiance(path: &Path, values: &[Vec3], width: usize) -> anyhow::Result<()> {
+    let height = values.len() / width.max(1);
+    let image = image::Rgb32FImage::from_fn(width as u32, height as u32, |x, y| {
+        let v = values[y as usize * width + x as usize].max(Vec3::ZERO);
+        image::Rgb([v.x, v.y, v.z])
+    });
+    image
+        .save(path)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 struct ReportInputs<'a> {
@@ -369,7 +390,7 @@ fn report_md(r: &ReportInputs<'_>) -> String {
     if !r.indirect.is_empty() {
         let _ = writeln!(
             w,
-            "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more).\n"
+            "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more); the values themselves in `reference-indirect.hdr` and `<technique>-indirect.hdr` (linear Radiance HDR).\n"
         );
         let _ = writeln!(w, "| technique | indirect_rmse |");
         let _ = writeln!(w, "|---|---|");

@@ -29,6 +29,10 @@ pub struct LpvSettings {
     pub debug_cascade: u32,
     pub debug_source: u32,
     pub map_count: u32,
+    pub coarse_far_light: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// `Cascade` in `lpv/volume.wgsl`.
@@ -369,6 +373,9 @@ pub struct Volumes {
     pub occluder_sums: wgpu::Buffer,
     pub steps: [wgpu::Buffer; 2],
     pub accumulated: wgpu::Buffer,
+    /// The accumulated light after half the steps (a coarser grid's share of what the next
+    /// finer grid already carries).
+    pub near: wgpu::Buffer,
 }
 
 impl Volumes {
@@ -378,7 +385,9 @@ impl Volumes {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size: size.max(16),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             })
         };
@@ -389,12 +398,13 @@ impl Volumes {
             occluder_sums: buffer("lpv occluder sums", 2 * cells * 4 * 4),
             steps: [buffer("lpv step a", light), buffer("lpv step b", light)],
             accumulated: buffer("lpv accumulated light", light),
+            near: buffer("lpv light within half the steps", light),
         }
     }
 
     /// Bytes of GPU memory.
     pub fn bytes(&self) -> u64 {
-        self.cells * (12 * 4 + 2 * 4 * 4 + 3 * 3 * 16)
+        self.cells * (12 * 4 + 2 * 4 * 4 + 4 * 3 * 16)
     }
 }
 

@@ -56,7 +56,12 @@ zoo_host::technique_params! {
         /// Finest cell size in world units (0: the coarsest grid spans the scene's diagonal).
         finest_cell: f32 = 0.0, range(0.0, 100.0), step(0.05);
         /// Cells over which a finer grid fades into the next at its border.
-        blend_cells: f32 = 2.0, range(0.0, 8.0), step(0.5);
+        blend_cells: f32 = 2.0, range(0.0, 16.0), step(0.5);
+        /// A coarser grid adds the light that travelled beyond the next finer grid's reach
+        /// (iterations x its cell: the coarser grid's steps past half the iterations); off, a
+        /// finer grid replaces the coarser ones where it lies and light reaches only
+        /// iterations x the finest cell there.
+        coarse_far_light: bool = false;
         /// Spot lights also render reflective shadow maps (directional lights always do).
         spot_lights: bool = false;
         /// Direct shadow-map resolution.
@@ -164,6 +169,7 @@ impl Stages {
                     storage(0, true),
                     storage(1, true),
                     storage_texture(2, F::Rgba16Float, D::D2),
+                    storage(3, true),
                 ],
                 StageGroups::AfterHost,
                 &[],
@@ -454,6 +460,8 @@ impl ShadowTechnique for Lpv {
             debug_cascade: p.debug_cascade.min(p.cascades - 1),
             debug_source: 0,
             map_count: rsm_lights.len() as u32,
+            coarse_far_light: u32::from(p.coarse_far_light),
+            ..Default::default()
         };
         let data = LpvData::new(settings, origin, &grids);
         ctx.gpu
@@ -516,11 +524,21 @@ impl ShadowTechnique for Lpv {
             [entries.div_ceil(64), 1, 1],
         );
         let n = p.grid_size.div_ceil(4);
+        // Coarser grids keep what they hold after half the steps: the share of their light
+        // the next finer grid (half the cell, as many steps) carries in finer detail.
+        let near_steps = p.iterations / 2;
+        let keep_near = p.coarse_far_light && p.cascades > 1;
+        if keep_near && near_steps == 0 {
+            copy_whole(recorder.encoder(), &volumes.accumulated, &volumes.near);
+        }
         for i in 0..p.iterations {
             let name = format!("{} {}", gpu::PROPAGATE_PASS, i + 1);
             let group = &groups.propagate[(i % 2) as usize];
             s.propagate
                 .dispatch(ctx, recorder, &name, group, &[], [n, n, n * p.cascades]);
+            if keep_near && i + 1 == near_steps {
+                copy_whole(recorder.encoder(), &volumes.accumulated, &volumes.near);
+            }
         }
         s.lookup
             .dispatch(ctx, recorder, gpu::LOOKUP_PASS, &groups.lookup, &[], screen);
@@ -658,6 +676,11 @@ impl ShadowTechnique for Lpv {
     }
 }
 
+/// Copies all of `from` into `to` (buffers of one size).
+fn copy_whole(encoder: &mut wgpu::CommandEncoder, from: &wgpu::Buffer, to: &wgpu::Buffer) {
+    encoder.copy_buffer_to_buffer(from, 0, to, 0, from.size());
+}
+
 /// Bind groups over the current data, buffers and maps.
 fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
     let device = &ctx.gpu.device;
@@ -724,6 +747,7 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
                 data.clone(),
                 buffer(&v.accumulated),
                 view(&ctx.indirect.view),
+                buffer(&v.near),
             ],
         ),
         debug: zoo_host::kit::bind_group(
@@ -789,7 +813,11 @@ mod tests {
             blend_cells,
             debug_cascade,
             debug_source,
-            map_count
+            map_count,
+            coarse_far_light,
+            _pad0,
+            _pad1,
+            _pad2
         });
         check_mirror(&source, "LpvSettings", size, &fields, SizeRule::Equal).unwrap();
         let (size, fields) = zoo_host::mirror_fields!(LpvData {

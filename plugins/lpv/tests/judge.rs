@@ -130,6 +130,40 @@ fn the_lit_cloth_colours_the_light_around_it() {
 }
 
 #[test]
+fn coarser_grids_carry_the_light_the_finest_grid_cannot_reach() {
+    // With the default lookup a finer grid replaces the coarser ones, and light there travels
+    // 8 steps of the finest cell (2.7 m in `atrium`): the west wall, 6 m from the lit floor,
+    // stays dark. `coarse_far_light` adds the coarser grids' light from beyond that reach.
+    let scene = Scene::load(&scene_path("atrium.ron")).unwrap();
+    let mut renderer = Renderer::new(gpu(), scene.clone(), SIZE).unwrap();
+    let mut reference = SceneReference::compute(&mut renderer, 1, |_| {}).unwrap();
+    let expected = reference.indirect(&scene, &scene.lights, 64).to_vec();
+    let mask = reference.surface_mask();
+    let mut indirect = |far: &str| {
+        let values = params(&[("coarse_far_light", far)]);
+        let judged = judge_technique(&mut renderer, &reference, "lpv", &values).unwrap();
+        judged.indirect.unwrap()
+    };
+    let (replaced, added) = (indirect("false"), indirect("true"));
+    // Pixels with light in the reference that the replacing lookup leaves under a quarter of
+    // it.
+    let dark = |i: usize| {
+        let e = expected[i].element_sum();
+        mask[i] && e > 0.3 && replaced[i].element_sum() < 0.25 * e
+    };
+    let count = (0..mask.len()).filter(|&i| dark(i)).count();
+    let reached =
+        |light: &[Vec3]| total(light, dark).element_sum() / total(&expected, dark).element_sum();
+    let (before, after) = (reached(&replaced), reached(&added));
+    eprintln!(
+        "{count} out-of-reach pixels: {before:.3} of the reference replaced, {after:.3} added"
+    );
+    assert!(count > 1000, "{count}");
+    // Measured 0.10 and 0.38.
+    assert!(after > 2.5 * before, "{before} -> {after}");
+}
+
+#[test]
 fn occlusion_stops_light_behind_a_wall() {
     // A sunlit floor on the left of a tall wall; the right side is in the wall's shadow and
     // sees the lit floor only through the wall.
