@@ -196,6 +196,49 @@ fn compare_writes_csv_report_and_error_maps() {
 }
 
 #[test]
+fn compare_writes_the_indirect_light_it_scores() {
+    let out_dir = temp_dir("compare-indirect").join("results");
+    let out = shadow_zoo(&[
+        "compare",
+        "--scene",
+        "scenes/atrium.ron",
+        "--techniques",
+        "lpv",
+        "--size",
+        "64x48",
+        "--samples",
+        "4",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    let csv = std::fs::read_to_string(out_dir.join("indirect.csv")).unwrap();
+    let row = csv.lines().nth(1).expect("a row for lpv");
+    let fields: Vec<&str> = row.split(',').collect();
+    assert_eq!(fields[..2], ["atrium", "lpv"], "{csv}");
+    let scored: f64 = fields[2].parse().unwrap();
+    // The written values give back the score (Radiance HDR keeps about 1 % per value).
+    let read = |name: &str| {
+        let image = image::open(out_dir.join(name)).unwrap().into_rgb32f();
+        assert_eq!(image.dimensions(), (64, 48), "{name}");
+        image.into_raw()
+    };
+    let (reference, estimate) = (read("reference-indirect.hdr"), read("lpv-indirect.hdr"));
+    let (mut error, mut norm) = (0.0f64, 0.0f64);
+    for (r, e) in reference.iter().zip(&estimate) {
+        error += f64::from(e - r).powi(2);
+        norm += f64::from(*r).powi(2);
+    }
+    let recomputed = (error / norm).sqrt();
+    assert!(norm > 0.0 && scored > 0.0);
+    assert!(
+        (recomputed / scored - 1.0).abs() < 0.05,
+        "{recomputed} against {scored}"
+    );
+}
+
+#[test]
 fn compare_rejects_bad_input_clearly() {
     let dir = temp_dir("compare-bad");
     let no_lights = dir.join("dark.ron");

@@ -264,7 +264,7 @@ fn judge_indirect(
             width,
         )?;
         if scores.is_empty() {
-            save_radiance(&args.out.join("reference-indirect.hdr"), &expected, width)?;
+            save_radiance(&args.out.join("reference-indirect.hdr"), expected, width)?;
         }
         scores.push((j.technique.clone(), rmse));
     }
