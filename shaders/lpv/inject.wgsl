@@ -15,6 +15,8 @@
 // coefficient, source 0 the light's view, 1 the camera's.
 @group(0) @binding(4) var<storage, read_write> light_sums: array<atomic<i32>>;
 @group(0) @binding(5) var<storage, read_write> occluder_sums: array<atomic<i32>>;
+// Emitters' normal moments: (cell x 3 + channel) x 4 + (flux x normal xyz, flux).
+@group(0) @binding(6) var<storage, read_write> moment_sums: array<atomic<i32>>;
 
 fn add_light(cell: u32, channel: u32, sh: vec4<f32>) {
     let base = (cell * 3u + channel) * 4u;
@@ -22,6 +24,16 @@ fn add_light(cell: u32, channel: u32, sh: vec4<f32>) {
     for (var k = 0u; k < 4u; k++) {
         if scaled[k] != 0 {
             atomicAdd(&light_sums[base + k], scaled[k]);
+        }
+    }
+}
+
+fn add_moment(cell: u32, channel: u32, moment: vec4<f32>) {
+    let base = (cell * 3u + channel) * 4u;
+    let scaled = vec4<i32>(round(moment * lpv.settings.light_scale));
+    for (var k = 0u; k < 4u; k++) {
+        if scaled[k] != 0 {
+            atomicAdd(&moment_sums[base + k], scaled[k]);
         }
     }
 }
@@ -75,6 +87,12 @@ fn cs_inject(@builtin(global_invocation_id) id: vec3<u32>) {
         add_light(cell, 0u, flux.r * lobe);
         add_light(cell, 1u, flux.g * lobe);
         add_light(cell, 2u, flux.b * lobe);
+        if lpv.settings.emitter_orientation != 0u {
+            let moment = vec4<f32>(n, 1.0);
+            add_moment(cell, 0u, flux.r * moment);
+            add_moment(cell, 1u, flux.g * moment);
+            add_moment(cell, 2u, flux.b * moment);
+        }
     }
     add_occluder(0u, position.xyz, n, normal.w);
 }

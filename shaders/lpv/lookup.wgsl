@@ -20,6 +20,16 @@
 @group(2) @binding(1) var<storage, read> accumulated: array<vec4<f32>>;
 @group(2) @binding(2) var indirect_out: texture_storage_2d<rgba16float, write>;
 @group(2) @binding(3) var<storage, read> near: array<vec4<f32>>;
+@group(2) @binding(4) var<storage, read> moments: array<vec4<f32>>;
+
+// What `sample_grid` reads.
+const ACCUMULATED: u32 = 0u;
+const WITHIN_HALF: u32 = 1u;
+const MOMENTS: u32 = 2u;
+
+// Band 1 over band 0 of the two-band projection of a uniform hemisphere about its axis:
+// y1 pi / (y0 2 pi) = sqrt(3)/2, where the clamped-cosine lookup facing the axis is zero.
+const HEMISPHERE_BAND_RATIO: f32 = 0.8660254;
 
 struct Sample {
     red: vec4<f32>,
@@ -27,9 +37,9 @@ struct Sample {
     blue: vec4<f32>,
 }
 
-// Trilinear SH of grid k at p (cells outside the grid count as dark): the accumulated light,
-// or with `within_half` the light after half the steps.
-fn sample_grid(k: u32, p: vec3<f32>, within_half: bool) -> Sample {
+// Trilinear values of grid k at p (cells outside the grid count as dark): the accumulated
+// light's SH, the light's after half the steps, or the emitters' moments.
+fn sample_grid(k: u32, p: vec3<f32>, what: u32) -> Sample {
     let g = lpv.cascades[k];
     let u = (p - g.min) / g.cell - vec3<f32>(0.5);
     let base = vec3<i32>(floor(u));
@@ -44,10 +54,14 @@ fn sample_grid(k: u32, p: vec3<f32>, within_half: bool) -> Sample {
         let w = mix(1.0 - f.x, f.x, f32(o.x)) * mix(1.0 - f.y, f.y, f32(o.y))
             * mix(1.0 - f.z, f.z, f32(o.z));
         let i = cell_index(k, c) * 3u;
-        if within_half {
+        if what == WITHIN_HALF {
             out.red += w * near[i];
             out.green += w * near[i + 1u];
             out.blue += w * near[i + 2u];
+        } else if what == MOMENTS {
+            out.red += w * moments[i];
+            out.green += w * moments[i + 1u];
+            out.blue += w * moments[i + 2u];
         } else {
             out.red += w * accumulated[i];
             out.green += w * accumulated[i + 1u];
@@ -72,13 +86,42 @@ fn lookup_point(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return p + n * (lpv.settings.damping * lpv.cascades[k].cell);
 }
 
+// The clamped-cosine lookup of one channel's SH `s` on a surface with normal n: the SH
+// product with the lobe around -n, C0 c0 - C1 (g . n), where g is the direction light flows
+// towards (the field is y0 c0 + y1 g . w). With `emitter_orientation`, g along the mean
+// normal of the emitters nearby (moment.xyz / moment.w, shorter than 1 where their normals
+// differ) is raised to what emitters facing that way give, HEMISPHERE_BAND_RATIO c0 times its
+// length: propagation spreads light sideways and adds band 0 faster than band 1, so a lit
+// plane would otherwise light itself (see `sh.rs`).
+fn receive(s: vec4<f32>, moment: vec4<f32>, n: vec3<f32>) -> f32 {
+    var g = vec3<f32>(-s.w, -s.y, s.z);
+    if lpv.settings.emitter_orientation != 0u && moment.w > 0.0 {
+        let mean = moment.xyz / moment.w;
+        let m = min(length(mean), 1.0);
+        if m > 1e-4 {
+            let axis = normalize(mean);
+            let restored = HEMISPHERE_BAND_RATIO * s.x * m;
+            g += max(restored - dot(g, axis), 0.0) * axis;
+        }
+    }
+    return SH_COS0 * s.x - SH_COS1 * dot(g, n);
+}
+
 // Irradiance over pi on a surface with normal n, read from grid k at its lookup point for p
 // (not clamped: grids combine before the clamp).
-fn irradiance(k: u32, p: vec3<f32>, n: vec3<f32>, within_half: bool) -> vec3<f32> {
+fn irradiance(k: u32, p: vec3<f32>, n: vec3<f32>, what: u32) -> vec3<f32> {
     let g = lpv.cascades[k];
-    let s = sample_grid(k, lookup_point(k, p, n), within_half);
-    let lobe = sh_cosine_lobe(-n);
-    let e = vec3<f32>(dot(s.red, lobe), dot(s.green, lobe), dot(s.blue, lobe));
+    let q = lookup_point(k, p, n);
+    let s = sample_grid(k, q, what);
+    var m: Sample;
+    if lpv.settings.emitter_orientation != 0u {
+        m = sample_grid(k, q, MOMENTS);
+    }
+    let e = vec3<f32>(
+        receive(s.red, m.red, n),
+        receive(s.green, m.green, n),
+        receive(s.blue, m.blue, n),
+    );
     return e / (g.cell * g.cell * 3.14159265);
 }
 
@@ -95,16 +138,16 @@ fn cs_lookup(@builtin(global_invocation_id) id: vec3<u32>) {
         let count = lpv.settings.cascade_count;
         let coarsest = count - 1u;
         light = grid_weight(coarsest, lookup_point(coarsest, s.position, s.normal))
-            * irradiance(coarsest, s.position, s.normal, false);
+            * irradiance(coarsest, s.position, s.normal, ACCUMULATED);
         for (var j = 1u; j < count; j++) {
             let k = coarsest - j;
             let w = grid_weight(k, lookup_point(k, s.position, s.normal));
             if w <= 0.0 {
                 continue;
             }
-            let fine = irradiance(k, s.position, s.normal, false);
+            let fine = irradiance(k, s.position, s.normal, ACCUMULATED);
             if lpv.settings.coarse_far_light != 0u {
-                light += w * (fine - irradiance(k + 1u, s.position, s.normal, true));
+                light += w * (fine - irradiance(k + 1u, s.position, s.normal, WITHIN_HALF));
             } else {
                 light = mix(light, fine, w);
             }

@@ -31,8 +31,10 @@ struct LpvSettings {
     // 1 when a coarser grid adds only the light that travelled beyond the next finer grid's
     // reach (its steps past half the iterations); 0 when a finer grid replaces it.
     coarse_far_light: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // 1 when lookups restore the flux direction from the emitters' mean normal.
+    emitter_orientation: u32,
+    // Cells each way over which emitters' normals are averaged.
+    orientation_cells: u32,
     _pad2: u32,
 }
 

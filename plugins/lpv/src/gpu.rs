@@ -30,8 +30,8 @@ pub struct LpvSettings {
     pub debug_source: u32,
     pub map_count: u32,
     pub coarse_far_light: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    pub emitter_orientation: u32,
+    pub orientation_cells: u32,
     pub _pad2: u32,
 }
 
@@ -246,6 +246,8 @@ pub const CAMERA_OCCLUDERS_PASS: &str = "LPV camera occluders";
 pub const RESOLVE_PASS: &str = "LPV resolve";
 /// The propagation steps (`"LPV propagation {i}"`).
 pub const PROPAGATE_PASS: &str = "LPV propagation";
+/// The passes that spread the emitters' normal moments (one per axis).
+pub const SPREAD_PASS: &str = "LPV spread emitter normals";
 /// The lookup into the indirect target.
 pub const LOOKUP_PASS: &str = "LPV lookup";
 /// The pass that draws a grid into the debug volume.
@@ -376,6 +378,11 @@ pub struct Volumes {
     /// The accumulated light after half the steps (a coarser grid's share of what the next
     /// finer grid already carries).
     pub near: wgpu::Buffer,
+    /// Fixed-point sums of the emitters' normal moments (per colour: flux x normal, flux).
+    pub moment_sums: wgpu::Buffer,
+    /// The moments, resolved (0) and spread over the box (ping-pong with 1; 1 after the three
+    /// passes).
+    pub moments: [wgpu::Buffer; 2],
 }
 
 impl Volumes {
@@ -399,12 +406,17 @@ impl Volumes {
             steps: [buffer("lpv step a", light), buffer("lpv step b", light)],
             accumulated: buffer("lpv accumulated light", light),
             near: buffer("lpv light within half the steps", light),
+            moment_sums: buffer("lpv emitter moment sums", cells * 12 * 4),
+            moments: [
+                buffer("lpv emitter moments a", light),
+                buffer("lpv emitter moments b", light),
+            ],
         }
     }
 
     /// Bytes of GPU memory.
     pub fn bytes(&self) -> u64 {
-        self.cells * (12 * 4 + 2 * 4 * 4 + 4 * 3 * 16)
+        self.cells * (2 * 12 * 4 + 2 * 4 * 4 + 6 * 3 * 16)
     }
 }
 

@@ -61,7 +61,14 @@ zoo_host::technique_params! {
         /// (iterations x its cell: the coarser grid's steps past half the iterations); off, a
         /// finer grid replaces the coarser ones where it lies and light reaches only
         /// iterations x the finest cell there.
-        coarse_far_light: bool = false;
+        coarse_far_light: bool = true;
+        /// Lookups restore the flux direction that propagation diffuses away, from the mean
+        /// normal of the virtual point lights within `orientation_cells`: above a lit plane a
+        /// receiver facing the plane's way then gets nothing, as in the exact field.
+        emitter_orientation: bool = true;
+        /// Cells each way over which the virtual point lights' normals are averaged (the
+        /// reach of `iterations` by default).
+        orientation_cells: u32 = 8, range(0, 16), step(1);
         /// Spot lights also render reflective shadow maps (directional lights always do).
         spot_lights: bool = false;
         /// Direct shadow-map resolution.
@@ -104,12 +111,24 @@ struct Stages {
     lookup: ComputeStage,
     debug_volume: ComputeStage,
     debug_bounds: ComputeStage,
+    /// The emitters' moments over the box, along x, y and z.
+    spread: [ComputeStage; 3],
 }
 
 impl Stages {
     fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Stages> {
         use wgpu::TextureFormat as F;
         use wgpu::TextureViewDimension as D;
+        let spread = |entry: &str| {
+            ComputeStage::new(
+                ctx,
+                "lpv/spread.wgsl",
+                entry,
+                &[storage(0, true), storage(1, true), storage(2, false)],
+                StageGroups::Alone,
+                &[],
+            )
+        };
         Ok(Stages {
             inject: ComputeStage::new(
                 ctx,
@@ -122,6 +141,7 @@ impl Stages {
                     texture_array(3),
                     storage(4, false),
                     storage(5, false),
+                    storage(6, false),
                 ],
                 StageGroups::Alone,
                 &[],
@@ -143,10 +163,17 @@ impl Stages {
                     storage(1, true),
                     storage(2, false),
                     storage(3, false),
+                    storage(4, true),
+                    storage(5, false),
                 ],
                 StageGroups::Alone,
                 &[],
             )?,
+            spread: [
+                spread("cs_spread_x")?,
+                spread("cs_spread_y")?,
+                spread("cs_spread_z")?,
+            ],
             propagate: ComputeStage::new(
                 ctx,
                 "lpv/propagate.wgsl",
@@ -170,6 +197,7 @@ impl Stages {
                     storage(1, true),
                     storage_texture(2, F::Rgba16Float, D::D2),
                     storage(3, true),
+                    storage(4, true),
                 ],
                 StageGroups::AfterHost,
                 &[],
@@ -213,6 +241,8 @@ struct Groups {
     resolve: wgpu::BindGroup,
     /// Step a to b, and b to a.
     propagate: [wgpu::BindGroup; 2],
+    /// Moments a to b, and b to a.
+    spread: [wgpu::BindGroup; 2],
     lookup: wgpu::BindGroup,
     debug: wgpu::BindGroup,
 }
@@ -328,6 +358,11 @@ impl ShadowTechnique for Lpv {
             passes.push(PassInfo::compute(gpu::CAMERA_OCCLUDERS_PASS));
         }
         passes.push(PassInfo::compute(gpu::RESOLVE_PASS));
+        if self.params.emitter_orientation {
+            for axis in ["x", "y", "z"] {
+                passes.push(PassInfo::compute(format!("{} {axis}", gpu::SPREAD_PASS)));
+            }
+        }
         for i in 0..self.params.iterations {
             passes.push(PassInfo::compute(format!(
                 "{} {}",
@@ -383,6 +418,22 @@ impl ShadowTechnique for Lpv {
                 &v.accumulated,
                 "vec4 x 3",
             ));
+            out.push(ResourceInfo::buffer(
+                "light within half the steps",
+                &v.near,
+                "vec4 x 3",
+            ));
+            out.push(ResourceInfo::buffer(
+                "emitter moment sums",
+                &v.moment_sums,
+                "i32 x 12",
+            ));
+            for (k, name) in ["emitter moments a", "emitter moments b"]
+                .into_iter()
+                .enumerate()
+            {
+                out.push(ResourceInfo::buffer(name, &v.moments[k], "vec4 x 3"));
+            }
         }
         if let Some(d) = &gpu.debug {
             for (k, name) in VOLUME_VIEWS.into_iter().enumerate() {
@@ -461,6 +512,8 @@ impl ShadowTechnique for Lpv {
             debug_source: 0,
             map_count: rsm_lights.len() as u32,
             coarse_far_light: u32::from(p.coarse_far_light),
+            emitter_orientation: u32::from(p.emitter_orientation),
+            orientation_cells: p.orientation_cells,
             ..Default::default()
         };
         let data = LpvData::new(settings, origin, &grids);
@@ -488,6 +541,7 @@ impl ShadowTechnique for Lpv {
         let encoder = recorder.encoder();
         encoder.clear_buffer(&volumes.light_sums, 0, None);
         encoder.clear_buffer(&volumes.occluder_sums, 0, None);
+        encoder.clear_buffer(&volumes.moment_sums, 0, None);
         let s = &gpu.stages;
         let rsm_groups = targets.resolution.div_ceil(8);
         let layers = gpu.rsm_lights.len() as u32;
@@ -524,6 +578,14 @@ impl ShadowTechnique for Lpv {
             [entries.div_ceil(64), 1, 1],
         );
         let n = p.grid_size.div_ceil(4);
+        if p.emitter_orientation {
+            // a -> b -> a -> b: the spread moments end in b.
+            for (axis, stage) in s.spread.iter().enumerate() {
+                let name = format!("{} {}", gpu::SPREAD_PASS, ["x", "y", "z"][axis]);
+                let group = &groups.spread[axis % 2];
+                stage.dispatch(ctx, recorder, &name, group, &[], [n, n, n * p.cascades]);
+            }
+        }
         // Coarser grids keep what they hold after half the steps: the share of their light
         // the next finer grid (half the cell, as many steps) carries in finer detail.
         let near_steps = p.iterations / 2;
@@ -707,6 +769,18 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
             ],
         )
     };
+    let spread = |from: usize| {
+        zoo_host::kit::bind_group(
+            device,
+            "lpv spread group",
+            &s.spread[0].layout,
+            &[
+                data.clone(),
+                buffer(&v.moments[from]),
+                buffer(&v.moments[1 - from]),
+            ],
+        )
+    };
     Groups {
         inject: zoo_host::kit::bind_group(
             device,
@@ -719,6 +793,7 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
                 view(&t.position.1),
                 buffer(&v.light_sums),
                 buffer(&v.occluder_sums),
+                buffer(&v.moment_sums),
             ],
         ),
         camera_occluders: zoo_host::kit::bind_group(
@@ -736,9 +811,12 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
                 buffer(&v.light_sums),
                 buffer(&v.steps[0]),
                 buffer(&v.accumulated),
+                buffer(&v.moment_sums),
+                buffer(&v.moments[0]),
             ],
         ),
         propagate: [propagate(0), propagate(1)],
+        spread: [spread(0), spread(1)],
         lookup: zoo_host::kit::bind_group(
             device,
             "lpv lookup group",
@@ -748,6 +826,7 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
                 buffer(&v.accumulated),
                 view(&ctx.indirect.view),
                 buffer(&v.near),
+                buffer(&v.moments[1]),
             ],
         ),
         debug: zoo_host::kit::bind_group(
@@ -815,8 +894,8 @@ mod tests {
             debug_source,
             map_count,
             coarse_far_light,
-            _pad0,
-            _pad1,
+            emitter_orientation,
+            orientation_cells,
             _pad2
         });
         check_mirror(&source, "LpvSettings", size, &fields, SizeRule::Equal).unwrap();

@@ -48,18 +48,21 @@ fn atrium_against_the_one_bounce_reference() {
         .indirect_rmse(&mut reference, &scene, &scene.lights, 64)
         .unwrap();
     // The amount of light: VPL intensities and the lookup follow from the renderer's units
-    // with no tuning; measured 0.96 to 0.98 of the reference per channel.
+    // with no tuning. Measured 0.83 to 0.85 of the reference per channel: surfaces that face
+    // away from the sunlit ones (the west wall) get a third of theirs, light reaching them
+    // from beyond the coarsest grid's 8 steps or past the geometry volume's cells.
     let (g, e) = (total(&got, |i| mask[i]), total(&expected, |i| mask[i]));
     let ratio = g / e;
     eprintln!("atrium: indirect {g} against {e} (ratio {ratio}), relative RMSE {rmse:.3}");
     assert!(
-        ratio.min_element() > 0.85 && ratio.max_element() < 1.15,
+        ratio.min_element() > 0.78 && ratio.max_element() < 1.15,
         "{ratio}"
     );
-    // Its distribution is a volume's: lit surfaces light themselves through the two-band
-    // lobes and light travels only `iterations` cells. Measured 0.83 (the issue's 0.3 is not
-    // reached); held here so that it cannot get worse unnoticed.
-    assert!(rmse < 0.9, "relative RMSE {rmse}");
+    // Measured 0.41 at 64 rays (0.40 at 256; 0.82 before lookups restored the emitters'
+    // orientation and coarser grids added the light beyond the finer grids' reach). The issue
+    // asks 0.3: see the README's accuracy notes. Held here so that it cannot get worse
+    // unnoticed.
+    assert!(rmse < 0.45, "relative RMSE {rmse}");
 }
 
 #[test]
@@ -122,8 +125,8 @@ fn the_lit_cloth_colours_the_light_around_it() {
             hue(&expected, &below) > hue(&expected, &everywhere) + 0.015,
             "{name}"
         );
-        // The volume carries it near the cloth, weaker and less far than the reference (blue:
-        // +0.081 around the cloth, none below; red: +0.011 around, +0.007 below).
+        // The volume carries it near the cloth (blue: +0.059 around the cloth, +0.001 below;
+        // red: +0.011 around, +0.019 below, where the reference has +0.023 and +0.026).
         let near = hue(&got, &around).max(hue(&got, &below));
         assert!(near > scene_hue + 0.005, "{name}: no colour in the volume");
     }
@@ -161,6 +164,36 @@ fn coarser_grids_carry_the_light_the_finest_grid_cannot_reach() {
     assert!(count > 1000, "{count}");
     // Measured 0.10 and 0.38.
     assert!(after > 2.5 * before, "{before} -> {after}");
+}
+
+#[test]
+fn a_lit_plane_does_not_light_itself() {
+    // A sunlit floor and nothing else: it has no light to receive. Propagation alone turns
+    // its light nearly isotropic and the floor reads it back; restoring the emitters'
+    // orientation at the lookup leaves next to nothing.
+    let scene = scene_from_ron(
+        "lit-plane.ron",
+        "(camera: (position: (0, 6, 12), target: (0, 0, 0)),
+          lights: [Directional(direction: (0.3, -0.9, -0.2), intensity: 3.0)],
+          objects: [(mesh: Plane(size: 24), color: (0.8, 0.8, 0.8))])",
+    );
+    let mut renderer = Renderer::new(gpu(), scene.clone(), SIZE).unwrap();
+    let reference = SceneReference::compute(&mut renderer, 1, |_| {}).unwrap();
+    let mask = reference.surface_mask();
+    let mut floor_light = |orientation: &str| {
+        let values = params(&[("emitter_orientation", orientation)]);
+        let judged = judge_technique(&mut renderer, &reference, "lpv", &values).unwrap();
+        total(&judged.indirect.unwrap(), |i| mask[i]).element_sum()
+    };
+    let (isotropic, restored) = (floor_light("false"), floor_light("true"));
+    // The floor's own reflected light, for scale: albedo x the sun's irradiance per pixel.
+    let pixels = mask.iter().filter(|m| **m).count() as f32;
+    eprintln!("lit plane: {isotropic:.2} without, {restored:.4} with, over {pixels} pixels");
+    assert!(isotropic > 0.05 * pixels, "{isotropic}");
+    assert!(
+        restored < 0.02 * isotropic,
+        "{restored} against {isotropic}"
+    );
 }
 
 #[test]
