@@ -32,10 +32,16 @@ pub fn place(eye: Vec3, view: Vec3, size: u32, count: u32, finest_cell: f32) -> 
         .collect()
 }
 
-/// The finest cell size for a scene whose bounds have diagonal `diagonal`: the coarsest of
-/// `count` grids spans the whole diagonal.
-pub fn finest_cell(diagonal: f32, size: u32, count: u32) -> f32 {
-    (diagonal / size as f32 / (1u32 << count.saturating_sub(1)) as f32).max(1e-4)
+/// The share of the scene's diagonal light travels in the coarsest grid over all its steps.
+pub const REACH: f32 = 1.0 / 3.0;
+
+/// The finest cell size for a scene whose bounds have diagonal `diagonal`: light in the
+/// coarsest of `count` grids travels [`REACH`] of the diagonal in `steps` steps (one cell a
+/// step). One-bounce light crosses the scene, and a volume's light goes no further than its
+/// steps: coarser cells trade detail for reach.
+pub fn finest_cell(diagonal: f32, steps: u32, count: u32) -> f32 {
+    let coarsest = diagonal * REACH / steps.max(1) as f32;
+    (coarsest / (1u32 << count.saturating_sub(1)) as f32).max(1e-4)
 }
 
 #[cfg(test)]
@@ -74,8 +80,11 @@ mod tests {
     }
 
     #[test]
-    fn the_coarsest_grid_spans_the_scene() {
-        let cell = finest_cell(40.0, 32, 3);
-        assert!((cell * 4.0 * 32.0 - 40.0).abs() < 1e-3);
+    fn light_in_the_coarsest_grid_reaches_a_third_of_the_scene() {
+        let cell = finest_cell(48.0, 8, 3);
+        assert!((cell * 4.0 * 8.0 - 16.0).abs() < 1e-4, "{cell}");
+        // More steps, finer cells at the same reach; no steps, one step's reach.
+        assert!((finest_cell(48.0, 16, 3) - cell / 2.0).abs() < 1e-6);
+        assert!((finest_cell(48.0, 0, 1) - 16.0).abs() < 1e-4);
     }
 }

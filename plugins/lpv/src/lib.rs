@@ -53,7 +53,8 @@ zoo_host::technique_params! {
         damping: f32 = 0.5, range(0.0, 1.0), step(0.05);
         /// Multiplies the indirect light.
         intensity: f32 = 1.0, range(0.0, 10.0), step(0.1);
-        /// Finest cell size in world units (0: the coarsest grid spans the scene's diagonal).
+        /// Finest cell size in world units (0: light in the coarsest grid travels a third of
+        /// the scene's diagonal in `iterations` steps).
         finest_cell: f32 = 0.0, range(0.0, 100.0), step(0.05);
         /// Cells over which a finer grid fades into the next at its border.
         blend_cells: f32 = 2.0, range(0.0, 16.0), step(0.5);
@@ -66,9 +67,9 @@ zoo_host::technique_params! {
         /// normal of the virtual point lights within `orientation_cells`: above a lit plane a
         /// receiver facing the plane's way then gets nothing, as in the exact field.
         emitter_orientation: bool = true;
-        /// Cells each way over which the virtual point lights' normals are averaged (the
-        /// reach of `iterations` by default).
-        orientation_cells: u32 = 8, range(0, 16), step(1);
+        /// Cells each way over which the virtual point lights' normals are averaged (half
+        /// the reach of `iterations` by default).
+        orientation_cells: u32 = 4, range(0, 16), step(1);
         /// Spot lights also render reflective shadow maps (directional lights always do).
         spot_lights: bool = false;
         /// Direct shadow-map resolution.
@@ -482,7 +483,7 @@ impl ShadowTechnique for Lpv {
         let finest = if p.finest_cell > 0.0 {
             p.finest_cell
         } else {
-            cascades::finest_cell(diagonal, p.grid_size, p.cascades)
+            cascades::finest_cell(diagonal, p.iterations, p.cascades)
         };
         let view = (ctx.camera.target - ctx.camera.position).normalize_or(Vec3::NEG_Z);
         let grids = cascades::place(ctx.camera.position, view, p.grid_size, p.cascades, finest);
