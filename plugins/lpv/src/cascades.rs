@@ -32,15 +32,12 @@ pub fn place(eye: Vec3, view: Vec3, size: u32, count: u32, finest_cell: f32) -> 
         .collect()
 }
 
-/// The share of the scene's diagonal light travels in the coarsest grid over all its steps.
-pub const REACH: f32 = 1.0 / 3.0;
-
 /// The finest cell size for a scene whose bounds have diagonal `diagonal`: light in the
-/// coarsest of `count` grids travels [`REACH`] of the diagonal in `steps` steps (one cell a
+/// coarsest of `count` grids travels `reach` times the diagonal in `steps` steps (one cell a
 /// step). One-bounce light crosses the scene, and a volume's light goes no further than its
 /// steps: coarser cells trade detail for reach.
-pub fn finest_cell(diagonal: f32, steps: u32, count: u32) -> f32 {
-    let coarsest = diagonal * REACH / steps.max(1) as f32;
+pub fn finest_cell(diagonal: f32, reach: f32, steps: u32, count: u32) -> f32 {
+    let coarsest = diagonal * reach / steps.max(1) as f32;
     (coarsest / (1u32 << count.saturating_sub(1)) as f32).max(1e-4)
 }
 
@@ -80,11 +77,11 @@ mod tests {
     }
 
     #[test]
-    fn light_in_the_coarsest_grid_reaches_a_third_of_the_scene() {
-        let cell = finest_cell(48.0, 8, 3);
-        assert!((cell * 4.0 * 8.0 - 16.0).abs() < 1e-4, "{cell}");
+    fn light_in_the_coarsest_grid_travels_the_reach() {
+        let cell = finest_cell(48.0, 0.4, 8, 3);
+        assert!((cell * 4.0 * 8.0 - 19.2).abs() < 1e-4, "{cell}");
         // More steps, finer cells at the same reach; no steps, one step's reach.
-        assert!((finest_cell(48.0, 16, 3) - cell / 2.0).abs() < 1e-6);
-        assert!((finest_cell(48.0, 0, 1) - 16.0).abs() < 1e-4);
+        assert!((finest_cell(48.0, 0.4, 16, 3) - cell / 2.0).abs() < 1e-6);
+        assert!((finest_cell(48.0, 0.5, 0, 1) - 24.0).abs() < 1e-4);
     }
 }

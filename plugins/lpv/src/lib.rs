@@ -50,11 +50,13 @@ zoo_host::technique_params! {
         /// Add the camera's G-buffer surfels to the geometry volume.
         camera_occluders: bool = true;
         /// Lookups move this fraction of a cell along the normal (against self-bleeding).
-        damping: f32 = 0.5, range(0.0, 1.0), step(0.05);
+        damping: f32 = 0.4, range(0.0, 1.0), step(0.05);
         /// Multiplies the indirect light.
         intensity: f32 = 1.0, range(0.0, 10.0), step(0.1);
-        /// Finest cell size in world units (0: light in the coarsest grid travels a third of
-        /// the scene's diagonal in `iterations` steps).
+        /// How far light travels in the coarsest grid over `iterations` steps, as a share of
+        /// the scene's diagonal: sets the cells' size (coarser cells reach further).
+        reach: f32 = 0.4, range(0.05, 2.0), step(0.05);
+        /// Finest cell size in world units (0: from `reach`).
         finest_cell: f32 = 0.0, range(0.0, 100.0), step(0.05);
         /// Cells over which a finer grid fades into the next at its border.
         blend_cells: f32 = 2.0, range(0.0, 16.0), step(0.5);
@@ -483,7 +485,7 @@ impl ShadowTechnique for Lpv {
         let finest = if p.finest_cell > 0.0 {
             p.finest_cell
         } else {
-            cascades::finest_cell(diagonal, p.iterations, p.cascades)
+            cascades::finest_cell(diagonal, p.reach, p.iterations, p.cascades)
         };
         let view = (ctx.camera.target - ctx.camera.position).normalize_or(Vec3::NEG_Z);
         let grids = cascades::place(ctx.camera.position, view, p.grid_size, p.cascades, finest);

@@ -40,29 +40,29 @@ fn atrium_against_the_one_bounce_reference() {
     let scene = Scene::load(&scene_path("atrium.ron")).unwrap();
     let mut renderer = Renderer::new(gpu(), scene.clone(), SIZE).unwrap();
     let mut reference = SceneReference::compute(&mut renderer, 16, |_| {}).unwrap();
-    let expected = reference.indirect(&scene, &scene.lights, 64).to_vec();
+    // 256 rays a pixel: the reference's own noise is then 0.06 in relative RMSE (0.12 at 64
+    // rays, which would add about 0.02 to the score below).
+    let rays = 256;
+    let expected = reference.indirect(&scene, &scene.lights, rays).to_vec();
     let mask = reference.surface_mask();
     let judged = judge_technique(&mut renderer, &reference, "lpv", &params(&[])).unwrap();
     let got = judged.indirect.clone().expect("lpv adds light");
     let rmse = judged
-        .indirect_rmse(&mut reference, &scene, &scene.lights, 64)
+        .indirect_rmse(&mut reference, &scene, &scene.lights, rays)
         .unwrap();
     // The amount of light: VPL intensities and the lookup follow from the renderer's units
-    // with no tuning. Measured 0.83 to 0.85 of the reference per channel: surfaces that face
-    // away from the sunlit ones (the west wall) get a third of theirs, light reaching them
-    // from beyond the coarsest grid's 8 steps or past the geometry volume's cells.
+    // with no tuning; measured 0.99 of the reference per channel.
     let (g, e) = (total(&got, |i| mask[i]), total(&expected, |i| mask[i]));
     let ratio = g / e;
     eprintln!("atrium: indirect {g} against {e} (ratio {ratio}), relative RMSE {rmse:.3}");
     assert!(
-        ratio.min_element() > 0.78 && ratio.max_element() < 1.15,
+        ratio.min_element() > 0.85 && ratio.max_element() < 1.15,
         "{ratio}"
     );
-    // Measured 0.41 at 64 rays (0.40 at 256; 0.82 before lookups restored the emitters'
-    // orientation and coarser grids added the light beyond the finer grids' reach). The issue
-    // asks 0.3: see the README's accuracy notes. Held here so that it cannot get worse
-    // unnoticed.
-    assert!(rmse < 0.45, "relative RMSE {rmse}");
+    // The issue's bound. Measured 0.294 (0.82 before lookups restored the emitters'
+    // orientation, coarser grids added the light beyond the finer grids' reach and the cells
+    // were sized for reach).
+    assert!(rmse <= 0.3, "relative RMSE {rmse}");
 }
 
 #[test]
@@ -125,10 +125,13 @@ fn the_lit_cloth_colours_the_light_around_it() {
             hue(&expected, &below) > hue(&expected, &everywhere) + 0.015,
             "{name}"
         );
-        // The volume carries it near the cloth (blue: +0.059 around the cloth, +0.001 below;
-        // red: +0.011 around, +0.019 below, where the reference has +0.023 and +0.026).
-        let near = hue(&got, &around).max(hue(&got, &below));
-        assert!(near > scene_hue + 0.005, "{name}: no colour in the volume");
+        // So does the volume: blue +0.011 below the cloth (the reference +0.023), red +0.021
+        // (+0.026). It also tints the wall around the cloth (blue +0.033, red +0.011), where
+        // the reference has none: the cloth's own light, spread sideways.
+        assert!(
+            hue(&got, &below) > scene_hue + 0.005,
+            "{name}: no colour on the floor below"
+        );
     }
 }
 
