@@ -1,5 +1,6 @@
-// Debug views: one grid as a 3D image (the accumulated light's mean intensity per channel, or
-// the occluders' mean blocking potential), and the grid bounds on screen.
+// Debug views: one grid as a 3D image (the accumulated light's mean intensity per channel, the
+// occluders' mean blocking potential, or the emitters' mean normal), and the grid bounds on
+// screen.
 
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
@@ -10,6 +11,7 @@
 @group(2) @binding(2) var<storage, read> occluder_sums: array<i32>;
 @group(2) @binding(3) var volume_out: texture_storage_3d<rgba16float, write>;
 @group(2) @binding(4) var bounds_out: texture_storage_2d<rgba8unorm, write>;
+@group(2) @binding(5) var<storage, read> moments: array<vec4<f32>>;
 
 // The mean of an SH4 over the sphere is its band-0 coefficient times y00.
 @compute @workgroup_size(4, 4, 4)
@@ -24,6 +26,15 @@ fn cs_volume(@builtin(global_invocation_id) id: vec3<u32>) {
     if lpv.settings.debug_source == 0u {
         let i = cell * 3u;
         value = SH_Y0 * vec3<f32>(accumulated[i].x, accumulated[i + 1u].x, accumulated[i + 2u].x);
+    } else if lpv.settings.debug_source == 2u {
+        // The emitters' mean normal (flux-weighted over the channels) as 0.5 + 0.5 n, scaled
+        // by its length: grey where normals cancel, black without emitters.
+        let i = cell * 3u;
+        let m = moments[i] + moments[i + 1u] + moments[i + 2u];
+        if m.w > 0.0 && lpv.settings.emitter_orientation != 0u {
+            let mean = m.xyz / m.w;
+            value = length(mean) * (0.5 + 0.5 * normalize(mean));
+        }
     } else {
         let total = cells_per_grid() * lpv.settings.cascade_count;
         let light_view = f32(occluder_sums[cell * 4u]);

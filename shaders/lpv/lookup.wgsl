@@ -22,28 +22,32 @@
 @group(2) @binding(3) var<storage, read> near: array<vec4<f32>>;
 @group(2) @binding(4) var<storage, read> moments: array<vec4<f32>>;
 
-// What `sample_grid` reads.
-const ACCUMULATED: u32 = 0u;
-const WITHIN_HALF: u32 = 1u;
-const MOMENTS: u32 = 2u;
-
 // Band 1 over band 0 of the two-band projection of a uniform hemisphere about its axis:
 // y1 pi / (y0 2 pi) = sqrt(3)/2, where the clamped-cosine lookup facing the axis is zero.
 const HEMISPHERE_BAND_RATIO: f32 = 0.8660254;
 
-struct Sample {
-    red: vec4<f32>,
-    green: vec4<f32>,
-    blue: vec4<f32>,
+// One colour's values in a grid at a point.
+struct Channel {
+    // The accumulated light's SH.
+    light: vec4<f32>,
+    // The light's SH after half the steps.
+    near: vec4<f32>,
+    // The emitters' moments (flux x normal, flux).
+    moment: vec4<f32>,
 }
 
-// Trilinear values of grid k at p (cells outside the grid count as dark): the accumulated
-// light's SH, the light's after half the steps, or the emitters' moments.
-fn sample_grid(k: u32, p: vec3<f32>, what: u32) -> Sample {
+struct Sample {
+    channels: array<Channel, 3>,
+}
+
+// Trilinear values of grid k at p, each cell read once (cells outside the grid count as
+// dark). `with_near` also reads the light after half the steps.
+fn sample_grid(k: u32, p: vec3<f32>, with_near: bool) -> Sample {
     let g = lpv.cascades[k];
     let u = (p - g.min) / g.cell - vec3<f32>(0.5);
     let base = vec3<i32>(floor(u));
     let f = u - floor(u);
+    let oriented = lpv.settings.emitter_orientation != 0u;
     var out: Sample;
     for (var corner = 0u; corner < 8u; corner++) {
         let o = vec3<i32>(i32(corner & 1u), i32((corner >> 1u) & 1u), i32((corner >> 2u) & 1u));
@@ -54,18 +58,14 @@ fn sample_grid(k: u32, p: vec3<f32>, what: u32) -> Sample {
         let w = mix(1.0 - f.x, f.x, f32(o.x)) * mix(1.0 - f.y, f.y, f32(o.y))
             * mix(1.0 - f.z, f.z, f32(o.z));
         let i = cell_index(k, c) * 3u;
-        if what == WITHIN_HALF {
-            out.red += w * near[i];
-            out.green += w * near[i + 1u];
-            out.blue += w * near[i + 2u];
-        } else if what == MOMENTS {
-            out.red += w * moments[i];
-            out.green += w * moments[i + 1u];
-            out.blue += w * moments[i + 2u];
-        } else {
-            out.red += w * accumulated[i];
-            out.green += w * accumulated[i + 1u];
-            out.blue += w * accumulated[i + 2u];
+        for (var ch = 0u; ch < 3u; ch++) {
+            out.channels[ch].light += w * accumulated[i + ch];
+            if with_near {
+                out.channels[ch].near += w * near[i + ch];
+            }
+            if oriented {
+                out.channels[ch].moment += w * moments[i + ch];
+            }
         }
     }
     return out;
@@ -107,22 +107,25 @@ fn receive(s: vec4<f32>, moment: vec4<f32>, n: vec3<f32>) -> f32 {
     return SH_COS0 * s.x - SH_COS1 * dot(g, n);
 }
 
-// Irradiance over pi on a surface with normal n, read from grid k at its lookup point for p
-// (not clamped: grids combine before the clamp).
-fn irradiance(k: u32, p: vec3<f32>, n: vec3<f32>, what: u32) -> vec3<f32> {
-    let g = lpv.cascades[k];
-    let q = lookup_point(k, p, n);
-    let s = sample_grid(k, q, what);
-    var m: Sample;
-    if lpv.settings.emitter_orientation != 0u {
-        m = sample_grid(k, q, MOMENTS);
+// One grid's irradiance over pi on a surface with normal n (not clamped: grids combine
+// before the clamp): from all its light, and from its light after half the steps.
+struct Irradiance {
+    all: vec3<f32>,
+    near: vec3<f32>,
+}
+
+fn irradiance(k: u32, p: vec3<f32>, n: vec3<f32>, with_near: bool) -> Irradiance {
+    let s = sample_grid(k, lookup_point(k, p, n), with_near);
+    var out: Irradiance;
+    for (var ch = 0u; ch < 3u; ch++) {
+        let c = s.channels[ch];
+        out.all[ch] = receive(c.light, c.moment, n);
+        out.near[ch] = receive(c.near, c.moment, n);
     }
-    let e = vec3<f32>(
-        receive(s.red, m.red, n),
-        receive(s.green, m.green, n),
-        receive(s.blue, m.blue, n),
-    );
-    return e / (g.cell * g.cell * 3.14159265);
+    let area = lpv.cascades[k].cell * lpv.cascades[k].cell * 3.14159265;
+    out.all /= area;
+    out.near /= area;
+    return out;
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -136,21 +139,25 @@ fn cs_lookup(@builtin(global_invocation_id) id: vec3<u32>) {
     var light = vec3<f32>(0.0);
     if s.valid {
         let count = lpv.settings.cascade_count;
+        let far = lpv.settings.coarse_far_light != 0u;
+        // From the coarsest grid in; `coarser` is the grid read last (its light within half
+        // the steps is what the next finer grid replaces).
         let coarsest = count - 1u;
-        light = grid_weight(coarsest, lookup_point(coarsest, s.position, s.normal))
-            * irradiance(coarsest, s.position, s.normal, ACCUMULATED);
+        var coarser = irradiance(coarsest, s.position, s.normal, far && count > 1u);
+        light = grid_weight(coarsest, lookup_point(coarsest, s.position, s.normal)) * coarser.all;
         for (var j = 1u; j < count; j++) {
             let k = coarsest - j;
             let w = grid_weight(k, lookup_point(k, s.position, s.normal));
             if w <= 0.0 {
-                continue;
+                break;
             }
-            let fine = irradiance(k, s.position, s.normal, ACCUMULATED);
-            if lpv.settings.coarse_far_light != 0u {
-                light += w * (fine - irradiance(k + 1u, s.position, s.normal, WITHIN_HALF));
+            let fine = irradiance(k, s.position, s.normal, far && k > 0u);
+            if far {
+                light += w * (fine.all - coarser.near);
             } else {
-                light = mix(light, fine, w);
+                light = mix(light, fine.all, w);
             }
+            coarser = fine;
         }
     }
     light = max(light, vec3<f32>(0.0));
