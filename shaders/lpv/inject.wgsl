@@ -3,7 +3,7 @@
 // cell along its normal (so a surface does not light itself); its surfel's blocking potential
 // B(w) = A_s s^-2 <n_s, w>+ goes into the geometry volume, whose cells are centred on the
 // light grid's corners. The camera's G-buffer adds occluders the light does not see. Sums are
-// fixed point (integer atomics), resolved by `propagate.wgsl`.
+// fixed point (integer atomics), resolved by `resolve.wgsl`.
 
 #import "lpv/volume.wgsl"
 

@@ -140,24 +140,24 @@ fn cs_lookup(@builtin(global_invocation_id) id: vec3<u32>) {
     if s.valid {
         let count = lpv.settings.cascade_count;
         let far = lpv.settings.coarse_far_light != 0u;
-        // From the coarsest grid in; `coarser` is the grid read last (its light within half
-        // the steps is what the next finer grid replaces).
+        // From the coarsest grid in; `coarser` is the grid read last and `coarser_weight` the
+        // weight its light has in `light` (its light within half the steps, at that weight,
+        // is what the next finer grid replaces).
         let coarsest = count - 1u;
         var coarser = irradiance(coarsest, s.position, s.normal, far && count > 1u);
-        light = grid_weight(coarsest, lookup_point(coarsest, s.position, s.normal)) * coarser.all;
+        var coarser_weight = grid_weight(coarsest, lookup_point(coarsest, s.position, s.normal));
+        light = coarser_weight * coarser.all;
         for (var j = 1u; j < count; j++) {
             let k = coarsest - j;
             let w = grid_weight(k, lookup_point(k, s.position, s.normal));
-            if w <= 0.0 {
-                break;
-            }
             let fine = irradiance(k, s.position, s.normal, far && k > 0u);
             if far {
-                light += w * (fine.all - coarser.near);
+                light += w * (fine.all - coarser_weight * coarser.near);
             } else {
                 light = mix(light, fine.all, w);
             }
             coarser = fine;
+            coarser_weight = w;
         }
     }
     light = max(light, vec3<f32>(0.0));

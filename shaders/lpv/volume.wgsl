@@ -22,7 +22,7 @@ struct LpvSettings {
     camera_occluders: u32,
     // Cells over which a finer grid fades into the next at its border.
     blend_cells: f32,
-    // The grid and volume the debug volume view shows (0 light, 1 occluders).
+    // The grid and volume the debug volume view shows (0 light, 1 occluders, 2 emitter normals).
     debug_cascade: u32,
     debug_source: u32,
     // Reflective shadow maps injected (each sees the same surfaces: their surfels count

@@ -230,8 +230,9 @@ fn summary_table(judged: &[Judged]) -> String {
 }
 
 /// Scores the indirect light of the techniques that add light against the one-bounce
-/// reference (traced once, with the area samples per pixel), writes `indirect.csv` and an
-/// error map per technique, and returns (technique, relative RMSE).
+/// reference (traced once, with the area samples per pixel), writes `indirect.csv`, an error
+/// map and the indirect light (`.hdr`) per technique and the reference's, and returns
+/// (technique, relative RMSE).
 fn judge_indirect(
     judged: &[Judged],
     reference: &mut SceneReference,

@@ -75,8 +75,8 @@ zoo_host::technique_params! {
         /// normal of the virtual point lights within `orientation_cells`: above a lit plane a
         /// receiver facing the plane's way then gets nothing, as in the exact field.
         emitter_orientation: bool = true;
-        /// Cells each way over which the virtual point lights' normals are averaged (half
-        /// the reach of `iterations` by default).
+        /// Cells each way over which the virtual point lights' normals are averaged (4: half
+        /// the default 8 iterations' reach).
         orientation_cells: u32 = 4, range(0, 16), step(1);
         /// Spot lights also render reflective shadow maps (directional lights always do).
         spot_lights: bool = false;
@@ -108,6 +108,9 @@ struct LpvShadow {
 
 const MAP_PASS: &str = "LPV shadow map";
 const SHADOW_PASS: &str = "LPV shadows";
+/// The axes the emitters' moments are spread along, one pass each (pass names).
+const SPREAD_AXES: [&str; 3] = ["x", "y", "z"];
+
 const VOLUME_VIEWS: [&str; 3] = ["light volume", "geometry volume", "emitter normals"];
 const RSM_VIEWS: [&str; 3] = ["RSM flux", "RSM normals", "RSM positions"];
 
@@ -330,7 +333,7 @@ impl Lpv {
 /// The fixed-point scale of the injected light: all the light every virtual point light of
 /// `resolution`² texels can carry (radiance × the texel's area across the light's rays, which
 /// for spot lights the falloff bounds by the texel's solid angle), times the lobe's largest
-/// coefficient, fits in 2^30.
+/// coefficient, fits in 2^30. The emitters' moments share it (their largest factor is 1).
 fn light_scale(
     lights: &[zoo_host::Light],
     rsm: &[usize],
@@ -370,7 +373,7 @@ impl ShadowTechnique for Lpv {
         }
         passes.push(PassInfo::compute(gpu::RESOLVE_PASS));
         if self.params.emitter_orientation {
-            for axis in ["x", "y", "z"] {
+            for axis in SPREAD_AXES {
                 passes.push(PassInfo::compute(format!("{} {axis}", gpu::SPREAD_PASS)));
             }
         }
@@ -592,13 +595,15 @@ impl ShadowTechnique for Lpv {
         if p.emitter_orientation {
             // a -> b -> a -> b: the spread moments end in b.
             for (axis, stage) in s.spread.iter().enumerate() {
-                let name = format!("{} {}", gpu::SPREAD_PASS, ["x", "y", "z"][axis]);
+                let name = format!("{} {}", gpu::SPREAD_PASS, SPREAD_AXES[axis]);
                 let group = &groups.spread[axis % 2];
                 stage.dispatch(ctx, recorder, &name, group, &[], [n, n, n * p.cascades]);
             }
         }
         // Coarser grids keep what they hold after half the steps: the share of their light
         // the next finer grid (half the cell, as many steps) carries in finer detail.
+        // (Rounded down: with odd iterations the finer grid's last half step of reach is
+        // counted twice.)
         let near_steps = p.iterations / 2;
         let keep_near = p.coarse_far_light && p.cascades > 1;
         if keep_near && near_steps == 0 {
@@ -783,7 +788,7 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
     let spread = |from: usize| {
         zoo_host::kit::bind_group(
             device,
-            "lpv spread group",
+            ["lpv spread group a to b", "lpv spread group b to a"][from],
             &s.spread[0].layout,
             &[
                 data.clone(),
