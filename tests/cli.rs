@@ -140,22 +140,27 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
-#[test]
-fn compare_writes_csv_report_and_error_maps() {
-    let out_dir = temp_dir("compare").join("results");
-    let out = shadow_zoo(&[
+/// `compare` of one technique on `scene` at 64x48 with 4 samples, into `out_dir`.
+fn compare_small(scene: &str, technique: &str, out_dir: &std::path::Path) -> Output {
+    shadow_zoo(&[
         "compare",
         "--scene",
-        "scenes/planar-room.ron",
+        scene,
         "--techniques",
-        "unshadowed",
+        technique,
         "--size",
         "64x48",
         "--samples",
         "4",
         "--out",
         out_dir.to_str().unwrap(),
-    ]);
+    ])
+}
+
+#[test]
+fn compare_writes_csv_report_and_error_maps() {
+    let out_dir = temp_dir("compare").join("results");
+    let out = compare_small("scenes/planar-room.ron", "unshadowed", &out_dir);
     let all = text(&out);
     assert!(out.status.success(), "{all}");
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
@@ -198,19 +203,7 @@ fn compare_writes_csv_report_and_error_maps() {
 #[test]
 fn compare_writes_the_indirect_light_it_scores() {
     let out_dir = temp_dir("compare-indirect").join("results");
-    let out = shadow_zoo(&[
-        "compare",
-        "--scene",
-        "scenes/atrium.ron",
-        "--techniques",
-        "lpv",
-        "--size",
-        "64x48",
-        "--samples",
-        "4",
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
+    let out = compare_small("scenes/atrium.ron", "lpv", &out_dir);
     let all = text(&out);
     assert!(out.status.success(), "{all}");
     let csv = std::fs::read_to_string(out_dir.join("indirect.csv")).unwrap();

@@ -18,22 +18,19 @@
 // Emitters' normal moments: (cell x 3 + channel) x 4 + (flux x normal xyz, flux).
 @group(0) @binding(6) var<storage, read_write> moment_sums: array<atomic<i32>>;
 
-fn add_light(cell: u32, channel: u32, sh: vec4<f32>) {
+// Adds `value` in fixed point to a cell's channel: its light SH, or with `moment` its
+// emitters' moments.
+fn add_sums(moment: bool, cell: u32, channel: u32, value: vec4<f32>) {
     let base = (cell * 3u + channel) * 4u;
-    let scaled = vec4<i32>(round(sh * lpv.settings.light_scale));
+    let scaled = vec4<i32>(round(value * lpv.settings.light_scale));
     for (var k = 0u; k < 4u; k++) {
-        if scaled[k] != 0 {
-            atomicAdd(&light_sums[base + k], scaled[k]);
+        if scaled[k] == 0 {
+            continue;
         }
-    }
-}
-
-fn add_moment(cell: u32, channel: u32, moment: vec4<f32>) {
-    let base = (cell * 3u + channel) * 4u;
-    let scaled = vec4<i32>(round(moment * lpv.settings.light_scale));
-    for (var k = 0u; k < 4u; k++) {
-        if scaled[k] != 0 {
+        if moment {
             atomicAdd(&moment_sums[base + k], scaled[k]);
+        } else {
+            atomicAdd(&light_sums[base + k], scaled[k]);
         }
     }
 }
@@ -84,14 +81,14 @@ fn cs_inject(@builtin(global_invocation_id) id: vec3<u32>) {
             continue;
         }
         let cell = cell_index(k, c);
-        add_light(cell, 0u, flux.r * lobe);
-        add_light(cell, 1u, flux.g * lobe);
-        add_light(cell, 2u, flux.b * lobe);
+        add_sums(false, cell, 0u, flux.r * lobe);
+        add_sums(false, cell, 1u, flux.g * lobe);
+        add_sums(false, cell, 2u, flux.b * lobe);
         if lpv.settings.emitter_orientation != 0u {
             let moment = vec4<f32>(n, 1.0);
-            add_moment(cell, 0u, flux.r * moment);
-            add_moment(cell, 1u, flux.g * moment);
-            add_moment(cell, 2u, flux.b * moment);
+            add_sums(true, cell, 0u, flux.r * moment);
+            add_sums(true, cell, 1u, flux.g * moment);
+            add_sums(true, cell, 2u, flux.b * moment);
         }
     }
     add_occluder(0u, position.xyz, n, normal.w);

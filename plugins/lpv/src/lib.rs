@@ -407,46 +407,20 @@ impl ShadowTechnique for Lpv {
             out.push(ResourceInfo::texture("RSM depth", t.depth(), false));
         }
         if let Some(v) = &gpu.volumes {
-            out.push(ResourceInfo::buffer(
-                "light sums",
-                &v.light_sums,
-                "i32 x 12",
-            ));
-            out.push(ResourceInfo::buffer(
-                "occluder sums",
-                &v.occluder_sums,
-                "i32 x 4 x 2",
-            ));
-            out.push(ResourceInfo::buffer(
-                "propagation step a",
-                &v.steps[0],
-                "vec4 x 3",
-            ));
-            out.push(ResourceInfo::buffer(
-                "propagation step b",
-                &v.steps[1],
-                "vec4 x 3",
-            ));
-            out.push(ResourceInfo::buffer(
-                "accumulated light",
-                &v.accumulated,
-                "vec4 x 3",
-            ));
-            out.push(ResourceInfo::buffer(
-                "light within half the steps",
-                &v.near,
-                "vec4 x 3",
-            ));
-            out.push(ResourceInfo::buffer(
-                "emitter moment sums",
-                &v.moment_sums,
-                "i32 x 12",
-            ));
-            for (k, name) in ["emitter moments a", "emitter moments b"]
-                .into_iter()
-                .enumerate()
-            {
-                out.push(ResourceInfo::buffer(name, &v.moments[k], "vec4 x 3"));
+            // (name, buffer, what a cell holds)
+            let buffers = [
+                ("light sums", &v.light_sums, "i32 x 12"),
+                ("occluder sums", &v.occluder_sums, "i32 x 4 x 2"),
+                ("propagation step a", &v.steps[0], "vec4 x 3"),
+                ("propagation step b", &v.steps[1], "vec4 x 3"),
+                ("accumulated light", &v.accumulated, "vec4 x 3"),
+                ("light within half the steps", &v.near, "vec4 x 3"),
+                ("emitter moment sums", &v.moment_sums, "i32 x 12"),
+                ("emitter moments a", &v.moments[0], "vec4 x 3"),
+                ("emitter moments b", &v.moments[1], "vec4 x 3"),
+            ];
+            for (name, buffer, layout) in buffers {
+                out.push(ResourceInfo::buffer(name, buffer, layout));
             }
         }
         if let Some(d) = &gpu.debug {
