@@ -92,12 +92,17 @@ fn cs_propagate(@builtin(global_invocation_id) id: vec3<u32>) {
         if !inside_grid(neighbour) {
             continue;
         }
+        // Cells light has not reached (band 0 of every channel zero) send nothing.
+        let src = cell_index(k, neighbour) * 3u;
+        let dark = source[src].x <= 0.0 && source[src + 1u].x <= 0.0 && source[src + 2u].x <= 0.0;
+        if dark && lpv.settings.skip_dark_cells != 0u {
+            continue;
+        }
         let t = transmittance(k, c, d);
         if t <= 0.0 {
             continue;
         }
         let df = vec3<f32>(d);
-        let src = cell_index(k, neighbour) * 3u;
         for (var ch = 0u; ch < 3u; ch++) {
             let sh = source[src + ch];
             let front = max(dot(sh, sh_basis(df)), 0.0);
@@ -117,6 +122,8 @@ fn cs_propagate(@builtin(global_invocation_id) id: vec3<u32>) {
     let dst = cell_index(k, c) * 3u;
     for (var ch = 0u; ch < 3u; ch++) {
         destination[dst + ch] = sum[ch];
-        accumulated[dst + ch] += sum[ch];
+        if any(sum[ch] != vec4<f32>(0.0)) {
+            accumulated[dst + ch] += sum[ch];
+        }
     }
 }

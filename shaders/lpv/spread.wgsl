@@ -1,7 +1,9 @@
 // Spreads the emitters' normal moments (per cell and colour: the flux-weighted sum of the
 // virtual point lights' normals, and their flux) over a box of `orientation_cells` cells each
-// way, one axis per pass, so that each cell knows the mean normal of the emitters whose light
-// can reach it. The lookup uses it to restore the flux direction propagation diffuses away.
+// way, one axis per pass; run twice, the boxes make a tent whose weights fall to zero at twice
+// that, so that each cell knows the mean normal of the emitters whose light reaches it, the
+// nearer ones weighing more. The lookup uses it to restore the flux direction propagation
+// diffuses away.
 
 #import "lpv/volume.wgsl"
 

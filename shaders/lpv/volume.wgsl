@@ -35,7 +35,8 @@ struct LpvSettings {
     emitter_orientation: u32,
     // Cells each way over which emitters' normals are averaged.
     orientation_cells: u32,
-    _pad2: u32,
+    // 1 when propagation skips neighbours light has not reached.
+    skip_dark_cells: u32,
 }
 
 struct Cascade {

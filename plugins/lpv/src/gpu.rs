@@ -32,7 +32,7 @@ pub struct LpvSettings {
     pub coarse_far_light: u32,
     pub emitter_orientation: u32,
     pub orientation_cells: u32,
-    pub _pad2: u32,
+    pub skip_dark_cells: u32,
 }
 
 /// `Cascade` in `lpv/volume.wgsl`.
@@ -246,7 +246,7 @@ pub const CAMERA_OCCLUDERS_PASS: &str = "LPV camera occluders";
 pub const RESOLVE_PASS: &str = "LPV resolve";
 /// The propagation steps (`"LPV propagation {i}"`).
 pub const PROPAGATE_PASS: &str = "LPV propagation";
-/// The passes that spread the emitters' normal moments (one per axis).
+/// The passes that spread the emitters' normal moments (one per axis, twice).
 pub const SPREAD_PASS: &str = "LPV spread emitter normals";
 /// The lookup into the indirect target.
 pub const LOOKUP_PASS: &str = "LPV lookup";
@@ -380,7 +380,7 @@ pub struct Volumes {
     pub near: wgpu::Buffer,
     /// Fixed-point sums of the emitters' normal moments (per colour: flux x normal, flux).
     pub moment_sums: wgpu::Buffer,
-    /// The moments, resolved (0) and spread over the box (ping-pong with 1; 1 after the three
+    /// The moments, resolved (0) and spread (ping-pong with 1; back in 0 after the six
     /// passes).
     pub moments: [wgpu::Buffer; 2],
 }

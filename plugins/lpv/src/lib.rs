@@ -75,9 +75,14 @@ zoo_host::technique_params! {
         /// normal of the virtual point lights within `orientation_cells`: above a lit plane a
         /// receiver facing the plane's way then gets nothing, as in the exact field.
         emitter_orientation: bool = true;
-        /// Cells each way over which the virtual point lights' normals are averaged (4: half
-        /// the default 8 iterations' reach).
+        /// Cells each way of the box the virtual point lights' normals are averaged over,
+        /// twice: weights fall linearly to zero at twice this (4: the default 8 iterations'
+        /// reach).
         orientation_cells: u32 = 4, range(0, 16), step(1);
+        /// Propagation skips neighbours light has not reached (the same result, less work
+        /// where the grids are dark); off, every cell costs the same, as in the published
+        /// timings.
+        skip_dark_cells: bool = true;
         /// Spot lights also render reflective shadow maps (directional lights always do).
         spot_lights: bool = false;
         /// Direct shadow-map resolution.
@@ -108,8 +113,19 @@ struct LpvShadow {
 
 const MAP_PASS: &str = "LPV shadow map";
 const SHADOW_PASS: &str = "LPV shadows";
-/// The axes the emitters' moments are spread along, one pass each (pass names).
-const SPREAD_AXES: [&str; 3] = ["x", "y", "z"];
+/// The passes that spread the emitters' moments: a box along x, y and z, twice.
+fn spread_pass_names() -> Vec<String> {
+    (0..6)
+        .map(|i| {
+            format!(
+                "{} {} {}",
+                gpu::SPREAD_PASS,
+                ["x", "y", "z"][i % 3],
+                1 + i / 3
+            )
+        })
+        .collect()
+}
 
 const VOLUME_VIEWS: [&str; 3] = ["light volume", "geometry volume", "emitter normals"];
 const RSM_VIEWS: [&str; 3] = ["RSM flux", "RSM normals", "RSM positions"];
@@ -373,9 +389,7 @@ impl ShadowTechnique for Lpv {
         }
         passes.push(PassInfo::compute(gpu::RESOLVE_PASS));
         if self.params.emitter_orientation {
-            for axis in SPREAD_AXES {
-                passes.push(PassInfo::compute(format!("{} {axis}", gpu::SPREAD_PASS)));
-            }
+            passes.extend(spread_pass_names().into_iter().map(PassInfo::compute));
         }
         for i in 0..self.params.iterations {
             passes.push(PassInfo::compute(format!(
@@ -502,7 +516,7 @@ impl ShadowTechnique for Lpv {
             coarse_far_light: u32::from(p.coarse_far_light),
             emitter_orientation: u32::from(p.emitter_orientation),
             orientation_cells: p.orientation_cells,
-            ..Default::default()
+            skip_dark_cells: u32::from(p.skip_dark_cells),
         };
         let data = LpvData::new(settings, origin, &grids);
         ctx.gpu
@@ -567,11 +581,12 @@ impl ShadowTechnique for Lpv {
         );
         let n = p.grid_size.div_ceil(4);
         if p.emitter_orientation {
-            // a -> b -> a -> b: the spread moments end in b.
-            for (axis, stage) in s.spread.iter().enumerate() {
-                let name = format!("{} {}", gpu::SPREAD_PASS, SPREAD_AXES[axis]);
-                let group = &groups.spread[axis % 2];
-                stage.dispatch(ctx, recorder, &name, group, &[], [n, n, n * p.cascades]);
+            // Two boxes along each axis make a tent: a -> b -> a -> b -> a -> b -> a, so the
+            // spread moments end in a.
+            for (i, name) in spread_pass_names().iter().enumerate() {
+                let stage = &s.spread[i % 3];
+                let group = &groups.spread[i % 2];
+                stage.dispatch(ctx, recorder, name, group, &[], [n, n, n * p.cascades]);
             }
         }
         // Coarser grids keep what they hold after half the steps: the share of their light
@@ -816,7 +831,7 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
                 buffer(&v.accumulated),
                 view(&ctx.indirect.view),
                 buffer(&v.near),
-                buffer(&v.moments[1]),
+                buffer(&v.moments[0]),
             ],
         ),
         debug: zoo_host::kit::bind_group(
@@ -829,7 +844,7 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
                 buffer(&v.occluder_sums),
                 view(&d.volume.1),
                 view(&d.bounds.1),
-                buffer(&v.moments[1]),
+                buffer(&v.moments[0]),
             ],
         ),
     }
@@ -887,7 +902,7 @@ mod tests {
             coarse_far_light,
             emitter_orientation,
             orientation_cells,
-            _pad2
+            skip_dark_cells
         });
         check_mirror(&source, "LpvSettings", size, &fields, SizeRule::Equal).unwrap();
         let (size, fields) = zoo_host::mirror_fields!(LpvData {
