@@ -82,23 +82,29 @@ pub fn gather_from(source: Vec4, d: Vec3) -> Vec4 {
     sum
 }
 
-/// Total flux an SH intensity distribution emits: ∫ I(ω) dω, clamped at 0 per direction,
-/// by numerical integration.
-pub fn flux(sh: Vec4, samples: u32) -> f32 {
-    let mut sum = 0.0;
+/// Calls `f(direction, solid angle)` for the cells of a `samples` x 2 `samples`
+/// latitude-longitude grid over the sphere: a midpoint rule for integrals over directions.
+pub fn for_sphere_cells(samples: u32, mut f: impl FnMut(Vec3, f32)) {
+    use std::f32::consts::{PI, TAU};
     for i in 0..samples {
         for j in 0..2 * samples {
-            let theta = (i as f32 + 0.5) / samples as f32 * std::f32::consts::PI;
-            let phi = (j as f32 + 0.5) / (2 * samples) as f32 * std::f32::consts::TAU;
+            let theta = (i as f32 + 0.5) / samples as f32 * PI;
+            let phi = (j as f32 + 0.5) / (2 * samples) as f32 * TAU;
             let d = Vec3::new(
                 theta.sin() * phi.cos(),
                 theta.sin() * phi.sin(),
                 theta.cos(),
             );
-            let area = theta.sin() * (std::f32::consts::PI / samples as f32).powi(2);
-            sum += sh.dot(basis(d)).max(0.0) * area;
+            f(d, theta.sin() * (PI / samples as f32).powi(2));
         }
     }
+}
+
+/// Total flux an SH intensity distribution emits: ∫ I(ω) dω, clamped at 0 per direction,
+/// by numerical integration.
+pub fn flux(sh: Vec4, samples: u32) -> f32 {
+    let mut sum = 0.0;
+    for_sphere_cells(samples, |d, area| sum += sh.dot(basis(d)).max(0.0) * area);
     sum
 }
 
@@ -108,21 +114,8 @@ mod tests {
 
     /// ∫ f(ω) y(ω) dω by a fine latitude-longitude sum.
     fn project(f: impl Fn(Vec3) -> f32) -> Vec4 {
-        let n = 400;
         let mut sum = Vec4::ZERO;
-        for i in 0..n {
-            for j in 0..2 * n {
-                let theta = (i as f32 + 0.5) / n as f32 * std::f32::consts::PI;
-                let phi = (j as f32 + 0.5) / (2 * n) as f32 * std::f32::consts::TAU;
-                let d = Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                );
-                let area = theta.sin() * (std::f32::consts::PI / n as f32).powi(2);
-                sum += basis(d) * f(d) * area;
-            }
-        }
+        for_sphere_cells(400, |d, area| sum += basis(d) * f(d) * area);
         sum
     }
 
