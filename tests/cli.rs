@@ -168,36 +168,142 @@ fn compare_writes_csv_report_and_error_maps() {
     assert_eq!(
         lines.next(),
         Some(
-            "scene,technique,light,light_kind,pixels,false_shadow,false_lit,false_shadow_core,false_lit_core,mae,p95_error,gpu_ms"
+            "scene,technique,view,light,light_kind,pixels,false_shadow,false_lit,false_shadow_core,false_lit_core,mae,p95_error,gpu_ms"
         )
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3, "{csv}");
     for (light, row) in rows.iter().enumerate() {
-        assert_eq!(row.len(), 12);
+        assert_eq!(row.len(), 13);
         assert_eq!(
-            (row[0], row[1], row[2]),
-            ("planar-room", "unshadowed", light.to_string().as_str())
+            (row[0], row[1], row[2], row[3]),
+            ("planar-room", "unshadowed", "0", light.to_string().as_str())
         );
-        for value in &row[5..11] {
+        for value in &row[6..12] {
             let v: f64 = value.parse().unwrap();
             assert!((0.0..=1.0).contains(&v), "{value}");
         }
-        assert_eq!(row[5], "0.000000", "unshadowed never shadows");
+        assert_eq!(row[6], "0.000000", "unshadowed never shadows");
         assert!(
             out_dir
                 .join(format!("unshadowed-light{light}-error.png"))
                 .is_file()
         );
     }
-    assert_eq!(rows[0][3], "point");
-    assert_eq!(rows[2][3], "directional");
+    assert_eq!(rows[0][4], "point");
+    assert_eq!(rows[2][4], "directional");
     let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
     assert!(
         report.contains("Adapter: ") && report.contains("3890 triangles, 3 lights"),
         "{report}"
     );
-    assert!(report.contains("| unshadowed | 0 | point |"), "{report}");
+    assert!(
+        report.contains("| unshadowed | 0 | 0 | point |"),
+        "{report}"
+    );
+}
+
+#[test]
+fn compare_judges_views_along_the_paths_and_scores_final_images() {
+    let out_dir = temp_dir("compare-views").join("results");
+    let out = shadow_zoo(&[
+        "compare",
+        "--scene",
+        "scenes/planar-room.ron",
+        "--techniques",
+        "unshadowed,sm-pcf",
+        "--size",
+        "64x48",
+        "--samples",
+        "4",
+        "--views",
+        "3",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    // 3 views x 2 techniques x 3 lights, then a worst and a mean row per technique and light.
+    assert_eq!(rows.len(), 3 * 2 * 3 + 2 * 2 * 3, "{csv}");
+    let views: Vec<&str> = rows.iter().map(|r| r[2]).collect();
+    for view in ["0", "1", "2", "worst", "mean"] {
+        assert!(views.contains(&view), "no rows for view {view}");
+    }
+    // The worst row of a metric is the largest of its views, the mean their mean.
+    let of = |view: &str, column: usize| -> Vec<f64> {
+        rows.iter()
+            .filter(|r| r[1] == "unshadowed" && r[3] == "0" && r[2] == view)
+            .map(|r| r[column].parse().unwrap())
+            .collect()
+    };
+    let per_view: Vec<f64> = ["0", "1", "2"].iter().flat_map(|v| of(v, 7)).collect();
+    let worst = of("worst", 7)[0];
+    let mean = of("mean", 7)[0];
+    assert!((worst - per_view.iter().copied().fold(0.0, f64::max)).abs() < 2e-6);
+    assert!((mean - per_view.iter().sum::<f64>() / 3.0).abs() < 2e-6);
+    assert!(
+        per_view.iter().any(|v| (v - per_view[0]).abs() > 1e-4),
+        "the views differ along the path: {per_view:?}"
+    );
+    // images.csv: one FLIP score per technique and view, then worst and mean; maps per view.
+    let images = std::fs::read_to_string(out_dir.join("images.csv")).unwrap();
+    let mut lines = images.lines();
+    assert_eq!(
+        lines.next(),
+        Some("scene,technique,view,flip_mean,flip_p95")
+    );
+    let image_rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(image_rows.len(), 2 * 3 + 2 * 2, "{images}");
+    let flip = |technique: &str, view: &str| -> f64 {
+        image_rows
+            .iter()
+            .find(|r| r[1] == technique && r[2] == view)
+            .map(|r| r[3].parse().unwrap())
+            .unwrap()
+    };
+    // Without shadows the image is further from the reference than with shadow maps.
+    assert!(
+        flip("unshadowed", "mean") > flip("sm-pcf", "mean"),
+        "{images}"
+    );
+    assert!(flip("sm-pcf", "0") >= 0.0 && flip("unshadowed", "0") < 1.0);
+    for view in 0..3 {
+        assert!(
+            out_dir
+                .join(format!("sm-pcf-view{view}-flip.png"))
+                .is_file()
+        );
+        assert!(
+            out_dir
+                .join(format!("sm-pcf-view{view}-light0-error.png"))
+                .is_file()
+        );
+    }
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(report.contains("## Over the views") && report.contains("| sm-pcf | worst |"));
+    assert!(report.contains("## Final images"), "{report}");
+    // A scene without paths cannot spread views.
+    let out = shadow_zoo(&[
+        "compare",
+        "--scene",
+        "scenes/curved.ron",
+        "--views",
+        "4",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out).contains("has no camera or light path"),
+        "{}",
+        text(&out)
+    );
 }
 
 #[test]
@@ -209,8 +315,8 @@ fn compare_writes_the_indirect_light_it_scores() {
     let csv = std::fs::read_to_string(out_dir.join("indirect.csv")).unwrap();
     let row = csv.lines().nth(1).expect("a row for lpv");
     let fields: Vec<&str> = row.split(',').collect();
-    assert_eq!(fields[..2], ["atrium", "lpv"], "{csv}");
-    let scored: f64 = fields[2].parse().unwrap();
+    assert_eq!(fields[..3], ["atrium", "lpv", "0"], "{csv}");
+    let scored: f64 = fields[3].parse().unwrap();
     // The written values give back the score (Radiance HDR keeps about 1 % per value).
     let read = |name: &str| {
         let image = image::open(out_dir.join(name)).unwrap().into_rgb32f();

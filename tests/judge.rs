@@ -36,11 +36,21 @@ fn unsupported_light_kinds_are_reported_not_scored() {
             (LightKind::Directional, false)
         ]
     );
-    let csv = shadow_zoo::compare::results_csv("planar-room", std::slice::from_ref(&run.judged));
+    let view = shadow_zoo::compare::JudgedView {
+        view: 0,
+        time: None,
+        reference: run.reference,
+        judged: vec![run.judged],
+        flip: vec![None],
+        indirect: Vec::new(),
+    };
+    let csv = shadow_zoo::compare::results_csv("planar-room", std::slice::from_ref(&view));
     let rows: Vec<&str> = csv.lines().skip(1).collect();
-    assert!(rows[0].starts_with("planar-room,test-point-only,0,point,") && !rows[0].contains(",,"));
     assert!(
-        rows[1].starts_with("planar-room,test-point-only,1,spot,,,,,,,,"),
+        rows[0].starts_with("planar-room,test-point-only,0,0,point,") && !rows[0].contains(",,")
+    );
+    assert!(
+        rows[1].starts_with("planar-room,test-point-only,0,1,spot,,,,,,,,"),
         "{}",
         rows[1]
     );

@@ -6,7 +6,7 @@
 // Link the application, which links every plugin.
 use shadow_zoo as _;
 use zoo_host::glam::UVec2;
-use zoo_host::judge::{Metrics, Occluders, reference_visibility};
+use zoo_host::judge::{Metrics, Occluders, Surfaces, reference_visibility};
 use zoo_host::judging::surface_points;
 use zoo_host::test_support::{gpu, scene_path};
 use zoo_host::{Renderer, View};
@@ -17,7 +17,7 @@ fn every_light_of_two_hundred_and_fifty_six_keeps_its_own_shadows() {
     let size = UVec2::new(320, 240);
     let mut renderer = Renderer::new(gpu(), scene.clone(), size).unwrap();
     renderer.render(&View::Final).unwrap();
-    let points = surface_points(&renderer.read_gbuffer());
+    let points = surface_points(&renderer.read_gbuffer(), &Surfaces::new(&scene));
     let occluders = Occluders::new(&scene);
     // Point and spot lights (140 and 170 are spots) across the middle of the plaza.
     let sample = [73usize, 85, 104, 140, 150, 170, 180, 199];

@@ -52,7 +52,7 @@ fn ray_direction(light: Light, p: vec3<f32>) -> vec3<f32> {
 
 // World size of one map texel at p across the rays (the larger side).
 fn texel_world(p: vec3<f32>, frame: mat2x3<f32>) -> f32 {
-    let step = 1e-3 * max(distance(p, camera.position), 1e-2);
+    let step = 1e-3 * max(distance(p, camera.position), camera.near);
     let at = map_point(warped.layer, p).uv;
     let across = map_point(warped.layer, p + frame[0] * step).uv - at;
     let along = map_point(warped.layer, p + frame[1] * step).uv - at;

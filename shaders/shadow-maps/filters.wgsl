@@ -125,7 +125,7 @@ fn pcss(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: Pcs
     let receiver = center.y;
     var search = light.size * (receiver - light.near);
     if light.perspective {
-        search /= max(light.near, 1e-4);
+        search /= max(light.near, 1e-30);
     }
     search = clamp(search, texel, light.max_texels * texel);
     var blockers = 0.0;
@@ -144,7 +144,7 @@ fn pcss(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: Pcs
     let blocker = blocker_sum / blockers;
     var penumbra = light.size * (receiver - blocker);
     if light.perspective {
-        penumbra /= max(blocker, 1e-4);
+        penumbra /= max(blocker, 1e-30);
     }
     return poisson_pcf(p, frame, clamp(penumbra, texel, light.max_texels * texel), r);
 }

@@ -103,7 +103,7 @@ fn texel_world(p: vec3<f32>) -> f32 {
 fn search_radius(receiver: f32, texel: f32) -> f32 {
     var search = current.size * (receiver - current.near);
     if current.perspective == 1u {
-        search /= max(current.near, 1e-4);
+        search /= max(current.near, 1e-30);
     }
     return clamp(search, texel, data.settings.search_texels * texel);
 }
@@ -114,7 +114,7 @@ fn search_radius(receiver: f32, texel: f32) -> f32 {
 fn width_for(receiver: f32, blocker: f32) -> f32 {
     var width = 2.0 * current.size * (receiver - blocker);
     if current.perspective == 1u {
-        width /= max(blocker, 1e-4);
+        width /= max(blocker, 1e-30);
     }
     return width;
 }

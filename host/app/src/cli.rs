@@ -96,6 +96,11 @@ pub struct CompareArgs {
     #[arg(long, default_value_t = zoo_host::judging::DEFAULT_SAMPLES,
           value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub samples: u32,
+    /// Judge N views spread evenly over the scene's camera and light paths (both ends
+    /// included) instead of the scene's camera alone; results get per-view rows and the worst
+    /// and mean over views.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub views: u32,
 }
 
 /// Arguments of `shadow-zoo render`.

@@ -8,16 +8,68 @@ use std::path::Path;
 use anyhow::{Context, bail};
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
-use zoo_host::judging::{Judged, SceneReference, error_map, judge_technique};
+use zoo_host::judge::Metrics;
+use zoo_host::judging::perceptual::{FlipScore, score_image};
+use zoo_host::judging::{Judged, LightScore, SceneReference, error_map, judge_technique};
 use zoo_host::params::{self, ParamValues};
+use zoo_host::scene::paths;
 use zoo_host::{Renderer, Scene, TechniqueRegistration};
 
 use crate::cli::CompareArgs;
 use crate::setup::headless_gpu;
 
 /// The exact header of `results.csv`.
-pub const CSV_HEADER: &str = "scene,technique,light,light_kind,pixels,false_shadow,false_lit,\
+pub const CSV_HEADER: &str = "scene,technique,view,light,light_kind,pixels,false_shadow,false_lit,\
 false_shadow_core,false_lit_core,mae,p95_error,gpu_ms";
+/// The exact header of `images.csv`.
+pub const IMAGES_CSV_HEADER: &str = "scene,technique,view,flip_mean,flip_p95";
+
+/// One view of the scene, judged.
+pub struct JudgedView {
+    /// Index along the paths (0 for the scene's own camera).
+    pub view: usize,
+    /// Time on the scene's paths (`None`: the scene's camera and lights as they are).
+    pub time: Option<f32>,
+    pub reference: SceneReference,
+    pub judged: Vec<Judged>,
+    /// FLIP of each judged technique's final image against the reference image, in the order
+    /// of `judged`.
+    pub flip: Vec<Option<FlipScore>>,
+    /// (technique, relative RMSE) of the techniques that add light.
+    pub indirect: Vec<(String, f64)>,
+}
+
+/// The times of `views` views spread evenly over the scene's paths, both ends included; one
+/// view (`None`) is the scene's camera and lights as they are.
+pub fn view_times(scene: &Scene, views: u32) -> anyhow::Result<Vec<Option<f32>>> {
+    if views <= 1 {
+        return Ok(vec![None]);
+    }
+    if scene.paths.camera.is_empty() && scene.paths.lights.is_empty() {
+        bail!(
+            "--views {views}: {} has no camera or light path to spread views along (add `paths` to the scene, or judge one view)",
+            scene.path.display()
+        );
+    }
+    let (start, end) = paths::duration(&scene.paths);
+    Ok((0..views)
+        .map(|k| Some(start + (end - start) * k as f32 / (views - 1) as f32))
+        .collect())
+}
+
+/// Moves `renderer`'s camera and lights to `time` on the scene's paths.
+fn go_to(renderer: &mut Renderer, time: Option<f32>) {
+    let scene = renderer.scene();
+    let (camera, lights) = match time {
+        None => (scene.camera, scene.lights.clone()),
+        Some(t) => (
+            paths::camera_at(&scene.camera, &scene.paths.camera, t),
+            paths::lights_at(&scene.lights, &scene.paths.lights, t),
+        ),
+    };
+    renderer.set_camera(camera);
+    renderer.set_lights(lights);
+}
 
 /// Resolves `ids` (comma-separated or `all`) to registrations.
 pub fn select_techniques(ids: &str) -> anyhow::Result<Vec<&'static TechniqueRegistration>> {
@@ -74,6 +126,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let techniques = select_techniques(&args.techniques)?;
     let params = technique_params(&techniques, &args.set)?;
     let scene = Scene::load(&args.scene)?;
+    let times = view_times(&scene, args.views)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
     let csv_path = args.out.join("results.csv");
@@ -83,61 +136,77 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let gpu = headless_gpu()?;
     let adapter = gpu.describe();
     println!(
-        "scene: {} ({} triangles, {} lights); {} techniques at {}x{}",
+        "scene: {} ({} triangles, {} lights); {} techniques at {}x{}, {} view{}",
         scene.name,
         scene.triangle_count(),
         scene.lights.len(),
         techniques.len(),
         args.size.x,
-        args.size.y
+        args.size.y,
+        times.len(),
+        if times.len() == 1 { "" } else { "s" }
     );
     let light_count = scene.lights.len();
     let scene_name = scene.name.clone();
     let triangles = scene.triangle_count();
     let mut renderer = Renderer::new(gpu, scene, args.size)?;
 
-    let bar = ProgressBar::new((light_count + techniques.len()) as u64);
+    let bar = ProgressBar::new((times.len() * (light_count + techniques.len())) as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed}]")
             .expect("valid template"),
     );
-    bar.set_message("reference");
-    let mut reference = SceneReference::compute(&mut renderer, args.samples, |_| bar.inc(1))?;
-    let mut judged = Vec::new();
+    let mut views = Vec::new();
     let mut failures = Vec::new();
-    for (technique, values) in techniques.iter().zip(&params) {
-        bar.set_message(technique.id);
-        match judge_technique(&mut renderer, &reference, technique.id, values) {
-            Ok(j) => judged.push(j),
-            Err(e) => failures.push((technique.id, e.to_string())),
+    for (view, &time) in times.iter().enumerate() {
+        go_to(&mut renderer, time);
+        bar.set_message(format!("view {view}: reference"));
+        let mut reference = SceneReference::compute(&mut renderer, args.samples, |_| bar.inc(1))?;
+        let mut judged = Vec::new();
+        for (technique, values) in techniques.iter().zip(&params) {
+            bar.set_message(format!("view {view}: {}", technique.id));
+            match judge_technique(&mut renderer, &reference, technique.id, values) {
+                Ok(j) => judged.push(j),
+                Err(e) => failures.push((view, technique.id, e.to_string())),
+            }
+            bar.inc(1);
         }
-        bar.inc(1);
+        bar.set_message(format!("view {view}: images"));
+        let flip = judged
+            .iter()
+            .map(|j| score_image(&renderer, &mut reference, j, args.samples))
+            .collect();
+        let view = JudgedView {
+            view,
+            time,
+            indirect: Vec::new(),
+            reference,
+            judged,
+            flip,
+        };
+        views.push(judge_view_outputs(view, &renderer, args, times.len() > 1)?);
     }
     bar.finish_and_clear();
-    println!(
-        "reference: {} occluder triangles, {} area samples, traced in {:.2} s",
-        reference.occluder_triangles,
-        reference.lights.first().map_or(0, |l| l.samples),
-        reference.seconds
-    );
-
-    csv.write_all(results_csv(&scene_name, &judged).as_bytes())
-        .with_context(|| format!("cannot write {}", csv_path.display()))?;
-    for j in &judged {
-        for score in j.scores.iter().filter(|s| s.metrics.is_some()) {
-            let path = args
-                .out
-                .join(format!("{}-light{}-error.png", j.technique, score.light));
-            error_map(
-                &reference.lights[score.light],
-                &j.visibility[score.light],
-                &j.image,
-            )
-            .save(&path)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        }
+    for v in &views {
+        println!(
+            "reference{}: {} occluder triangles, {} area samples, traced in {:.2} s",
+            view_label(v, views.len()),
+            v.reference.occluder_triangles,
+            v.reference.lights.first().map_or(0, |l| l.samples),
+            v.reference.seconds
+        );
     }
-    let indirect = judge_indirect(&judged, &mut reference, &renderer, args)?;
+
+    csv.write_all(results_csv(&scene_name, &views).as_bytes())
+        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+    if let Some(indirect) = indirect_csv(&scene_name, &views) {
+        let path = args.out.join("indirect.csv");
+        std::fs::write(&path, indirect)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let images_path = args.out.join("images.csv");
+    std::fs::write(&images_path, images_csv(&scene_name, &views))
+        .with_context(|| format!("cannot write {}", images_path.display()))?;
     let report = report_md(&ReportInputs {
         scene: &scene_name,
         scene_path: &args.scene,
@@ -145,68 +214,292 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         lights: light_count,
         size: (args.size.x, args.size.y),
         adapter: &adapter,
-        reference: &reference,
-        judged: &judged,
-        indirect: &indirect,
+        views: &views,
         failures: &failures,
     });
     let report_path = args.out.join("report.md");
     std::fs::write(&report_path, &report)
         .with_context(|| format!("cannot write {}", report_path.display()))?;
-    print!("{}", summary_table(&judged));
+    for v in &views {
+        if views.len() > 1 {
+            println!("view {} (time {:.2}):", v.view, v.time.unwrap_or(0.0));
+        }
+        print!("{}", summary_table(v));
+        for (technique, rmse) in &v.indirect {
+            println!("  {technique:16} indirect_rmse {rmse:.4}");
+        }
+    }
     println!(
-        "wrote {}, {} and the error maps",
+        "wrote {}, {}, {} and the error maps",
         csv_path.display(),
+        images_path.display(),
         report_path.display()
     );
     if !failures.is_empty() {
-        for (id, e) in &failures {
-            eprintln!("{id} failed: {e}");
+        for (view, id, e) in &failures {
+            eprintln!("{id} failed (view {view}): {e}");
         }
         bail!(
-            "{} of {} techniques failed",
+            "{} of {} technique runs failed",
             failures.len(),
-            techniques.len()
+            techniques.len() * views.len()
         );
     }
     Ok(())
 }
 
-/// `results.csv`: one row per technique and light; unsupported lights have empty metrics.
-pub fn results_csv(scene: &str, judged: &[Judged]) -> String {
-    let mut out = format!("{CSV_HEADER}\n");
-    for j in judged {
-        for s in &j.scores {
-            let metrics = match &s.metrics {
-                Some(m) => format!(
-                    "{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
-                    m.pixels,
-                    m.false_shadow,
-                    m.false_lit,
-                    m.false_shadow_core,
-                    m.false_lit_core,
-                    m.mae,
-                    m.p95_error
-                ),
-                None => ",,,,,,".to_string(),
-            };
-            writeln!(
-                out,
-                "{scene},{},{},{},{metrics},{:.4}",
-                j.technique,
-                s.light,
-                s.kind.name(),
-                j.gpu_ms
+/// `" (view N)"` when there are several views, else nothing.
+fn view_label(view: &JudgedView, views: usize) -> String {
+    if views > 1 {
+        format!(" (view {})", view.view)
+    } else {
+        String::new()
+    }
+}
+
+/// An output file name: `<stem>.<ext>` for a single view, `<technique>-view<N>-<rest>` with
+/// several (the view goes after the technique id).
+fn output_name(technique: &str, view: usize, several: bool, rest: &str) -> String {
+    if several {
+        format!("{technique}-view{view}-{rest}")
+    } else {
+        format!("{technique}-{rest}")
+    }
+}
+
+/// Writes one view's error maps, FLIP maps and indirect-light files, and scores its indirect
+/// light.
+fn judge_view_outputs(
+    mut view: JudgedView,
+    renderer: &Renderer,
+    args: &CompareArgs,
+    several: bool,
+) -> anyhow::Result<JudgedView> {
+    for (j, flip) in view.judged.iter().zip(&view.flip) {
+        for score in j.scores.iter().filter(|s| s.metrics.is_some()) {
+            let name = output_name(
+                &j.technique,
+                view.view,
+                several,
+                &format!("light{}-error.png", score.light),
+            );
+            let path = args.out.join(name);
+            error_map(
+                &view.reference.lights[score.light],
+                &j.visibility[score.light],
+                &j.image,
             )
-            .expect("write to string");
+            .save(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        if let Some(flip) = flip {
+            let path = args
+                .out
+                .join(output_name(&j.technique, view.view, several, "flip.png"));
+            flip.map
+                .save(&path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+    }
+    view.indirect = judge_indirect(&mut view, renderer, args, several)?;
+    Ok(view)
+}
+
+/// `results.csv`: one row per view, technique and light (unsupported lights have empty
+/// metrics); with several views, then a `worst` and a `mean` row per technique and light.
+pub fn results_csv(scene: &str, views: &[JudgedView]) -> String {
+    let mut out = format!("{CSV_HEADER}\n");
+    let row = |out: &mut String,
+               technique: &str,
+               view: &str,
+               s: &LightScore,
+               m: Option<&Metrics>,
+               ms: f64| {
+        let metrics = match m {
+            Some(m) => format!(
+                "{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+                m.pixels,
+                m.false_shadow,
+                m.false_lit,
+                m.false_shadow_core,
+                m.false_lit_core,
+                m.mae,
+                m.p95_error
+            ),
+            None => ",,,,,,".to_string(),
+        };
+        writeln!(
+            out,
+            "{scene},{technique},{view},{},{},{metrics},{ms:.4}",
+            s.light,
+            s.kind.name(),
+        )
+        .expect("write to string");
+    };
+    for v in views {
+        for j in &v.judged {
+            for s in &j.scores {
+                row(
+                    &mut out,
+                    &j.technique,
+                    &v.view.to_string(),
+                    s,
+                    s.metrics.as_ref(),
+                    j.gpu_ms,
+                );
+            }
+        }
+    }
+    if views.len() > 1 {
+        for series in per_technique_and_light(views) {
+            let score = &series.scores[0].0;
+            let [(worst, worst_ms), (mean, mean_ms)] = series.worst_and_mean();
+            row(
+                &mut out,
+                series.technique,
+                "worst",
+                score,
+                worst.as_ref(),
+                worst_ms,
+            );
+            row(
+                &mut out,
+                series.technique,
+                "mean",
+                score,
+                mean.as_ref(),
+                mean_ms,
+            );
         }
     }
     out
 }
 
-fn summary_table(judged: &[Judged]) -> String {
+/// One technique's scores of one light over the views: (score, frame time) per view.
+struct LightSeries<'a> {
+    technique: &'a str,
+    light: usize,
+    scores: Vec<(LightScore, f64)>,
+}
+
+impl LightSeries<'_> {
+    /// The worst (largest) and the mean metrics over the views, and the frame time of each.
+    fn worst_and_mean(&self) -> [(Option<Metrics>, f64); 2] {
+        let n = self.scores.len() as f64;
+        let ms = self.scores.iter().map(|(_, ms)| *ms);
+        [
+            (
+                aggregate(&self.scores, f64::max),
+                ms.clone().fold(0.0, f64::max),
+            ),
+            (
+                aggregate(&self.scores, |a, b| a + b).map(|m| scale(m, 1.0 / n)),
+                ms.sum::<f64>() / n,
+            ),
+        ]
+    }
+}
+
+/// Per technique and light, in order: its scores over the views.
+fn per_technique_and_light(views: &[JudgedView]) -> Vec<LightSeries<'_>> {
+    let mut out: Vec<LightSeries<'_>> = Vec::new();
+    for v in views {
+        for j in &v.judged {
+            for s in &j.scores {
+                match out
+                    .iter_mut()
+                    .find(|x| x.technique == j.technique && x.light == s.light)
+                {
+                    Some(series) => series.scores.push((s.clone(), j.gpu_ms)),
+                    None => out.push(LightSeries {
+                        technique: &j.technique,
+                        light: s.light,
+                        scores: vec![(s.clone(), j.gpu_ms)],
+                    }),
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Folds the metrics of every view with `combine` (pixels are summed), or `None` when the light
+/// was not scored.
+fn aggregate(scores: &[(LightScore, f64)], combine: impl Fn(f64, f64) -> f64) -> Option<Metrics> {
+    let metrics: Vec<&Metrics> = scores
+        .iter()
+        .filter_map(|(s, _)| s.metrics.as_ref())
+        .collect();
+    let (first, rest) = metrics.split_first()?;
+    Some(rest.iter().fold(**first, |a, m| Metrics {
+        pixels: a.pixels + m.pixels,
+        false_shadow: combine(a.false_shadow, m.false_shadow),
+        false_lit: combine(a.false_lit, m.false_lit),
+        false_shadow_core: combine(a.false_shadow_core, m.false_shadow_core),
+        false_lit_core: combine(a.false_lit_core, m.false_lit_core),
+        mae: combine(a.mae, m.mae),
+        p95_error: combine(a.p95_error, m.p95_error),
+    }))
+}
+
+/// `m`'s fractions times `factor` (pixels kept).
+fn scale(m: Metrics, factor: f64) -> Metrics {
+    Metrics {
+        false_shadow: m.false_shadow * factor,
+        false_lit: m.false_lit * factor,
+        false_shadow_core: m.false_shadow_core * factor,
+        false_lit_core: m.false_lit_core * factor,
+        mae: m.mae * factor,
+        p95_error: m.p95_error * factor,
+        ..m
+    }
+}
+
+/// `images.csv`: the FLIP score of every technique's final image per view; with several
+/// views, then its worst and mean.
+pub fn images_csv(scene: &str, views: &[JudgedView]) -> String {
+    let mut out = format!("{IMAGES_CSV_HEADER}\n");
+    let mut per_technique: Vec<(&str, Vec<(f64, f64)>)> = Vec::new();
+    for v in views {
+        for (j, flip) in v.judged.iter().zip(&v.flip) {
+            let Some(flip) = flip else { continue };
+            writeln!(
+                out,
+                "{scene},{},{},{:.6},{:.6}",
+                j.technique, v.view, flip.mean, flip.p95
+            )
+            .expect("write to string");
+            match per_technique.iter_mut().find(|(t, _)| *t == j.technique) {
+                Some((_, scores)) => scores.push((flip.mean, flip.p95)),
+                None => per_technique.push((&j.technique, vec![(flip.mean, flip.p95)])),
+            }
+        }
+    }
+    if views.len() > 1 {
+        for (technique, scores) in per_technique {
+            let n = scores.len() as f64;
+            let worst = scores
+                .iter()
+                .fold((0.0f64, 0.0f64), |(a, b), (m, p)| (a.max(*m), b.max(*p)));
+            let mean = scores
+                .iter()
+                .fold((0.0, 0.0), |(a, b), (m, p)| (a + m / n, b + p / n));
+            writeln!(
+                out,
+                "{scene},{technique},worst,{:.6},{:.6}",
+                worst.0, worst.1
+            )
+            .expect("write to string");
+            writeln!(out, "{scene},{technique},mean,{:.6},{:.6}", mean.0, mean.1)
+                .expect("write to string");
+        }
+    }
+    out
+}
+
+fn summary_table(view: &JudgedView) -> String {
     let mut out = String::new();
-    for j in judged {
+    for (j, flip) in view.judged.iter().zip(&view.flip) {
         for s in &j.scores {
             match &s.metrics {
                 Some(m) => writeln!(
@@ -225,23 +518,32 @@ fn summary_table(judged: &[Judged]) -> String {
             }
             .expect("write to string");
         }
+        if let Some(flip) = flip {
+            writeln!(
+                out,
+                "  {:16} image FLIP mean {:.4}  p95 {:.4}",
+                j.technique, flip.mean, flip.p95
+            )
+            .expect("write to string");
+        }
     }
     out
 }
 
-/// Scores the indirect light of the techniques that add light against the one-bounce
-/// reference (traced once, with the area samples per pixel), writes `indirect.csv`, an error
-/// map and the indirect light (`.hdr`) per technique and the reference's, and returns
+/// Scores the indirect light of the techniques that add light in `view` against the
+/// one-bounce reference (traced once per view, with the area samples per pixel), writes an
+/// error map and the indirect light (`.hdr`) per technique and the reference's, and returns
 /// (technique, relative RMSE).
 fn judge_indirect(
-    judged: &[Judged],
-    reference: &mut SceneReference,
+    view: &mut JudgedView,
     renderer: &Renderer,
     args: &CompareArgs,
+    several: bool,
 ) -> anyhow::Result<Vec<(String, f64)>> {
     let mut scores = Vec::new();
     let (scene, lights) = (renderer.scene(), renderer.lights());
-    for j in judged {
+    let reference = &mut view.reference;
+    for j in &view.judged {
         let (Some(estimate), Some(rmse)) = (
             &j.indirect,
             j.indirect_rmse(reference, scene, lights, args.samples),
@@ -256,31 +558,32 @@ fn judge_indirect(
             let v = (error.min(1.0) * 255.0) as u8;
             image::Rgba([v, v, v, 255])
         });
-        let path = args.out.join(format!("{}-indirect-error.png", j.technique));
+        let name = |rest: &str| output_name(&j.technique, view.view, several, rest);
+        let path = args.out.join(name("indirect-error.png"));
         map.save(&path)
             .with_context(|| format!("cannot write {}", path.display()))?;
-        save_radiance(
-            &args.out.join(format!("{}-indirect.hdr", j.technique)),
-            estimate,
-            width,
-        )?;
+        save_radiance(&args.out.join(name("indirect.hdr")), estimate, width)?;
         if scores.is_empty() {
-            save_radiance(&args.out.join("reference-indirect.hdr"), expected, width)?;
+            let path = output_name("reference", view.view, several, "indirect.hdr");
+            save_radiance(&args.out.join(path), expected, width)?;
         }
         scores.push((j.technique.clone(), rmse));
     }
-    if !scores.is_empty() {
-        let mut csv = String::from("scene,technique,indirect_rmse\n");
-        for (technique, rmse) in &scores {
-            writeln!(csv, "{},{technique},{rmse:.6}", scene.name).expect("write to string");
-        }
-        let path = args.out.join("indirect.csv");
-        std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
-        for (technique, rmse) in &scores {
-            println!("  {technique:16} indirect_rmse {rmse:.4}");
+    Ok(scores)
+}
+
+/// `indirect.csv`: the relative RMSE of each technique that adds light, per view (`None` when
+/// no technique adds light).
+fn indirect_csv(scene: &str, views: &[JudgedView]) -> Option<String> {
+    let mut csv = String::from("scene,technique,view,indirect_rmse\n");
+    let mut any = false;
+    for v in views {
+        for (technique, rmse) in &v.indirect {
+            any = true;
+            writeln!(csv, "{scene},{technique},{},{rmse:.6}", v.view).expect("write to string");
         }
     }
-    Ok(scores)
+    any.then_some(csv)
 }
 
 /// Writes linear RGB values, row by row from the top, as a Radiance HDR image.
@@ -302,16 +605,49 @@ struct ReportInputs<'a> {
     lights: usize,
     size: (u32, u32),
     adapter: &'a str,
-    reference: &'a SceneReference,
-    judged: &'a [Judged],
-    /// (technique, relative RMSE) of the techniques that add light.
-    indirect: &'a [(String, f64)],
-    failures: &'a [(&'static str, String)],
+    views: &'a [JudgedView],
+    /// (view, technique, error) of the runs that failed.
+    failures: &'a [(usize, &'static str, String)],
 }
+
+/// One row of the report's metrics table.
+fn metrics_row(
+    w: &mut String,
+    technique: &str,
+    view: &str,
+    s: &LightScore,
+    m: Option<&Metrics>,
+    ms: f64,
+) {
+    let _ = match m {
+        Some(m) => writeln!(
+            w,
+            "| {technique} | {view} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {ms:.3} |",
+            s.light,
+            s.kind.name(),
+            m.pixels,
+            m.false_shadow,
+            m.false_lit,
+            m.false_shadow_core,
+            m.false_lit_core,
+            m.mae,
+            m.p95_error,
+        ),
+        None => writeln!(
+            w,
+            "| {technique} | {view} | {} | {} | not supported | | | | | | | {ms:.3} |",
+            s.light,
+            s.kind.name(),
+        ),
+    };
+}
+
+const METRICS_TABLE_HEAD: &str = "| technique | view | light | kind | pixels | false_shadow | false_lit | false_shadow_core | false_lit_core | mae | p95_error | gpu_ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|";
 
 fn report_md(r: &ReportInputs<'_>) -> String {
     let mut out = String::new();
     let w = &mut out;
+    let first = r.views.first();
     let _ = writeln!(w, "# Shadow Zoo comparison: {}\n", r.scene);
     let _ = writeln!(
         w,
@@ -322,16 +658,33 @@ fn report_md(r: &ReportInputs<'_>) -> String {
     );
     let _ = writeln!(w, "- Resolution: {}x{}", r.size.0, r.size.1);
     let _ = writeln!(w, "- Adapter: {}", r.adapter);
-    let _ = writeln!(
-        w,
-        "- Reference: {} occluder triangles, {} area samples per pixel, traced in {:.2} s",
-        r.reference.occluder_triangles,
-        r.reference.lights.first().map_or(0, |l| l.samples),
-        r.reference.seconds
-    );
-    if r.reference.lights.iter().any(|l| l.color.is_some()) {
-        let opaque: Vec<String> = r
-            .judged
+    if r.views.len() > 1 {
+        let times: Vec<String> = r
+            .views
+            .iter()
+            .map(|v| format!("{:.2}", v.time.unwrap_or(0.0)))
+            .collect();
+        let _ = writeln!(
+            w,
+            "- Views: {} along the scene's camera and light paths, at times {}",
+            r.views.len(),
+            times.join(", ")
+        );
+    }
+    if let Some(v) = first {
+        let seconds: f64 = r.views.iter().map(|v| v.reference.seconds).sum();
+        let _ = writeln!(
+            w,
+            "- Reference: {} occluder triangles, {} area samples per pixel, traced in {:.2} s",
+            v.reference.occluder_triangles,
+            v.reference.lights.first().map_or(0, |l| l.samples),
+            seconds
+        );
+    }
+    if first.is_some_and(|v| v.reference.lights.iter().any(|l| l.color.is_some())) {
+        let opaque: Vec<String> = first
+            .map(|v| v.judged.as_slice())
+            .unwrap_or_default()
             .iter()
             .filter(|j| j.transmittance.iter().all(Option::is_none))
             .map(|j| format!("`{}`", j.technique))
@@ -350,57 +703,88 @@ fn report_md(r: &ReportInputs<'_>) -> String {
         w,
         "\nFractions are of the pixels each light reaches. `core` leaves out the one-pixel band around reference shadow boundaries; `mae` and `p95` compare with the area-light reference. Error maps: red = false shadow, blue = false lit, grey = both shadowed.\n"
     );
+    let _ = writeln!(w, "{METRICS_TABLE_HEAD}");
+    for v in r.views {
+        for j in &v.judged {
+            for s in &j.scores {
+                metrics_row(
+                    w,
+                    &j.technique,
+                    &v.view.to_string(),
+                    s,
+                    s.metrics.as_ref(),
+                    j.gpu_ms,
+                );
+            }
+        }
+    }
+    if r.views.len() > 1 {
+        let _ = writeln!(
+            w,
+            "\n## Over the views\n\nPer technique and light, the worst (largest) and the mean of each metric over the {} views.\n",
+            r.views.len()
+        );
+        let _ = writeln!(w, "{METRICS_TABLE_HEAD}");
+        for series in per_technique_and_light(r.views) {
+            let score = &series.scores[0].0;
+            let [(worst, worst_ms), (mean, mean_ms)] = series.worst_and_mean();
+            metrics_row(
+                w,
+                series.technique,
+                "worst",
+                score,
+                worst.as_ref(),
+                worst_ms,
+            );
+            metrics_row(w, series.technique, "mean", score, mean.as_ref(), mean_ms);
+        }
+    }
     let _ = writeln!(
         w,
-        "| technique | light | kind | pixels | false_shadow | false_lit | false_shadow_core | false_lit_core | mae | p95_error | gpu_ms |"
+        "\n## Final images\n\nꟻLIP of each technique's final image against the reference image (the reference's area visibility shaded by the same lighting on the CPU, with the one-bounce indirect reference for techniques that add light), at 67 pixels per degree: 0 is identical, 1 the largest difference. Maps `<technique>-flip.png` (magma: black none, yellow large); values in `images.csv`.\n"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|");
-    for j in r.judged {
-        for s in &j.scores {
-            match &s.metrics {
-                Some(m) => {
-                    let _ = writeln!(
-                        w,
-                        "| {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.3} |",
-                        j.technique,
-                        s.light,
-                        s.kind.name(),
-                        m.pixels,
-                        m.false_shadow,
-                        m.false_lit,
-                        m.false_shadow_core,
-                        m.false_lit_core,
-                        m.mae,
-                        m.p95_error,
-                        j.gpu_ms
-                    );
-                }
-                None => {
-                    let _ = writeln!(
-                        w,
-                        "| {} | {} | {} | not supported | | | | | | | {:.3} |",
-                        j.technique,
-                        s.light,
-                        s.kind.name(),
-                        j.gpu_ms
-                    );
+    let _ = writeln!(w, "| technique | view | flip_mean | flip_p95 |");
+    let _ = writeln!(w, "|---|---|---|---|");
+    let mut per_technique: Vec<(&str, Vec<f64>)> = Vec::new();
+    for v in r.views {
+        for (j, flip) in v.judged.iter().zip(&v.flip) {
+            if let Some(flip) = flip {
+                let _ = writeln!(
+                    w,
+                    "| {} | {} | {:.4} | {:.4} |",
+                    j.technique, v.view, flip.mean, flip.p95
+                );
+                match per_technique.iter_mut().find(|(t, _)| *t == j.technique) {
+                    Some((_, means)) => means.push(flip.mean),
+                    None => per_technique.push((&j.technique, vec![flip.mean])),
                 }
             }
         }
     }
-    if !r.indirect.is_empty() {
+    if r.views.len() > 1 {
+        for (technique, means) in per_technique {
+            let worst = means.iter().copied().fold(0.0, f64::max);
+            let mean = means.iter().sum::<f64>() / means.len() as f64;
+            let _ = writeln!(w, "| {technique} | worst | {worst:.4} | |");
+            let _ = writeln!(w, "| {technique} | mean | {mean:.4} | |");
+        }
+    }
+    if r.views.iter().any(|v| !v.indirect.is_empty()) {
         let _ = writeln!(
             w,
             "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more); the values themselves in `reference-indirect.hdr` and `<technique>-indirect.hdr` (linear Radiance HDR).\n"
         );
-        let _ = writeln!(w, "| technique | indirect_rmse |");
-        let _ = writeln!(w, "|---|---|");
-        for (technique, rmse) in r.indirect {
-            let _ = writeln!(w, "| {technique} | {rmse:.4} |");
+        let _ = writeln!(w, "| technique | view | indirect_rmse |");
+        let _ = writeln!(w, "|---|---|---|");
+        for v in r.views {
+            for (technique, rmse) in &v.indirect {
+                let _ = writeln!(w, "| {technique} | {} | {rmse:.4} |", v.view);
+            }
         }
     }
+    let judged = first.map(|v| v.judged.as_slice()).unwrap_or_default();
     let _ = writeln!(w, "\n## Parameters\n");
-    for j in r.judged {
+    for j in judged {
         let values: Vec<String> = j.params.iter().map(|(k, v)| format!("{k} = {v}")).collect();
         let _ = writeln!(
             w,
@@ -415,10 +799,10 @@ fn report_md(r: &ReportInputs<'_>) -> String {
     }
     let _ = writeln!(
         w,
-        "\n## Pass timings ({})\n",
-        r.judged.first().map_or("", |j| j.timings.source.label())
+        "\n## Pass timings ({}, view 0)\n",
+        judged.first().map_or("", |j| j.timings.source.label())
     );
-    for j in r.judged {
+    for j in judged {
         let passes: Vec<String> = j
             .timings
             .passes
@@ -429,8 +813,8 @@ fn report_md(r: &ReportInputs<'_>) -> String {
     }
     if !r.failures.is_empty() {
         let _ = writeln!(w, "\n## Failures\n");
-        for (id, e) in r.failures {
-            let _ = writeln!(w, "- `{id}`: {e}");
+        for (view, id, e) in r.failures {
+            let _ = writeln!(w, "- `{id}` (view {view}): {e}");
         }
     }
     out

@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 use anyhow::Context;
 use image::{Rgb, RgbImage, RgbaImage};
 use plotters::prelude::*;
+use zoo_host::judging::perceptual::score_image;
 use zoo_host::judging::{Judged, SceneReference, judge_technique, shade_on_cpu};
 use zoo_host::params::ParamValues;
 use zoo_host::{GpuContext, Renderer, Scene, TechniqueRegistration};
@@ -19,6 +20,8 @@ pub struct Summary {
     pub false_shadow_core: f64,
     pub false_lit_core: f64,
     pub mae: f64,
+    /// Mean ꟻLIP of the final image against the reference image (`None` when not scored).
+    pub flip: Option<f64>,
 }
 
 impl Summary {
@@ -40,6 +43,7 @@ impl Summary {
             false_shadow_core: mean(&|m| m.false_shadow_core),
             false_lit_core: mean(&|m| m.false_lit_core),
             mae: mean(&|m| m.mae),
+            flip: None,
         })
     }
 }
@@ -93,10 +97,16 @@ impl Row {
         }
         lines.push(timing);
         match &self.summary {
-            Some(s) => lines.push(format!(
-                "false shadow {:.4}  false lit {:.4}  mae {:.4}",
-                s.false_shadow_core, s.false_lit_core, s.mae
-            )),
+            Some(s) => {
+                let mut line = format!(
+                    "false shadow {:.4}  false lit {:.4}  mae {:.4}",
+                    s.false_shadow_core, s.false_lit_core, s.mae
+                );
+                if let Some(flip) = s.flip {
+                    let _ = write!(line, "  FLIP {flip:.3}");
+                }
+                lines.push(line)
+            }
             None if self.id == "reference (hard)" => {
                 lines.push("the judge's exact visibility".to_string())
             }
@@ -149,11 +159,9 @@ pub fn build(
     mut progress: impl FnMut(&str),
 ) -> anyhow::Result<Sheet> {
     progress("reference");
-    let reference = SceneReference::compute(renderer, samples, |_| {})?;
+    let mut reference = SceneReference::compute(renderer, samples, |_| {})?;
     let background = renderer.read_output();
-    let gbuffer = &reference.gbuffer;
-    let hard: Vec<&[f32]> = reference.lights.iter().map(|l| l.hard.as_slice()).collect();
-    let area: Vec<&[f32]> = reference.lights.iter().map(|l| l.area.as_slice()).collect();
+    let gbuffer_size = reference.gbuffer.size;
     let traced = format!(
         "ray traced in {:.2} s ({} triangles)",
         reference.seconds, reference.occluder_triangles
@@ -179,21 +187,29 @@ pub fn build(
             ),
         ),
     ];
-    let mut images = vec![
-        shade_on_cpu(renderer, gbuffer, &hard, None, &background),
-        shade_on_cpu(renderer, gbuffer, &area, None, &background),
-    ];
+    let mut images = {
+        let hard: Vec<&[f32]> = reference.lights.iter().map(|l| l.hard.as_slice()).collect();
+        let area: Vec<&[f32]> = reference.lights.iter().map(|l| l.area.as_slice()).collect();
+        vec![
+            shade_on_cpu(renderer, &reference.gbuffer, &hard, None, &background),
+            shade_on_cpu(renderer, &reference.gbuffer, &area, None, &background),
+        ]
+    };
     for (registration, values) in techniques {
         progress(registration.id);
         match judge_technique(renderer, &reference, registration.id, values) {
             Ok(judged) => {
+                let flip = score_image(renderer, &mut reference, &judged, samples);
                 rows.push(Row {
                     id: registration.id.to_string(),
                     name: registration.name.to_string(),
                     frame_ms: Some(judged.timings.frame_total()),
                     technique_ms: Some(judged.gpu_ms),
                     timings: Some(judged.timings.clone()),
-                    summary: Summary::of(&judged),
+                    summary: Summary::of(&judged).map(|s| Summary {
+                        flip: flip.map(|f| f.mean),
+                        ..s
+                    }),
                     unsupported: judged
                         .scores
                         .iter()
@@ -218,8 +234,8 @@ pub fn build(
                     note: None,
                 });
                 images.push(RgbaImage::from_pixel(
-                    gbuffer.size.x,
-                    gbuffer.size.y,
+                    gbuffer_size.x,
+                    gbuffer_size.y,
                     image::Rgba([60, 20, 20, 255]),
                 ));
             }
@@ -381,8 +397,8 @@ pub fn table(sheet: &Sheet) -> String {
         .unwrap_or(8)
         .max(9);
     let mut out = format!(
-        "{:width$}  {:>9}  {:>9}  {:>17}  {:>14}  {:>7}\n",
-        "technique", "frame ms", "tech. ms", "false shadow core", "false lit core", "mae"
+        "{:width$}  {:>9}  {:>9}  {:>17}  {:>14}  {:>7}  {:>6}\n",
+        "technique", "frame ms", "tech. ms", "false shadow core", "false lit core", "mae", "FLIP"
     );
     let cell = |v: Option<f64>, digits: usize| match v {
         Some(v) => format!("{v:.digits$}"),
@@ -391,13 +407,14 @@ pub fn table(sheet: &Sheet) -> String {
     for row in &sheet.rows {
         let _ = write!(
             out,
-            "{:width$}  {:>9}  {:>9}  {:>17}  {:>14}  {:>7}",
+            "{:width$}  {:>9}  {:>9}  {:>17}  {:>14}  {:>7}  {:>6}",
             row.id,
             cell(row.frame_ms, 2),
             cell(row.technique_ms, 2),
             cell(row.summary.map(|s| s.false_shadow_core), 4),
             cell(row.summary.map(|s| s.false_lit_core), 4),
             cell(row.summary.map(|s| s.mae), 4),
+            cell(row.summary.and_then(|s| s.flip), 3),
         );
         if let Some(f) = &row.failure {
             let _ = write!(out, "  failed: {f}");

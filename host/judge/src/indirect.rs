@@ -13,25 +13,22 @@ use rayon::prelude::*;
 use zoo_scene::shading::falloff;
 use zoo_scene::{Light, Scene};
 
-use crate::occluders::{CanonicalFrame, Occluders, TriangleBvh};
-use crate::reference::SurfacePoint;
+use crate::occluders::Occluders;
 use crate::sampling::stratified_disk;
+use crate::surfaces::{SurfacePoint, Surfaces};
 
-/// Every surface of a scene as a diffuse reflector: triangles with their normals and albedo.
+/// Every surface of a scene as a diffuse reflector: its triangles with their albedo.
 pub struct Reflectors {
-    bvh: TriangleBvh,
-    frame: CanonicalFrame,
-    /// Per triangle: unit geometric normal and albedo.
-    normals: Vec<Vec3>,
+    surfaces: Surfaces,
+    /// Per triangle: albedo.
     albedo: Vec<Vec3>,
 }
 
 /// Where a ray meets a reflector.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReflectorHit {
-    pub position: Vec3,
-    /// Unit normal on the side the ray came from.
-    pub normal: Vec3,
+    /// The point, with its normal on the side the ray came from.
+    pub point: SurfacePoint,
     pub albedo: Vec3,
     pub distance: f32,
 }
@@ -51,49 +48,34 @@ impl Reflectors {
 
     /// Reflectors from world-space triangles and their albedo.
     pub fn from_triangles(triangles: &[([Vec3; 3], Vec3)]) -> Reflectors {
-        let frame = CanonicalFrame::of(triangles.iter().map(|(t, _)| t));
-        let canonical: Vec<_> = triangles.iter().map(|(t, _)| frame.triangle(t)).collect();
         Reflectors {
-            bvh: TriangleBvh::new(&canonical),
-            frame,
-            normals: triangles
-                .iter()
-                .map(|([a, b, c], _)| (*b - *a).cross(*c - *a).normalize_or_zero())
-                .collect(),
+            surfaces: Surfaces::from_triangles(triangles.iter().map(|(t, _)| *t).collect()),
             albedo: triangles.iter().map(|(_, albedo)| *albedo).collect(),
         }
     }
 
     /// The nearest reflector from `origin` along unit `direction`.
     pub fn closest(&self, origin: Vec3, direction: Vec3) -> Option<ReflectorHit> {
-        let ray = self.frame.ray(origin, direction, f32::INFINITY)?;
-        let (index, t) = self.bvh.closest(ray)?;
-        let distance = self.frame.world_distance(t);
-        let normal = self.normals[index];
+        let hit = self.surfaces.closest(origin, direction)?;
         Some(ReflectorHit {
-            position: origin + direction * distance,
-            normal: if normal.dot(direction) > 0.0 {
-                -normal
-            } else {
-                normal
-            },
-            albedo: self.albedo[index],
-            distance,
+            point: hit.point,
+            albedo: self.albedo[hit.triangle],
+            distance: hit.distance,
         })
     }
 }
 
-/// The diffuse light a surface at `p` (unit normal `n`, `albedo`) reflects in every direction:
+/// The diffuse light a surface point with `albedo` reflects in every direction:
 /// albedo × Σ radiance · falloff · max(n · l, 0), each light's share filtered by what lies
 /// between (opaque casters block, translucent ones tint).
 pub fn reflected_direct(
     occluders: &Occluders,
     lights: &[Light],
-    p: Vec3,
-    n: Vec3,
+    point: &SurfacePoint,
     albedo: Vec3,
 ) -> Vec3 {
-    let origin = p + n * occluders.epsilon();
+    let (p, n) = (point.position, point.normal);
+    let origin = point.ray_origin();
     let mut sum = Vec3::ZERO;
     for light in lights {
         let l = light.direction_to_light(p);
@@ -151,7 +133,7 @@ fn indirect_at(
 ) -> Vec3 {
     let n = point.normal;
     let (u, v) = basis(n);
-    let origin = point.position + n * occluders.epsilon();
+    let origin = point.ray_origin();
     let mut sum = Vec3::ZERO;
     let mut count = 0;
     for d in stratified_disk(grid, seed ^ 0x1b0c_e5a1) {
@@ -161,7 +143,7 @@ fn indirect_at(
         let direction = (u * d.x + v * d.y + n * up).normalize_or_zero();
         count += 1;
         if let Some(hit) = reflectors.closest(origin, direction) {
-            sum += reflected_direct(occluders, lights, hit.position, hit.normal, hit.albedo);
+            sum += reflected_direct(occluders, lights, &hit.point, hit.albedo);
         }
     }
     sum / count.max(1) as f32

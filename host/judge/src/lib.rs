@@ -1,20 +1,26 @@
 //! The reference judge: exact ray-traced visibility for the pixels of a rendered G-buffer, and
 //! the metrics that score a technique's visibility against it. No GPU dependency.
 //!
-//! For every pixel whose surface a light reaches (facing it, inside its range and cone), shadow
-//! rays go from the surface, offset along its normal by a scene-scaled epsilon, to the light:
-//! one ray to the light's centre for hard visibility, and stratified samples over the light's
-//! disk (point and spot: a disk of the light's radius facing the surface; directional: the cone
-//! of the light's angular radius) for area visibility.
+//! Each pixel's surface is found on the scene's exact triangles (the ray from the eye through
+//! the G-buffer's position). For every pixel whose surface a light reaches (facing it, inside
+//! its range and cone), shadow rays go from that point, moved off its triangle along the
+//! triangle's normal by the bound on its floating-point error (nothing scales with the scene's
+//! size), to the light: one ray to the light's centre for hard visibility, and stratified
+//! samples over the light's disk (point and spot: a disk of the light's radius facing the
+//! surface; directional: the cone of the light's angular radius) for area visibility.
 
+mod bvh;
 mod indirect;
 mod metrics;
 mod occluders;
 mod reference;
+mod robust;
 mod sampling;
+mod surfaces;
 
 pub use indirect::{ReflectorHit, Reflectors, one_bounce, reflected_direct, relative_rmse};
 pub use metrics::{ErrorClass, Metrics, edge_band, error_class, percentile};
 pub use occluders::Occluders;
-pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, SurfacePoint, reference_visibility};
+pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, reference_visibility};
 pub use sampling::{concentric_disk, stratified_disk};
+pub use surfaces::{SurfaceHit, SurfacePoint, Surfaces};

@@ -7,17 +7,10 @@ use zoo_scene::{Light, LightKind};
 
 use crate::occluders::Occluders;
 use crate::sampling::stratified_disk;
+use crate::surfaces::SurfacePoint;
 
 /// Area samples per pixel unless configured otherwise (an 8 x 8 stratified grid).
 pub const DEFAULT_AREA_SAMPLES: u32 = 64;
-
-/// The surface seen at a pixel.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SurfacePoint {
-    pub position: Vec3,
-    /// Unit normal on the side facing the camera.
-    pub normal: Vec3,
-}
 
 /// Reference visibility of one light.
 #[derive(Debug, Clone, PartialEq)]
@@ -110,7 +103,7 @@ fn point_visibility(
     grid: u32,
     seed: u32,
 ) -> (Vec3, Vec3) {
-    let origin = point.position + point.normal * occluders.epsilon();
+    let origin = point.ray_origin();
     match light.kind {
         LightKind::Directional => {
             let toward = -light.direction;

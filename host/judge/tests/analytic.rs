@@ -23,10 +23,11 @@ fn floor_points(center: Vec2, half: f32) -> Vec<Option<SurfacePoint>> {
             let (x, z) = ((i % GRID) as f32, (i / GRID) as f32);
             let t = (Vec2::new(x, z) + 0.5) / GRID as f32 * 2.0 - 1.0;
             let p = center + t * half;
-            Some(SurfacePoint {
-                position: Vec3::new(p.x, 0.0, p.y),
-                normal: Vec3::Y,
-            })
+            Some(SurfacePoint::on_plane(
+                Vec3::new(p.x, 0.0, p.y),
+                Vec3::Y,
+                10.0,
+            ))
         })
         .collect()
 }
@@ -244,10 +245,11 @@ fn a_wall_at_grazing_incidence_is_fully_visible() {
         // Normals as a G-buffer stores them: a hair towards the light, so the light counts.
         let points: Vec<Option<SurfacePoint>> = (0..64)
             .map(|i| {
-                Some(SurfacePoint {
-                    position: Vec3::new(-3.0 + i as f32 * 0.1, 1.0 + i as f32 * 0.05, 0.0),
-                    normal: Vec3::new(0.0, 1e-6, 1.0).normalize(),
-                })
+                Some(SurfacePoint::on_plane(
+                    Vec3::new(-3.0 + i as f32 * 0.1, 1.0 + i as f32 * 0.05, 0.0),
+                    Vec3::new(0.0, 1e-6, 1.0).normalize(),
+                    10.0,
+                ))
             })
             .collect();
         let r = reference_visibility(&occluders, &s.lights[0], &points, 64);
@@ -317,7 +319,6 @@ fn translucent_casters_filter_once_each_and_opaque_ones_block() {
             (cube(Vec3::new(0.0, 4.0, 0.0), 0.5), cyan),
             (cube(Vec3::new(-4.0, 2.0, 0.0), 0.5), cyan),
         ],
-        20.0,
     );
     let up = Vec3::Y;
     // Through one closed box: two of its faces, one filter.

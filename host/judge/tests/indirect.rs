@@ -41,10 +41,11 @@ fn centred_form_factor(a: f32, b: f32, c: f32) -> f32 {
 fn floor_points(count: usize) -> Vec<Option<SurfacePoint>> {
     (0..count)
         .map(|i| {
-            Some(SurfacePoint {
-                position: Vec3::new(0.0, 0.0, 0.0) + Vec3::X * (i as f32 * 1e-3),
-                normal: Vec3::Y,
-            })
+            Some(SurfacePoint::on_plane(
+                Vec3::X * (i as f32 * 1e-3),
+                Vec3::Y,
+                1.0,
+            ))
         })
         .collect()
 }
@@ -53,7 +54,7 @@ fn floor_points(count: usize) -> Vec<Option<SurfacePoint>> {
 fn a_lit_square_gives_its_form_factor() {
     let (half, height, albedo, radiance) = (2.0, 1.0, 0.5, 1.5);
     let square = ceiling(half, height);
-    let occluders = Occluders::from_triangles(&square, 6.0);
+    let occluders = Occluders::from_triangles(&square);
     let reflectors = Reflectors::from_triangles(
         &square
             .iter()
@@ -66,8 +67,8 @@ fn a_lit_square_gives_its_form_factor() {
         .closest(Vec3::ZERO, Vec3::Y)
         .expect("the square is above");
     assert!((hit.distance - height).abs() < 1e-4);
-    assert_eq!(hit.normal, Vec3::NEG_Y);
-    let leaving = reflected_direct(&occluders, &lights, hit.position, hit.normal, hit.albedo);
+    assert_eq!(hit.point.normal, Vec3::NEG_Y);
+    let leaving = reflected_direct(&occluders, &lights, &hit.point, hit.albedo);
     assert!(
         (leaving - Vec3::splat(albedo * radiance))
             .abs()
@@ -100,7 +101,7 @@ fn a_shadowed_reflector_sends_nothing_and_albedo_scales_the_light() {
         .iter()
         .map(|t| (*t, Vec3::new(0.8, 0.4, 0.2)))
         .collect();
-    let occluders = Occluders::from_triangles(&square, 6.0);
+    let occluders = Occluders::from_triangles(&square);
     let lit = one_bounce(
         &occluders,
         &Reflectors::from_triangles(&bright),
@@ -119,7 +120,7 @@ fn a_shadowed_reflector_sends_nothing_and_albedo_scales_the_light() {
     // the square in shadow: it sends nothing.
     let mut blocked = square.clone();
     blocked.extend(ceiling(2.5, 0.9));
-    let plate_above_points = Occluders::from_triangles(&blocked, 6.0);
+    let plate_above_points = Occluders::from_triangles(&blocked);
     let dark = one_bounce(
         &plate_above_points,
         &Reflectors::from_triangles(&bright),

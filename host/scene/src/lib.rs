@@ -392,6 +392,55 @@ impl Scene {
         mesh::bounds(&self.mesh.positions).unwrap_or((Vec3::ZERO, Vec3::ZERO))
     }
 
+    /// The same scene uniformly scaled by `factor` about the world origin: geometry,
+    /// transforms, light positions, ranges and radii (angular radii stay), receiver planes,
+    /// the camera with its near and far planes, and the paths' positions. Visibility is the
+    /// same at every scale, so the judge and every technique should score it the same.
+    pub fn scaled(&self, factor: f32) -> Scene {
+        let mut out = self.clone();
+        let scale = Mat4::from_scale(Vec3::splat(factor));
+        for p in &mut out.mesh.positions {
+            *p *= factor;
+        }
+        for object in &mut out.objects {
+            object.transform = scale * object.transform;
+        }
+        for light in &mut out.lights {
+            light.position *= factor;
+            light.range *= factor;
+            if light.kind != LightKind::Directional {
+                light.radius *= factor;
+            }
+        }
+        for receiver in &mut out.receivers {
+            receiver.plane.w *= factor;
+            for corner in &mut receiver.corners {
+                *corner *= factor;
+            }
+        }
+        let camera = &mut out.camera;
+        camera.position *= factor;
+        camera.target *= factor;
+        camera.near *= factor;
+        camera.far *= factor;
+        for key in &mut out.paths.camera {
+            key.position *= factor;
+            key.target *= factor;
+        }
+        for path in &mut out.paths.lights {
+            let moves = out
+                .lights
+                .get(path.light)
+                .is_some_and(|l| l.kind != LightKind::Directional);
+            if moves {
+                for key in &mut path.keys {
+                    key.value *= factor;
+                }
+            }
+        }
+        out
+    }
+
     /// Which object each triangle belongs to.
     pub fn triangle_objects(&self) -> Vec<u32> {
         let mut out = vec![0; self.triangle_count()];

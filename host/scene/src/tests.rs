@@ -279,3 +279,50 @@ fn tessellation_scales_procedural_meshes() {
     assert_eq!(sphere(&finer), 2 * 64 * 31);
     assert_eq!(sphere(&coarser), 2 * 8 * 3);
 }
+
+#[test]
+fn scaling_a_scene_scales_every_length_and_keeps_angles() {
+    let scene = parse(
+        "(camera: (position: (0, 2, 5), target: (0, 0, 0), near: 0.1, far: 50),
+          lights: [Point(position: (1, 3, 0), range: 20, radius: 0.2),
+                   Directional(direction: (0, -1, 0.2), angular_radius_degrees: 0.5),
+                   Spot(position: (0, 4, 0), direction: (0, -1, 0), range: 9, angle_degrees: 30, radius: 0.1)],
+          objects: [(mesh: Plane(size: 4), receiver: true, transform: (translation: (0, 0.5, 0))), (mesh: Sphere(radius: 0.5), transform: (translation: (0, 1, 0)))],
+          paths: (camera: [(time: 0, position: (0, 2, 5), target: (0, 0, 0))],
+                  lights: [(light: 0, keys: [(time: 0, value: (1, 3, 0))]),
+                           (light: 1, keys: [(time: 0, value: (0, -1, 0))])]))",
+    )
+    .unwrap();
+    let big = scene.scaled(100.0);
+    assert_eq!(big.mesh.positions.len(), scene.mesh.positions.len());
+    for (a, b) in scene.mesh.positions.iter().zip(&big.mesh.positions) {
+        assert_eq!(*a * 100.0, *b);
+    }
+    assert_eq!(big.mesh.normals, scene.mesh.normals);
+    assert_eq!(big.camera.position, scene.camera.position * 100.0);
+    assert_eq!((big.camera.near, big.camera.far), (10.0, 5000.0));
+    assert_eq!(big.camera.fov_y, scene.camera.fov_y);
+    let [point, sun, spot] = [0, 1, 2].map(|i| (scene.lights[i], big.lights[i]));
+    assert_eq!(point.1.position, point.0.position * 100.0);
+    assert_eq!((point.1.range, point.1.radius), (2000.0, 20.0));
+    assert_eq!(sun.1.radius, sun.0.radius, "angular radius is kept");
+    assert_eq!(sun.1.direction, sun.0.direction);
+    assert_eq!(spot.1.spot_angle, spot.0.spot_angle);
+    assert_eq!(spot.1.radius, spot.0.radius * 100.0);
+    let receiver = (scene.receivers[0], big.receivers[0]);
+    assert_eq!(receiver.1.plane.w, receiver.0.plane.w * 100.0);
+    assert_eq!(receiver.1.corners[2], receiver.0.corners[2] * 100.0);
+    assert_eq!(big.paths.camera[0].position, Vec3::new(0.0, 200.0, 500.0));
+    assert_eq!(
+        big.paths.lights[0].keys[0].value,
+        Vec3::new(100.0, 300.0, 0.0)
+    );
+    assert_eq!(
+        big.paths.lights[1].keys[0].value,
+        Vec3::NEG_Y,
+        "a direction"
+    );
+    let (lo, hi) = big.bounds();
+    let (slo, shi) = scene.bounds();
+    assert_eq!((lo, hi), (slo * 100.0, shi * 100.0));
+}

@@ -7,7 +7,9 @@ use zoo_host::glam::camera::rh::view::look_to_mat4;
 use zoo_host::glam::{Mat4, Vec3, Vec4};
 use zoo_host::scene::{Camera, Light, LightKind};
 
-use crate::light_space::{Aabb, LightFrustum, Projection, corners, transformed_bounds, up_for};
+use crate::light_space::{
+    Aabb, LightFrustum, Projection, corners, magnitude, resolvable, transformed_bounds, up_for,
+};
 use crate::planning::{LayerPlan, PlanInputs};
 
 /// The cascade plan: `splits` layers for every directional light (none for other lights),
@@ -110,7 +112,7 @@ pub fn visible_depth_range(camera: &Camera, aspect: f32, objects: &[Aabb]) -> (f
         }
     }
     let near = lo.clamp(camera.near, camera.far);
-    let far = hi.min(camera.far).max(near * 1.001 + 1e-4);
+    let far = hi.min(camera.far).max(near * 1.001);
     (near, far)
 }
 
@@ -156,7 +158,10 @@ pub fn slice_sphere(corners: &[Vec3; 8]) -> (Vec3, f32) {
     let far_centre = corners[4..].iter().copied().sum::<Vec3>() / 4.0;
     let near_radius = corners[0].distance(near_centre);
     let far_radius = corners[4].distance(far_centre);
-    let length = near_centre.distance(far_centre).max(1e-6);
+    let length = resolvable(
+        near_centre.distance(far_centre),
+        magnitude(near_centre, far_centre),
+    );
     let axis = (far_centre - near_centre) / length;
     // Equal distance to a near and a far corner along the axis, kept inside the slice.
     let t = ((length * length + far_radius * far_radius - near_radius * near_radius)
@@ -186,7 +191,7 @@ pub fn cascade_frustum(
     let (mut centre, extent);
     if let Some(resolution) = stable_texels {
         let (sphere_centre, radius) = slice_sphere(corners);
-        let quantum = 2f32.powf((2.0 * radius).max(1e-6).log2().floor()) / 64.0;
+        let quantum = 2f32.powf(resolvable(2.0 * radius, magnitude(lo, hi)).log2().floor()) / 64.0;
         // Two texels of margin: snapping moves the sphere by up to half a texel.
         extent = ((2.0 * radius) / quantum).ceil() * quantum * (1.0 + 2.0 / resolution as f32);
         let texel = extent / resolution as f32;
@@ -196,7 +201,7 @@ pub fn cascade_frustum(
         lo.z = centre.z - radius;
         hi.z = centre.z + radius;
     } else {
-        extent = (hi.x - lo.x).max(hi.y - lo.y).max(1e-4) * 1.01;
+        extent = resolvable((hi.x - lo.x).max(hi.y - lo.y), magnitude(lo, hi)) * 1.01;
         centre = (lo + hi) * 0.5;
     }
     let half = extent * 0.5;
@@ -212,7 +217,7 @@ pub fn cascade_frustum(
             nearest = nearest.max(chi.z);
         }
     }
-    let margin = (nearest - lo.z).max(1e-3) * 0.01;
+    let margin = resolvable(nearest - lo.z, magnitude(lo, hi).max(nearest.abs())) * 0.01;
     let (mut near, mut far) = (-nearest - margin, -lo.z + margin);
     if stable_texels.is_some() {
         // The depth range moves outward in coarse steps too.

@@ -101,9 +101,21 @@ pub(crate) fn up_for(direction: Vec3) -> Vec3 {
 }
 
 /// Near plane of a perspective light map: close enough for nearby casters, far enough to
-/// keep depth precision.
+/// keep depth precision (a thousandth of the range, at any scale).
 pub fn perspective_near(range: f32) -> f32 {
-    (range * 1e-3).max(0.02)
+    resolvable(range * 1e-3, range)
+}
+
+/// `length`, or when it vanishes, the smallest length still resolvable beside coordinates of
+/// size `magnitude` (a millionth of it): guards fits of degenerate boxes without a fixed
+/// distance, so a fit is the same at every scale.
+pub fn resolvable(length: f32, magnitude: f32) -> f32 {
+    length.max(magnitude.abs() * 1e-6).max(1e-30)
+}
+
+/// The largest absolute coordinate of two points.
+pub(crate) fn magnitude(a: Vec3, b: Vec3) -> f32 {
+    a.abs().max(b.abs()).max_element()
 }
 
 /// A perspective frustum around a spot light's cone (with a small margin).
@@ -126,7 +138,7 @@ pub fn spot_frustum(light: &Light) -> LightFrustum {
 pub fn directional_frustum_over(direction: Vec3, bounds: Aabb) -> LightFrustum {
     let (lo, hi) = bounds;
     let centre = (lo + hi) * 0.5;
-    let radius = (lo.distance(hi) * 0.5).max(1e-3);
+    let radius = resolvable(lo.distance(hi) * 0.5, magnitude(lo, hi));
     let eye = centre - direction * (radius * 1.01);
     let view = look_to_mat4(eye, direction, up_for(direction));
     LightFrustum::new(
@@ -268,7 +280,7 @@ pub fn directional_frustum(
         }
     }
     // Square extent centred on the receivers (the map is square).
-    let mut extent = (hi.x - lo.x).max(hi.y - lo.y).max(1e-3) * 1.02;
+    let mut extent = resolvable((hi.x - lo.x).max(hi.y - lo.y), magnitude(lo, hi)) * 1.02;
     let mut center = (lo + hi) * 0.5;
     if let Some(resolution) = stable_texels {
         // Two texels of margin: rounding the centre moves the receivers by up to half a texel.
@@ -278,7 +290,7 @@ pub fn directional_frustum(
         center.x = (center.x / texel).round() * texel;
         center.y = (center.y / texel).round() * texel;
     }
-    let margin = (nearest - lo.z).max(1e-3) * 0.01;
+    let margin = resolvable(nearest - lo.z, magnitude(lo, hi).max(nearest.abs())) * 0.01;
     let (mut near, mut far) = (-nearest - margin, -lo.z + margin);
     if stable_texels.is_some() {
         // The depth range moves outward in coarse steps too.

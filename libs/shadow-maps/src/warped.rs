@@ -8,7 +8,9 @@ use zoo_host::glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
 use zoo_host::scene::{Camera, Light, LightKind};
 
 use crate::cascades::slice_corners;
-use crate::light_space::{Aabb, LightFrustum, corners, transformed_bounds, up_for};
+use crate::light_space::{
+    Aabb, LightFrustum, corners, magnitude, resolvable, transformed_bounds, up_for,
+};
 
 /// Below this sine of the angle between the view and light directions, LiSPSM's warp is
 /// dropped: its optimal near distance grows as 1 / sin γ and the map becomes uniform.
@@ -122,7 +124,7 @@ pub fn lispsm_frustum(
             sin_gamma,
         };
     }
-    let d = (hi.y - lo.y).max(1e-4);
+    let d = resolvable(hi.y - lo.y, magnitude(lo, hi));
     let n = lispsm_near(near, d, sin_gamma) / strength;
     let f = n + d;
     // The warp's centre of projection: n before the body along y, at the camera laterally.
@@ -266,7 +268,9 @@ pub fn psm_frustum(
     let view_proj = projection * pp_view * post;
     // Where the light grazes the view's squashed post-perspective box, the view lands on a
     // sliver of the map: no better than a uniform map, and its depth slopes defeat biasing.
-    let (lo, hi) = transformed_bounds(view_proj, &slice);
+    // (The map's coordinates are after the perspective division.)
+    let mapped: Vec<Vec3> = slice.iter().map(|p| view_proj.project_point3(*p)).collect();
+    let (lo, hi) = transformed_bounds(Mat4::IDENTITY, &mapped);
     if (hi.x - lo.x).min(2.0) * (hi.y - lo.y).min(2.0) < 4.0 * MIN_MAP_USE {
         return None;
     }
@@ -524,5 +528,53 @@ mod tests {
         let (r, b) = (map(&fit.frustum, receiver), map(&fit.frustum, blocker));
         assert!((r.truncate() - b.truncate()).length() < 1e-3);
         assert!(b.z < r.z);
+    }
+
+    #[test]
+    fn psm_fits_the_same_view_at_every_scale() {
+        // A spot light and a sun over a caster on the ground: the fit (and whether PSM warps at
+        // all) must not depend on the scene's units.
+        let base = camera();
+        let spot = Light {
+            kind: LightKind::Spot,
+            position: Vec3::new(-3.0, 5.0, -4.0),
+            direction: Vec3::new(0.4, -1.0, -0.2).normalize(),
+            range: 40.0,
+            spot_angle: 0.8,
+            ..sun(Vec3::NEG_Y)
+        };
+        let caster = (Vec3::new(-1.0, 0.0, -7.0), Vec3::new(0.0, 2.0, -6.0));
+        for light in [spot, sun(Vec3::new(0.5, -0.8, -0.3).normalize())] {
+            let fit_at = |s: f32| {
+                let c = Camera {
+                    position: base.position * s,
+                    target: base.target * s,
+                    near: base.near * s,
+                    far: base.far * s,
+                    ..base
+                };
+                let l = Light {
+                    position: light.position * s,
+                    range: light.range * s,
+                    ..light
+                };
+                let scaled = |(lo, hi): Aabb| (lo * s, hi * s);
+                let boxes = [scaled(caster), scaled(ground())];
+                psm_frustum(&l, &c, 1.5, (0.1 * s, 60.0 * s), &boxes, &boxes, 0.002)
+                    .map(|f| f.frustum.view_proj * Mat4::from_scale(Vec3::splat(s)))
+            };
+            let unit = fit_at(1.0).expect("PSM warps this view");
+            for s in [1e-3, 0.01, 100.0, 1e4] {
+                let fit = fit_at(s).unwrap_or_else(|| panic!("no fit at scale {s}"));
+                // Homogeneous matrices agree up to a common factor: compare normalised.
+                let norm = |m: Mat4| m * (1.0 / m.w_axis.length());
+                let (a, b) = (norm(unit), norm(fit));
+                assert!(
+                    a.abs_diff_eq(b, 1e-3),
+                    "{:?} at scale {s}: {b:?} against {a:?}",
+                    light.kind
+                );
+            }
+        }
     }
 }

@@ -72,8 +72,12 @@ pub fn draw(camera: &Camera, aspect: f32, lights: &[LightMaps], distances: &[f32
     }
     let forward = (camera.target - camera.position) * Vec3::new(1.0, 0.0, 1.0);
     let forward = forward.try_normalize().unwrap_or(Vec3::NEG_Z);
-    let far = distances.last().copied().unwrap_or(camera.far).max(1e-3);
-    let r0 = distances.get(1).copied().unwrap_or(far).max(1e-3) * 0.25;
+    let far = distances
+        .last()
+        .copied()
+        .unwrap_or(camera.far)
+        .max(camera.near);
+    let r0 = distances.get(1).copied().unwrap_or(far).max(camera.near) * 0.25;
     let mapping = Mapping {
         origin: camera.position,
         right: forward.cross(Vec3::Y),

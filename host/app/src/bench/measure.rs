@@ -5,7 +5,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use zoo_host::gpu::{PassOwner, TimingSource};
-use zoo_host::judge::{Occluders, reference_visibility};
+use zoo_host::judge::{Occluders, Surfaces, reference_visibility};
 use zoo_host::judging::surface_points;
 use zoo_host::scene::paths;
 use zoo_host::{GpuContext, Renderer, Scene, View};
@@ -63,7 +63,9 @@ pub fn run_configuration(
     }
     let scene = Scene::from_description(&description, &plan.scene_path, base)?;
     let triangles = scene.triangle_count();
-    let occluders = plan.flicker.then(|| Occluders::new(&scene));
+    let occluders = plan
+        .flicker
+        .then(|| (Occluders::new(&scene), Surfaces::new(&scene)));
     let mut renderer = Renderer::new(gpu.clone(), scene.clone(), config.size)?;
     renderer.set_technique(config.technique.id, &config.params)?;
     renderer.set_pipeline_statistics(!plan.cpu_timing);
@@ -115,9 +117,9 @@ pub fn run_configuration(
                 pass_samples[index].invocations.push(counts);
             }
         }
-        if let Some(occluders) = &occluders {
+        if let Some((occluders, surfaces)) = &occluders {
             let g = renderer.read_gbuffer();
-            let points = surface_points(&g);
+            let points = surface_points(&g, surfaces);
             let frame = FrameVisibility {
                 technique: (0..renderer.lights().len())
                     .map(|l| renderer.read_visibility(l))

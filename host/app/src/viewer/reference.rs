@@ -7,7 +7,7 @@ use std::thread::JoinHandle;
 use std::time::Instant;
 
 use zoo_host::image::RgbaImage;
-use zoo_host::judge::{Metrics, Occluders, reference_visibility};
+use zoo_host::judge::{Metrics, Occluders, Surfaces, reference_visibility};
 use zoo_host::judging::{DEFAULT_SAMPLES, error_map, surface_points};
 use zoo_host::params::ParamValues;
 use zoo_host::scene::{Camera, Light};
@@ -103,7 +103,7 @@ impl ReferenceOverlay {
             .spawn(move || {
                 let start = Instant::now();
                 let occluders = Occluders::new(&scene);
-                let points = surface_points(&gbuffer);
+                let points = surface_points(&gbuffer, &Surfaces::new(&scene));
                 let (width, height) = (gbuffer.size.x as usize, gbuffer.size.y as usize);
                 let mut metrics = Vec::new();
                 let mut error_maps = Vec::new();

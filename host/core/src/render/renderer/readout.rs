@@ -9,6 +9,8 @@ use crate::gpu::readback;
 #[derive(Debug, Clone)]
 pub struct GBufferData {
     pub size: UVec2,
+    /// The camera position it was rendered from.
+    pub eye: Vec3,
     /// World position; w = 1 on geometry, 0 on background.
     pub positions: Vec<Vec4>,
     /// World normal (facing the camera).
@@ -122,6 +124,7 @@ impl Renderer {
         );
         GBufferData {
             size: self.size,
+            eye: matrices.eye,
             positions,
             normals: normals
                 .chunks_exact(4)

@@ -3,12 +3,15 @@
 //! The reference depends only on the G-buffer (the camera and the scene), so it is computed once
 //! per view and every technique rendered from that view is scored against it.
 
+pub mod perceptual;
+
 use std::time::Instant;
 
 use image::{Rgba, RgbaImage};
+use rayon::prelude::*;
 use zoo_judge::{
     DEFAULT_AREA_SAMPLES, ErrorClass, LightReference, Metrics, Occluders, Reflectors, SurfacePoint,
-    error_class, one_bounce, reference_visibility, relative_rmse,
+    Surfaces, error_class, one_bounce, reference_visibility, relative_rmse,
 };
 
 use crate::gpu::{FrameTimings, PassOwner};
@@ -44,7 +47,7 @@ impl SceneReference {
         let gbuffer = renderer.read_gbuffer();
         let start = Instant::now();
         let occluders = Occluders::new(renderer.scene());
-        let points = surface_points(&gbuffer);
+        let points = surface_points(&gbuffer, &Surfaces::new(renderer.scene()));
         let lights = renderer
             .lights()
             .iter()
@@ -77,7 +80,7 @@ impl SceneReference {
             let start = Instant::now();
             let occluders = Occluders::new(scene);
             let reflectors = Reflectors::new(scene);
-            let points = surface_points(&self.gbuffer);
+            let points = surface_points(&self.gbuffer, &Surfaces::new(scene));
             let traced = one_bounce(&occluders, &reflectors, lights, &points, samples);
             self.seconds += start.elapsed().as_secs_f64();
             self.indirect = Some((samples, lights.to_vec(), traced));
@@ -96,17 +99,16 @@ impl SceneReference {
     }
 }
 
-/// The G-buffer's surfaces as judge input (`None` on background pixels).
-pub fn surface_points(gbuffer: &GBufferData) -> Vec<Option<SurfacePoint>> {
+/// The G-buffer's surfaces as judge input (`None` on background pixels), each located on the
+/// exact triangles of the scene ([`Surfaces::locate`]).
+pub fn surface_points(gbuffer: &GBufferData, surfaces: &Surfaces) -> Vec<Option<SurfacePoint>> {
     gbuffer
         .positions
-        .iter()
+        .par_iter()
         .zip(&gbuffer.normals)
         .map(|(p, n)| {
-            (p.w > 0.5 && n.is_finite() && p.is_finite()).then(|| SurfacePoint {
-                position: p.truncate(),
-                normal: n.normalize_or_zero(),
-            })
+            (p.w > 0.5 && n.is_finite() && p.is_finite())
+                .then(|| surfaces.locate(gbuffer.eye, p.truncate(), n.normalize_or_zero()))
         })
         .collect()
 }

@@ -1,0 +1,259 @@
+//! Triangles in a bounding volume hierarchy over world coordinates, traversed without any
+//! distance cut-off.
+//!
+//! The hierarchy is built by obvhs (PLOC, a binary BVH) and traversed here: obvhs's compressed
+//! wide BVH skips nodes that end closer than a fixed 1e-4 to the ray origin, which is a
+//! distance in world units, so a scene's scale would decide which nearby occluders count. The
+//! slab test here is conservative in floating point (Ize, "Robust BVH Ray Traversal", 2013:
+//! the far distance is scaled by 1 + 2γ₃) and leaf boxes are grown by the triangle test's own
+//! rounding, so a node is never skipped that holds a triangle the triangle test accepts.
+
+use std::cell::RefCell;
+use std::time::Duration;
+
+use glam::{Vec3, Vec3A};
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
+use obvhs::bvh2::builder::build_bvh2;
+use obvhs::ray::Ray;
+use obvhs::triangle::Triangle;
+
+use crate::robust::gamma;
+
+/// A ray query: origin, unit direction and the open distance range (0, `tmax`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Query {
+    ray: Ray,
+}
+
+impl Query {
+    /// The segment from `origin` along unit `direction` up to `tmax` (`None` when not finite).
+    pub(crate) fn new(origin: Vec3, direction: Vec3, tmax: f32) -> Option<Query> {
+        if !direction.is_finite() || !origin.is_finite() || tmax.is_nan() {
+            return None;
+        }
+        // -0.0 + 0.0 == +0.0; every other value is unchanged.
+        let direction = Vec3A::from(direction) + Vec3A::ZERO;
+        Some(Query {
+            ray: Ray {
+                origin: Vec3A::from(origin),
+                direction,
+                inv_direction: direction.map(reciprocal),
+                // Hits at the origin itself (t = 0) do not count: origins are offset off
+                // their surface by its error bound (see `SurfacePoint::ray_origin`).
+                tmin: f32::MIN_POSITIVE,
+                tmax,
+            },
+        })
+    }
+}
+
+/// What a leaf visit tells the traversal.
+enum Visit {
+    /// Keep going (with the ray's `tmax` possibly shortened by the visitor).
+    Continue,
+    /// Stop: the answer is known.
+    Stop,
+}
+
+/// Triangles in a BVH, stored in traversal order.
+pub(crate) struct TriangleBvh {
+    bvh: Bvh2,
+    triangles: Vec<Triangle>,
+    /// Per stored triangle: the index of the input triangle it came from.
+    sources: Vec<usize>,
+}
+
+thread_local! {
+    /// Each thread's traversal stack, kept between queries.
+    static STACK: RefCell<Vec<(u32, f32)>> = const { RefCell::new(Vec::new()) };
+}
+
+impl TriangleBvh {
+    /// Builds the BVH over the non-degenerate ones of world-space `triangles`.
+    pub(crate) fn new(triangles: &[[Vec3; 3]]) -> TriangleBvh {
+        let (sources, kept): (Vec<usize>, Vec<Triangle>) = triangles
+            .iter()
+            .map(|[a, b, c]| Triangle {
+                v0: (*a).into(),
+                v1: (*b).into(),
+                v2: (*c).into(),
+            })
+            .enumerate()
+            .filter(|(_, t)| !is_degenerate(t))
+            .unzip();
+        if kept.is_empty() {
+            return TriangleBvh {
+                bvh: Bvh2::default(),
+                triangles: Vec::new(),
+                sources: Vec::new(),
+            };
+        }
+        // The triangle test rounds at the magnitude of the coordinates, so it accepts hits up
+        // to a few ulps outside a triangle (at a vertex or an edge lying in a box face); boxes
+        // grow by a bound on that so that traversal finds every hit brute force would. This
+        // costs only traversal time: which hits count is the triangle test's alone.
+        let magnitude = kept
+            .iter()
+            .flat_map(|t| [t.v0, t.v1, t.v2])
+            .map(|v| v.abs().max_element())
+            .fold(0.0f32, f32::max);
+        let padding = Vec3A::splat(gamma(16) * magnitude);
+        let boxes: Vec<Aabb> = kept
+            .iter()
+            .map(|t| {
+                let b = t.aabb();
+                Aabb::new(b.min - padding, b.max + padding)
+            })
+            .collect();
+        let mut bvh = build_bvh2(
+            &boxes,
+            BvhBuildParams::fast_build(),
+            &mut Duration::default(),
+        );
+        // Store triangles in leaf order so that a leaf's triangles are contiguous.
+        let order = std::mem::take(&mut bvh.primitive_indices);
+        let triangles = order.iter().map(|&i| kept[i as usize]).collect();
+        let sources = order.iter().map(|&i| sources[i as usize]).collect();
+        bvh.primitive_indices = (0..order.len() as u32).collect();
+        TriangleBvh {
+            bvh,
+            triangles,
+            sources,
+        }
+    }
+
+    /// Number of triangles kept.
+    pub(crate) fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Visits the leaves `query` may cross, nearer child first, calling `leaf` with each
+    /// triangle range; `leaf` may shorten the ray's `tmax`.
+    fn traverse(
+        &self,
+        query: &Query,
+        mut leaf: impl FnMut(std::ops::Range<usize>, &mut Ray) -> Visit,
+    ) {
+        if self.triangles.is_empty() {
+            return;
+        }
+        let mut ray = query.ray;
+        let Some(root) = enters(&self.bvh.nodes[0].aabb, &ray) else {
+            return;
+        };
+        STACK.with_borrow_mut(|stack| {
+            stack.clear();
+            stack.push((0, root));
+            while let Some((index, near)) = stack.pop() {
+                // A closer hit found since the node was pushed may rule it out.
+                if near > ray.tmax {
+                    continue;
+                }
+                let node = &self.bvh.nodes[index as usize];
+                let first = node.first_index as usize;
+                if node.prim_count > 0 {
+                    let range = first..first + node.prim_count as usize;
+                    if let Visit::Stop = leaf(range, &mut ray) {
+                        return;
+                    }
+                    continue;
+                }
+                // Children are `first` and `first + 1`; the nearer one is pushed last.
+                let children = [first, first + 1]
+                    .map(|c| enters(&self.bvh.nodes[c].aabb, &ray).map(|t| (c as u32, t)));
+                match children {
+                    [Some(a), Some(b)] if a.1 <= b.1 => stack.extend([b, a]),
+                    [Some(a), Some(b)] => stack.extend([a, b]),
+                    [Some(a), None] | [None, Some(a)] => stack.push(a),
+                    [None, None] => {}
+                }
+            }
+        });
+    }
+
+    /// The nearest triangle `query` hits: its input index and distance.
+    pub(crate) fn closest(&self, query: &Query) -> Option<(usize, f32)> {
+        let mut best = None;
+        self.traverse(query, |range, ray| {
+            for i in range {
+                let t = self.triangles[i].intersect(ray);
+                if t < ray.tmax {
+                    ray.tmax = t;
+                    best = Some((self.sources[i], t));
+                }
+            }
+            Visit::Continue
+        });
+        best
+    }
+
+    /// Whether `query` hits any triangle.
+    pub(crate) fn any_hit(&self, query: &Query) -> bool {
+        let mut hit = false;
+        self.traverse(query, |range, ray| {
+            hit = range
+                .into_iter()
+                .any(|i| self.triangles[i].intersect(ray) < f32::INFINITY);
+            if hit { Visit::Stop } else { Visit::Continue }
+        });
+        hit
+    }
+
+    /// Calls `hit` with the input index of every triangle `query` crosses.
+    pub(crate) fn each_hit(&self, query: &Query, mut hit: impl FnMut(usize)) {
+        self.traverse(query, |range, ray| {
+            for i in range {
+                if self.triangles[i].intersect(ray) < f32::INFINITY {
+                    hit(self.sources[i]);
+                }
+            }
+            Visit::Continue
+        });
+    }
+
+    /// Whether brute force over every triangle finds a hit (for tests of the traversal).
+    #[cfg(test)]
+    pub(crate) fn any_hit_brute_force(&self, query: &Query) -> bool {
+        self.triangles
+            .iter()
+            .any(|t| t.intersect(&query.ray) < f32::INFINITY)
+    }
+}
+
+/// The distance at which `ray` enters `aabb` within (0, tmax], or `None` when it misses.
+/// Conservative: the far distance is enlarged by the slab test's worst rounding error.
+fn enters(aabb: &Aabb, ray: &Ray) -> Option<f32> {
+    let t1 = (aabb.min - ray.origin) * ray.inv_direction;
+    let t2 = (aabb.max - ray.origin) * ray.inv_direction;
+    let near = t1.min(t2).max_element().max(0.0);
+    let far = t1.max(t2).min_element() * (1.0 + 2.0 * gamma(3));
+    (near <= far && near <= ray.tmax).then_some(near)
+}
+
+/// Whether a triangle has no area at f32 precision: its height over its longest edge is below
+/// 1e-6 of that edge (whatever the vertex order). Such a triangle cannot occlude anything, but
+/// the ray-triangle test divides by its vanishing normal and reports hits far outside it.
+fn is_degenerate(t: &Triangle) -> bool {
+    let twice_area = (t.v1 - t.v0).cross(t.v2 - t.v0).length();
+    let longest = [t.v1 - t.v0, t.v2 - t.v1, t.v0 - t.v2]
+        .map(|e| e.length_squared())
+        .into_iter()
+        .fold(0.0f32, f32::max);
+    // height / longest = twice_area / longest^2; NaN (non-finite corners) is degenerate too.
+    twice_area.partial_cmp(&(1e-6 * longest)) != Some(std::cmp::Ordering::Greater)
+}
+
+/// The reciprocal of a direction component for slab tests: exact except that it stays finite
+/// (a 0 gives a huge positive value, so no 0 x inf = NaN). obvhs's own `Ray::new` clamps every
+/// |x| <= f32::EPSILON to 1 / f32::EPSILON, which makes slabs of near-axis rays (components
+/// of 1e-7) end too early.
+fn reciprocal(x: f32) -> f32 {
+    const HUGE: f32 = 1e30;
+    if x == 0.0 {
+        HUGE
+    } else {
+        (1.0 / x).clamp(-HUGE, HUGE)
+    }
+}

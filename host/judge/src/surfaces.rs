@@ -1,0 +1,239 @@
+//! The surface seen at each pixel, located on the scene's exact triangles, and where rays from
+//! it start.
+
+use glam::Vec3;
+use zoo_scene::Scene;
+
+use crate::bvh::{Query, TriangleBvh};
+use crate::robust::{gamma, magnitude, offset_along, plane_test_error};
+
+/// How far (relative to the view distance) the surface the judge finds along a pixel's ray
+/// may lie from the G-buffer's position and still be taken as the same surface. Rasterisers
+/// snap vertices to sub-pixel grids, which moves a grazing surface's depth by about 1e-4 of
+/// the view distance; beyond this the pixel is a silhouette the ray misses.
+const GBUFFER_AGREEMENT: f32 = 1.0 / 512.0;
+
+/// A surface point that rays leave from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    pub position: Vec3,
+    /// Unit shading normal on the side facing the camera: decides whether a light reaches
+    /// the point and weights area samples.
+    pub normal: Vec3,
+    /// Unit normal of the triangle's plane on the side facing the camera: rays start on
+    /// this side, so a triangle facing away from a light shadows its own points.
+    pub geometric_normal: Vec3,
+    /// The distance rays start from `position` along `geometric_normal`: the bound on the
+    /// position's error off the surface, plus the ray-triangle test's error.
+    pub offset: f32,
+}
+
+impl SurfacePoint {
+    /// A point exactly on a flat surface with unit `normal` (geometric and shading), lying on
+    /// a triangle whose coordinates are at most `magnitude` and whose size is at most
+    /// `magnitude` too (as for analytic test surfaces).
+    pub fn on_plane(position: Vec3, normal: Vec3, magnitude: f32) -> SurfacePoint {
+        let magnitude = magnitude.max(position.abs().max_element());
+        SurfacePoint {
+            position,
+            normal,
+            geometric_normal: normal,
+            offset: gamma(2) * magnitude + gamma(8) * 2.0 * magnitude,
+        }
+    }
+
+    /// Where rays from this point start: `position` moved off the surface by `offset` along
+    /// the geometric normal.
+    pub fn ray_origin(&self) -> Vec3 {
+        offset_along(self.position, self.geometric_normal, self.offset)
+    }
+}
+
+/// Where a ray meets a surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceHit {
+    /// The point, its normal on the side the ray came from (shading normal = geometric
+    /// normal), and its ray offset.
+    pub point: SurfacePoint,
+    /// Index of the input triangle.
+    pub triangle: usize,
+    pub distance: f32,
+}
+
+/// Every triangle of a scene (shadow casters or not), to find the exact surface seen through
+/// a pixel or by a ray.
+pub struct Surfaces {
+    bvh: TriangleBvh,
+    triangles: Vec<[Vec3; 3]>,
+}
+
+impl Surfaces {
+    /// Every object of `scene`.
+    pub fn new(scene: &Scene) -> Surfaces {
+        let triangles = scene
+            .objects
+            .iter()
+            .flat_map(|object| {
+                scene.mesh.indices[object.indices.clone()]
+                    .chunks_exact(3)
+                    .map(|tri| [tri[0], tri[1], tri[2]].map(|i| scene.mesh.positions[i as usize]))
+            })
+            .collect();
+        Surfaces::from_triangles(triangles)
+    }
+
+    /// Surfaces from world-space triangles.
+    pub fn from_triangles(triangles: Vec<[Vec3; 3]>) -> Surfaces {
+        Surfaces {
+            bvh: TriangleBvh::new(&triangles),
+            triangles,
+        }
+    }
+
+    /// The input triangle `index`.
+    pub fn triangle(&self, index: usize) -> &[Vec3; 3] {
+        &self.triangles[index]
+    }
+
+    /// The nearest surface from `origin` along unit `direction`.
+    pub fn closest(&self, origin: Vec3, direction: Vec3) -> Option<SurfaceHit> {
+        let query = Query::new(origin, direction, f32::INFINITY)?;
+        let (triangle, distance) = self.bvh.closest(&query)?;
+        let corners = &self.triangles[triangle];
+        let (position, error) = barycentric_point(corners, origin, direction);
+        let mut normal = (corners[1] - corners[0])
+            .cross(corners[2] - corners[0])
+            .normalize_or_zero();
+        if normal.dot(direction) > 0.0 {
+            normal = -normal;
+        }
+        let offset = normal.abs().dot(error)
+            + plane_test_error(corners, magnitude(corners.iter().chain([&position])));
+        Some(SurfaceHit {
+            point: SurfacePoint {
+                position,
+                normal,
+                geometric_normal: normal,
+                offset,
+            },
+            triangle,
+            distance,
+        })
+    }
+
+    /// The surface a camera at `eye` sees where the G-buffer holds `position` with shading
+    /// normal `normal` (facing the camera): the exact point where the ray from the eye
+    /// through `position` meets the triangles, with its triangle's normal, when that point
+    /// agrees with the G-buffer (within [`GBUFFER_AGREEMENT`] of the view distance).
+    /// Elsewhere (silhouettes, where rasterisation covers a pixel centre the ray misses) the
+    /// G-buffer's position and normal, offset by the bound on its reconstruction error.
+    pub fn locate(&self, eye: Vec3, position: Vec3, normal: Vec3) -> SurfacePoint {
+        let to = position - eye;
+        let depth = to.length();
+        let direction = to / depth;
+        if depth > 0.0
+            && let Some(hit) = self.closest(eye, direction)
+            && (hit.distance - depth).abs() <= GBUFFER_AGREEMENT * depth
+        {
+            return SurfacePoint {
+                normal,
+                ..hit.point
+            };
+        }
+        SurfacePoint {
+            position,
+            normal,
+            geometric_normal: normal,
+            offset: reconstruction_error(eye, position, depth),
+        }
+    }
+}
+
+/// A bound on how far a G-buffer position lies off its surface: the position is rebuilt as
+/// eye + depth × ray from the rasterised view depth, each step rounding at the magnitude of
+/// the eye, the position and the view distance (about 16 roundings in all, with the
+/// rasteriser's interpolation of the depth).
+fn reconstruction_error(eye: Vec3, position: Vec3, depth: f32) -> f32 {
+    gamma(16) * (eye.abs().max_element() + position.abs().max_element() + depth)
+}
+
+/// The point where the ray from `origin` along `direction` meets the plane of `corners`,
+/// computed from its barycentric coordinates (so that its error depends on the triangle's
+/// coordinates, not on the ray's length), and the bound on its error per axis:
+/// γ₇ (|b₀ v₀| + |b₁ v₁| + |b₂ v₂|) (Pharr, Jakob and Humphreys, PBR 3rd ed., 3.9.5).
+fn barycentric_point(corners: &[Vec3; 3], origin: Vec3, direction: Vec3) -> (Vec3, Vec3) {
+    let [v0, v1, v2] = *corners;
+    let (e1, e2) = (v1 - v0, v2 - v0);
+    let p = direction.cross(e2);
+    let det = e1.dot(p);
+    let s = origin - v0;
+    let (b1, b2) = if det != 0.0 {
+        let q = s.cross(e1);
+        (s.dot(p) / det, direction.dot(q) / det)
+    } else {
+        (0.0, 0.0)
+    };
+    let (b1, b2) = (b1.clamp(0.0, 1.0), b2.clamp(0.0, 1.0));
+    let total = b1 + b2;
+    let (b1, b2) = if total > 1.0 {
+        (b1 / total, b2 / total)
+    } else {
+        (b1, b2)
+    };
+    let b0 = 1.0 - b1 - b2;
+    let position = b0 * v0 + b1 * v1 + b2 * v2;
+    let error = gamma(7) * ((b0 * v0).abs() + (b1 * v1).abs() + (b2 * v2).abs());
+    (position, error)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hits_are_on_the_triangle_and_face_the_ray() {
+        let s = Surfaces::from_triangles(vec![[
+            Vec3::new(-1.0, 2.0, -1.0),
+            Vec3::new(1.0, 2.0, -1.0),
+            Vec3::new(0.0, 2.0, 1.0),
+        ]]);
+        let hit = s.closest(Vec3::new(0.1, 0.0, 0.0), Vec3::Y).expect("above");
+        assert!((hit.point.position - Vec3::new(0.1, 2.0, 0.0)).length() < 1e-6);
+        assert_eq!(hit.point.geometric_normal, Vec3::NEG_Y);
+        assert!((hit.distance - 2.0).abs() < 1e-6);
+        assert!(hit.point.offset > 0.0 && hit.point.offset < 1e-5);
+        let from_above = s.closest(Vec3::new(0.1, 5.0, 0.0), Vec3::NEG_Y).unwrap();
+        assert_eq!(from_above.point.geometric_normal, Vec3::Y);
+        assert!(s.closest(Vec3::new(3.0, 0.0, 0.0), Vec3::Y).is_none());
+    }
+
+    #[test]
+    fn located_points_agree_with_the_gbuffer_or_fall_back_to_it() {
+        let floor = vec![
+            [
+                Vec3::new(-10.0, 0.0, -10.0),
+                Vec3::new(-10.0, 0.0, 10.0),
+                Vec3::new(10.0, 0.0, 10.0),
+            ],
+            [
+                Vec3::new(-10.0, 0.0, -10.0),
+                Vec3::new(10.0, 0.0, 10.0),
+                Vec3::new(10.0, 0.0, -10.0),
+            ],
+        ];
+        let s = Surfaces::from_triangles(floor);
+        let eye = Vec3::new(0.0, 3.0, 4.0);
+        // A G-buffer position a little off the floor (reconstruction error): the exact point
+        // on the floor replaces it, with the floor's normal.
+        let shading = Vec3::new(0.1, 1.0, 0.0).normalize();
+        let seen = s.locate(eye, Vec3::new(1.0, 1e-4, -2.0), shading);
+        assert!(seen.position.y.abs() < 1e-6, "{}", seen.position);
+        assert_eq!(seen.geometric_normal, Vec3::Y);
+        assert_eq!(seen.normal, shading);
+        // A position the ray does not reach (a silhouette): the G-buffer's own point.
+        let beyond = Vec3::new(30.0, 1.0, 0.0);
+        let kept = s.locate(eye, beyond, Vec3::Y);
+        assert_eq!(kept.position, beyond);
+        assert!(kept.offset > 0.0);
+    }
+}
