@@ -90,11 +90,6 @@ impl Surfaces {
         }
     }
 
-    /// The input triangle `index`.
-    pub fn triangle(&self, index: usize) -> &[Vec3; 3] {
-        &self.triangles[index]
-    }
-
     /// The nearest surface from `origin` along unit `direction`.
     pub fn closest(&self, origin: Vec3, direction: Vec3) -> Option<SurfaceHit> {
         let query = Query::new(origin, direction, f32::INFINITY)?;
