@@ -98,8 +98,8 @@ pub struct CompareArgs {
     pub samples: u32,
     /// Judge N views spread evenly over the scene's camera and light paths (both ends
     /// included) instead of the scene's camera alone; results get per-view rows and the worst
-    /// and mean over views.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    /// and mean over views (every view's frames stay in memory until the report: at most 64).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub views: u32,
 }
 

@@ -52,6 +52,12 @@ pub fn view_times(scene: &Scene, views: u32) -> anyhow::Result<Vec<Option<f32>>>
         );
     }
     let (start, end) = paths::duration(&scene.paths);
+    if end <= start {
+        log::warn!(
+            "{}: the paths' keys all have time {start}: every view is the same",
+            scene.path.display()
+        );
+    }
     Ok((0..views)
         .map(|k| Some(start + (end - start) * k as f32 / (views - 1) as f32))
         .collect())
@@ -257,8 +263,8 @@ fn view_label(view: &JudgedView, views: usize) -> String {
     }
 }
 
-/// An output file name: `<stem>.<ext>` for a single view, `<technique>-view<N>-<rest>` with
-/// several (the view goes after the technique id).
+/// An output file name: `<technique>-<rest>` for a single view, `<technique>-view<N>-<rest>`
+/// with several.
 fn output_name(technique: &str, view: usize, several: bool, rest: &str) -> String {
     if several {
         format!("{technique}-view{view}-{rest}")
@@ -384,16 +390,22 @@ struct LightSeries<'a> {
 
 impl LightSeries<'_> {
     /// The worst (largest) and the mean metrics over the views, and the frame time of each.
+    /// Only the views where the light was scored and reached some pixel count (a spot light
+    /// off-screen in one view does not pull the mean down); the mean weighs every such view
+    /// alike, and `pixels` is their total.
     fn worst_and_mean(&self) -> [(Option<Metrics>, f64); 2] {
+        let scored: Vec<&Metrics> = self
+            .scores
+            .iter()
+            .filter_map(|(s, _)| s.metrics.as_ref())
+            .filter(|m| m.pixels > 0)
+            .collect();
         let n = self.scores.len() as f64;
         let ms = self.scores.iter().map(|(_, ms)| *ms);
         [
+            (aggregate(&scored, f64::max), ms.clone().fold(0.0, f64::max)),
             (
-                aggregate(&self.scores, f64::max),
-                ms.clone().fold(0.0, f64::max),
-            ),
-            (
-                aggregate(&self.scores, |a, b| a + b).map(|m| scale(m, 1.0 / n)),
+                aggregate(&scored, |a, b| a + b).map(|m| scale(m, 1.0 / scored.len() as f64)),
                 ms.sum::<f64>() / n,
             ),
         ]
@@ -425,11 +437,7 @@ fn per_technique_and_light(views: &[JudgedView]) -> Vec<LightSeries<'_>> {
 
 /// Folds the metrics of every view with `combine` (pixels are summed), or `None` when the light
 /// was not scored.
-fn aggregate(scores: &[(LightScore, f64)], combine: impl Fn(f64, f64) -> f64) -> Option<Metrics> {
-    let metrics: Vec<&Metrics> = scores
-        .iter()
-        .filter_map(|(s, _)| s.metrics.as_ref())
-        .collect();
+fn aggregate(metrics: &[&Metrics], combine: impl Fn(f64, f64) -> f64) -> Option<Metrics> {
     let (first, rest) = metrics.split_first()?;
     Some(rest.iter().fold(**first, |a, m| Metrics {
         pixels: a.pixels + m.pixels,
@@ -455,6 +463,18 @@ fn scale(m: Metrics, factor: f64) -> Metrics {
     }
 }
 
+/// The worst and the mean (mean FLIP, p95 FLIP) over the views.
+fn worst_and_mean_flip(scores: &[(f64, f64)]) -> [(f64, f64); 2] {
+    let n = scores.len().max(1) as f64;
+    let worst = scores
+        .iter()
+        .fold((0.0f64, 0.0f64), |(a, b), (m, p)| (a.max(*m), b.max(*p)));
+    let mean = scores
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (m, p)| (a + m / n, b + p / n));
+    [worst, mean]
+}
+
 /// `images.csv`: the FLIP score of every technique's final image per view; with several
 /// views, then its worst and mean.
 pub fn images_csv(scene: &str, views: &[JudgedView]) -> String {
@@ -477,13 +497,7 @@ pub fn images_csv(scene: &str, views: &[JudgedView]) -> String {
     }
     if views.len() > 1 {
         for (technique, scores) in per_technique {
-            let n = scores.len() as f64;
-            let worst = scores
-                .iter()
-                .fold((0.0f64, 0.0f64), |(a, b), (m, p)| (a.max(*m), b.max(*p)));
-            let mean = scores
-                .iter()
-                .fold((0.0, 0.0), |(a, b), (m, p)| (a + m / n, b + p / n));
+            let [worst, mean] = worst_and_mean_flip(&scores);
             writeln!(
                 out,
                 "{scene},{technique},worst,{:.6},{:.6}",
@@ -741,11 +755,11 @@ fn report_md(r: &ReportInputs<'_>) -> String {
     }
     let _ = writeln!(
         w,
-        "\n## Final images\n\nꟻLIP of each technique's final image against the reference image (the reference's area visibility shaded by the same lighting on the CPU, with the one-bounce indirect reference for techniques that add light), at 67 pixels per degree: 0 is identical, 1 the largest difference. Maps `<technique>-flip.png` (magma: black none, yellow large); values in `images.csv`.\n"
+        "\n## Final images\n\nꟻLIP of each technique's final image against the reference image (the reference's area visibility shaded by the same lighting on the CPU, with the one-bounce indirect reference for techniques that add light), at 67 pixels per degree: 0 is identical, 1 the largest difference. Maps `<technique>-flip.png` (`<technique>-view<K>-flip.png` with several views; magma: black none, yellow large); values in `images.csv`.\n"
     );
     let _ = writeln!(w, "| technique | view | flip_mean | flip_p95 |");
     let _ = writeln!(w, "|---|---|---|---|");
-    let mut per_technique: Vec<(&str, Vec<f64>)> = Vec::new();
+    let mut per_technique: Vec<(&str, Vec<(f64, f64)>)> = Vec::new();
     for v in r.views {
         for (j, flip) in v.judged.iter().zip(&v.flip) {
             if let Some(flip) = flip {
@@ -755,18 +769,21 @@ fn report_md(r: &ReportInputs<'_>) -> String {
                     j.technique, v.view, flip.mean, flip.p95
                 );
                 match per_technique.iter_mut().find(|(t, _)| *t == j.technique) {
-                    Some((_, means)) => means.push(flip.mean),
-                    None => per_technique.push((&j.technique, vec![flip.mean])),
+                    Some((_, scores)) => scores.push((flip.mean, flip.p95)),
+                    None => per_technique.push((&j.technique, vec![(flip.mean, flip.p95)])),
                 }
             }
         }
     }
     if r.views.len() > 1 {
-        for (technique, means) in per_technique {
-            let worst = means.iter().copied().fold(0.0, f64::max);
-            let mean = means.iter().sum::<f64>() / means.len() as f64;
-            let _ = writeln!(w, "| {technique} | worst | {worst:.4} | |");
-            let _ = writeln!(w, "| {technique} | mean | {mean:.4} | |");
+        for (technique, scores) in per_technique {
+            let [worst, mean] = worst_and_mean_flip(&scores);
+            let _ = writeln!(
+                w,
+                "| {technique} | worst | {:.4} | {:.4} |",
+                worst.0, worst.1
+            );
+            let _ = writeln!(w, "| {technique} | mean | {:.4} | {:.4} |", mean.0, mean.1);
         }
     }
     if r.views.iter().any(|v| !v.indirect.is_empty()) {

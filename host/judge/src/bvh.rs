@@ -5,8 +5,10 @@
 //! wide BVH skips nodes that end closer than a fixed 1e-4 to the ray origin, which is a
 //! distance in world units, so a scene's scale would decide which nearby occluders count. The
 //! slab test here is conservative in floating point (Ize, "Robust BVH Ray Traversal", 2013:
-//! the far distance is scaled by 1 + 2γ₃) and leaf boxes are grown by the triangle test's own
-//! rounding, so a node is never skipped that holds a triangle the triangle test accepts.
+//! the far distance is scaled by 1 + 2γ₃) and leaf boxes are grown by the triangle test's
+//! rounding at the scene's coordinates, so traversal finds what brute force over every
+//! triangle finds (tested for rays from inside the scene; a hit the triangle test accepts
+//! only by rounding, outside the exact triangle, may still be missed from far outside it).
 
 use std::cell::RefCell;
 use std::time::Duration;
@@ -28,7 +30,9 @@ pub(crate) struct Query {
 }
 
 impl Query {
-    /// The segment from `origin` along unit `direction` up to `tmax` (`None` when not finite).
+    /// The segment from `origin` along unit `direction` up to `tmax` (infinite for rays to
+    /// directional lights); `None` when the origin or direction is not finite or `tmax` is NaN
+    /// (callers treat such a query as unoccluded).
     pub(crate) fn new(origin: Vec3, direction: Vec3, tmax: f32) -> Option<Query> {
         if !direction.is_finite() || !origin.is_finite() || tmax.is_nan() {
             return None;
@@ -92,8 +96,8 @@ impl TriangleBvh {
         }
         // The triangle test rounds at the magnitude of the coordinates, so it accepts hits up
         // to a few ulps outside a triangle (at a vertex or an edge lying in a box face); boxes
-        // grow by a bound on that so that traversal finds every hit brute force would. This
-        // costs only traversal time: which hits count is the triangle test's alone.
+        // grow by that much so that traversal finds the hits brute force would. This costs
+        // only traversal time: which hits count is the triangle test's alone.
         let magnitude = kept
             .iter()
             .flat_map(|t| [t.v0, t.v1, t.v2])
@@ -192,10 +196,8 @@ impl TriangleBvh {
     /// Whether `query` hits any triangle.
     pub(crate) fn any_hit(&self, query: &Query) -> bool {
         let mut hit = false;
-        self.traverse(query, |range, ray| {
-            hit = range
-                .into_iter()
-                .any(|i| self.triangles[i].intersect(ray) < f32::INFINITY);
+        self.traverse(query, |mut range, ray| {
+            hit = range.any(|i| self.triangles[i].intersect(ray) < f32::INFINITY);
             if hit { Visit::Stop } else { Visit::Continue }
         });
         hit
@@ -211,6 +213,17 @@ impl TriangleBvh {
             }
             Visit::Continue
         });
+    }
+
+    /// The nearest hit by brute force over every triangle (for tests of the traversal).
+    #[cfg(test)]
+    pub(crate) fn closest_brute_force(&self, query: &Query) -> Option<(usize, f32)> {
+        self.triangles
+            .iter()
+            .zip(&self.sources)
+            .map(|(t, s)| (*s, t.intersect(&query.ray)))
+            .filter(|(_, t)| *t < f32::INFINITY)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
     /// Whether brute force over every triangle finds a hit (for tests of the traversal).
@@ -245,8 +258,9 @@ fn is_degenerate(t: &Triangle) -> bool {
     twice_area.partial_cmp(&(1e-6 * longest)) != Some(std::cmp::Ordering::Greater)
 }
 
-/// The reciprocal of a direction component for slab tests: exact except that it stays finite
-/// (a 0 gives a huge positive value, so no 0 x inf = NaN). obvhs's own `Ray::new` clamps every
+/// The reciprocal of a direction component for slab tests: correctly rounded, except that it
+/// stays finite (a 0 gives a huge positive value, so no 0 x inf = NaN; components below 1e-30,
+/// which no unit direction of a scene has, are clamped too). obvhs's own `Ray::new` clamps every
 /// |x| <= f32::EPSILON to 1 / f32::EPSILON, which makes slabs of near-axis rays (components
 /// of 1e-7) end too early.
 fn reciprocal(x: f32) -> f32 {

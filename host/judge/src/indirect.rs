@@ -14,6 +14,7 @@ use zoo_scene::shading::falloff;
 use zoo_scene::{Light, Scene};
 
 use crate::occluders::Occluders;
+use crate::robust::to_light;
 use crate::sampling::stratified_disk;
 use crate::surfaces::{SurfacePoint, Surfaces};
 
@@ -86,7 +87,7 @@ pub fn reflected_direct(
         }
         let distance = match light.kind {
             zoo_scene::LightKind::Directional => f32::INFINITY,
-            _ => origin.distance(light.position) * (1.0 - 1e-4),
+            _ => to_light(origin.distance(light.position)),
         };
         let arrives = occluders.transmittance(origin, l, distance);
         sum += light.radiance * f * n_dot_l * arrives;

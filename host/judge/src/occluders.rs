@@ -273,9 +273,10 @@ mod tests {
     }
 
     #[test]
-    fn bvh_agrees_with_brute_force_for_axis_and_near_axis_rays() {
+    fn bvh_agrees_with_brute_force_for_axis_and_near_axis_rays_and_nearest_hits() {
         let mut rng = Rng(0x5eed_1234);
         let mut disagreements = Vec::new();
+        let mut closest_disagreements = Vec::new();
         let mut hits = 0;
         let mut rays = 0;
         for scene in 0..10 {
@@ -292,6 +293,17 @@ mod tests {
                 let bvh = occluders.occluded(origin, direction, tmax);
                 let query = Query::new(origin, direction, tmax).unwrap();
                 let brute = occluders.opaque.any_hit_brute_force(&query);
+                // The nearest hit too: the same triangle (or one at the same distance).
+                let nearest = occluders.opaque.closest(&query);
+                let nearest_brute = occluders.opaque.closest_brute_force(&query);
+                let same_nearest = match (nearest, nearest_brute) {
+                    (Some((a, ta)), Some((b, tb))) => a == b || ta == tb,
+                    (None, None) => true,
+                    _ => false,
+                };
+                if !same_nearest && closest_disagreements.len() < 10 {
+                    closest_disagreements.push((scene, origin, direction, nearest, nearest_brute));
+                }
                 rays += 1;
                 hits += usize::from(brute);
                 if bvh != brute && disagreements.len() < 10 {
@@ -307,6 +319,10 @@ mod tests {
         assert!(
             disagreements.is_empty(),
             "BVH and brute force disagree (scene, origin, direction, tmax, brute force):\n{disagreements:#?}"
+        );
+        assert!(
+            closest_disagreements.is_empty(),
+            "nearest hits disagree (scene, origin, direction, BVH, brute force):\n{closest_disagreements:#?}"
         );
     }
 

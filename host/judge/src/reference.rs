@@ -6,6 +6,7 @@ use zoo_scene::shading::contributes;
 use zoo_scene::{Light, LightKind};
 
 use crate::occluders::Occluders;
+use crate::robust::to_light;
 use crate::sampling::stratified_disk;
 use crate::surfaces::SurfacePoint;
 
@@ -77,7 +78,7 @@ fn transmitted_to(occluders: &Occluders, origin: Vec3, target: Vec3) -> Vec3 {
     if distance <= 0.0 {
         return Vec3::ONE;
     }
-    transmitted(occluders, origin, to / distance, distance * (1.0 - 1e-4))
+    transmitted(occluders, origin, to / distance, to_light(distance))
 }
 
 /// Cosine-weighted mean of the samples' transmitted light: each sample direction counts with

@@ -30,6 +30,12 @@ pub(crate) fn offset_along(p: Vec3, n: Vec3, distance: f32) -> Vec3 {
     out
 }
 
+/// The length of a shadow ray to a light `distance` away: all of it but the rounding of the
+/// distance itself (lights have no geometry, so nothing at the light is missed).
+pub(crate) fn to_light(distance: f32) -> f32 {
+    distance * (1.0 - gamma(4))
+}
+
 /// The distance a ray origin must keep from the plane of triangle `corners` so that the
 /// ray-triangle test (Möller-Trumbore, as obvhs computes it) finds the origin on the correct
 /// side of the triangle's plane: the test's sign is n · (v0 − o) with n = (v0 − v1) × (v2 − v0),

@@ -30,8 +30,8 @@ pub struct SurfacePoint {
 
 impl SurfacePoint {
     /// A point exactly on a flat surface with unit `normal` (geometric and shading), lying on
-    /// a triangle whose coordinates are at most `magnitude` and whose size is at most
-    /// `magnitude` too (as for analytic test surfaces).
+    /// a well-shaped triangle (angles far from 0) whose coordinates and size are at most
+    /// `magnitude`: for analytic surfaces, such as test planes, that no G-buffer sees.
     pub fn on_plane(position: Vec3, normal: Vec3, magnitude: f32) -> SurfacePoint {
         let magnitude = magnitude.max(position.abs().max_element());
         SurfacePoint {
@@ -144,10 +144,12 @@ impl Surfaces {
     }
 }
 
-/// A bound on how far a G-buffer position lies off its surface: the position is rebuilt as
+/// How far a G-buffer position may lie off its surface: the position is rebuilt as
 /// eye + depth × ray from the rasterised view depth, each step rounding at the magnitude of
 /// the eye, the position and the view distance (about 16 roundings in all, with the
-/// rasteriser's interpolation of the depth).
+/// rasteriser's interpolation of the depth). A margin rather than a strict bound: GPU
+/// interpolation is not correctly rounded. Used only where the pixel's ray misses the
+/// G-buffer's surface (silhouettes).
 fn reconstruction_error(eye: Vec3, position: Vec3, depth: f32) -> f32 {
     gamma(16) * (eye.abs().max_element() + position.abs().max_element() + depth)
 }

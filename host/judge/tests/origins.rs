@@ -127,7 +127,7 @@ fn a_surface_never_shadows_itself_toward_the_front_and_always_toward_the_back() 
 }
 
 #[test]
-fn an_occluder_a_millionth_of_the_coordinates_away_is_found_at_every_scale() {
+fn an_occluder_a_hundred_thousandth_of_the_coordinates_away_is_found_at_every_scale() {
     for scale in SCALES {
         // A floor far from the origin and a plate just above it: the gap is 1e-5 of the
         // coordinates' magnitude, far above their rounding (6e-8) and far below any fixed

@@ -396,7 +396,10 @@ impl Scene {
     /// transforms, light positions, ranges and radii (angular radii stay), receiver planes,
     /// the camera with its near and far planes, and the paths' positions. Visibility is the
     /// same at every scale, so the judge and every technique should score it the same.
+    /// `factor` must be positive and finite (a negative one would mirror the geometry without
+    /// turning its normals).
     pub fn scaled(&self, factor: f32) -> Scene {
+        debug_assert!(factor.is_finite() && factor > 0.0, "scale factor {factor}");
         let mut out = self.clone();
         let scale = Mat4::from_scale(Vec3::splat(factor));
         for p in &mut out.mesh.positions {
