@@ -48,15 +48,7 @@ const CLASS_EDGE: vec4<f32> = vec4<f32>(1.0, 0.2, 0.2, 1.0);
 
 // World size of one map texel at p.
 fn texel_world(light: Light, p: vec3<f32>) -> f32 {
-    if edge.perspective == 0u {
-        return edge.texel_scale;
-    }
-    let d = p - light.position;
-    if edge.layer_count == 6u {
-        let a = abs(d);
-        return edge.texel_scale * max(a.x, max(a.y, a.z));
-    }
-    return edge.texel_scale * dot(d, light.direction);
+    return map_texel_world(edge.perspective == 1u, edge.layer_count, edge.texel_scale, light.position, light.direction, p);
 }
 
 // Number of lit taps in the (2r + 1)² neighbourhood of p.

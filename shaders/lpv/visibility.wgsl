@@ -36,15 +36,7 @@ fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
 }
 
 fn texel_world(p: vec3<f32>, light: Light) -> f32 {
-    if shadow.perspective == 0u {
-        return shadow.texel_scale;
-    }
-    let d = p - light.position;
-    if shadow.layer_count == 6u {
-        let a = abs(d);
-        return shadow.texel_scale * max(a.x, max(a.y, a.z));
-    }
-    return shadow.texel_scale * length(d);
+    return map_texel_world(shadow.perspective == 1u, shadow.layer_count, shadow.texel_scale, light.position, light.direction, p);
 }
 
 @fragment

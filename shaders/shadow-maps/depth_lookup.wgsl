@@ -5,12 +5,6 @@
 
 #import "shadow-maps/layers.wgsl"
 
-// One layer's camera in a 256-byte slot of the depth pass's uniform buffer.
-struct CameraSlot {
-    camera: LayerCamera,
-    _pad: array<vec4<f32>, 7>,
-}
-
 @group(3) @binding(0) var depth_maps: texture_depth_2d_array;
 @group(3) @binding(1) var depth_compare_linear: sampler_comparison;
 @group(3) @binding(2) var depth_compare_nearest: sampler_comparison;

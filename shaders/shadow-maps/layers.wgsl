@@ -44,6 +44,29 @@ fn light_layer(first_layer: u32, layer_count: u32, light_position: vec3<f32>, p:
     return first_layer;
 }
 
+// One layer's camera in a 256-byte slot of the depth pass's uniform buffer, as lookups read
+// the cameras (`CAMERA_STRIDE` in the library).
+struct CameraSlot {
+    camera: LayerCamera,
+    _pad: array<vec4<f32>, 7>,
+}
+
+// World size of one map texel at p, across the light's rays: `texel_scale` itself for
+// orthographic layers; for perspective layers `texel_scale` times p's distance along the
+// layer's axis (the spot axis `axis`, or on cube faces the face axis: the largest component).
+// The distance along the axis, not along the ray, is the texel's largest footprint there.
+fn map_texel_world(perspective: bool, layer_count: u32, texel_scale: f32, light_position: vec3<f32>, axis: vec3<f32>, p: vec3<f32>) -> f32 {
+    if !perspective {
+        return texel_scale;
+    }
+    let d = p - light_position;
+    if layer_count == 6u {
+        let a = abs(d);
+        return texel_scale * max(a.x, max(a.y, a.z));
+    }
+    return texel_scale * dot(d, axis);
+}
+
 // Two unit vectors perpendicular to the ray direction `w` and to each other.
 fn tangent_frame(w: vec3<f32>) -> mat2x3<f32> {
     let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(w.x) > 0.9);

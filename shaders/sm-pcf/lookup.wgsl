@@ -4,9 +4,8 @@
 // cube face it falls in), so filtering is seamless across cube faces. The maps are read
 // through the library's depth lookup group (`shadow-maps/depth_lookup.wgsl`).
 
-#import "common/frame.wgsl"
-#import "common/gbuffer.wgsl"
 #import "common/fullscreen.wgsl"
+#import "shadow-maps/receiver.wgsl"
 #import "shadow-maps/filters.wgsl"
 #import "shadow-maps/depth_lookup.wgsl"
 
@@ -22,65 +21,43 @@ const FILTER_POISSON: u32 = 6u;
 const FILTER_PCSS: u32 = 7u;
 
 struct ShadowLight {
-    first_layer: u32,
-    // 1 (spot, directional) or 6 (point: cube faces).
-    layer_count: u32,
+    map: MapHeader,
     filter_mode: u32,
-    // Index of the scene light.
-    light: u32,
-    // World size of a texel: per unit of distance along the face axis (perspective) or
-    // absolute (orthographic).
-    texel_scale: f32,
-    perspective: u32,
-    near: f32,
-    far: f32,
-    normal_offset: f32,
     kernel_texels: f32,
     // Light radius (point, spot) or tangent of the angular radius (directional).
     light_size: f32,
     search_texels: f32,
-    position: vec3<f32>,
     // 1 when this light's diagnostics are written.
     debug: u32,
-    direction: vec3<f32>,
-    _pad: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 }
 
 // The light being looked up; the maps come from `shadow-maps/depth_lookup.wgsl` (group 3).
 @group(2) @binding(0) var<uniform> shadow_light: ShadowLight;
 
 fn project(sl: ShadowLight, p: vec3<f32>) -> MapPoint {
-    return map_point(light_layer(sl.first_layer, sl.layer_count, sl.position, p), p);
+    return map_point(header_layer(sl.map, p), p);
 }
 
 // Distance along the map's axis for a [0, 1] depth value.
 fn linear_depth(sl: ShadowLight, d: f32) -> f32 {
-    if sl.perspective == 1u {
-        return sl.near * sl.far / (sl.far - d * (sl.far - sl.near));
+    let near = sl.map.near;
+    let far = sl.map.far;
+    if sl.map.perspective == 1u {
+        return near * far / (far - d * (far - near));
     }
-    return sl.near + d * (sl.far - sl.near);
+    return near + d * (far - near);
 }
-
 
 // Unit direction light rays travel at p.
 fn ray_direction(sl: ShadowLight, p: vec3<f32>) -> vec3<f32> {
-    if sl.perspective == 1u {
-        return normalize(p - sl.position);
+    let light = lights[sl.map.light];
+    if sl.map.perspective == 1u {
+        return normalize(p - light.position);
     }
-    return sl.direction;
-}
-
-// World size of one shadow-map texel at p.
-fn texel_world(sl: ShadowLight, p: vec3<f32>) -> f32 {
-    if sl.perspective == 0u {
-        return sl.texel_scale;
-    }
-    let d = p - sl.position;
-    if sl.layer_count == 6u {
-        let a = abs(d);
-        return sl.texel_scale * max(a.x, max(a.y, a.z));
-    }
-    return sl.texel_scale * dot(d, sl.direction);
+    return light.direction;
 }
 
 // The light being looked up (set first thing in `fs_lookup`), for the filters' map access.
@@ -108,30 +85,14 @@ struct Outputs {
 
 @fragment
 fn fs_lookup(in: FullscreenOut) -> Outputs {
-    var out: Outputs;
-    out.visibility = vec4<f32>(1.0);
-    out.diagnostics = vec4<f32>(0.0);
-    let s = load_surface(vec2<i32>(in.position.xy));
-    if !s.valid {
-        return out;
-    }
     let sl = shadow_light;
     looked_up = sl;
-    // Write only where the light reaches, so lights with disjoint influence can share a slot.
-    let light = lights[sl.light];
-    if light.kind != LIGHT_DIRECTIONAL {
-        let to_surface = s.position - light.position;
-        let distance = length(to_surface);
-        if distance >= light.range
-            || (light.kind == LIGHT_SPOT && dot(to_surface, light.direction) <= light.cos_outer * distance) {
-            discard;
-        }
-    }
-    let texel = texel_world(sl, s.position);
-    // Normal offset: move the lookup point off the surface by a number of texels.
-    let p = s.position + s.normal * (sl.normal_offset * texel);
+    let receiver = map_receiver(sl.map, in.position.xy);
+    let texel = receiver.texel;
+    let p = receiver.lookup;
     let frame = tangent_frame(ray_direction(sl, p));
     let r = rotation(in.position.xy);
+    var out: Outputs;
     var visibility = 1.0;
     switch sl.filter_mode {
         case FILTER_NONE: { visibility = shadow_tap(p, false); }
@@ -142,13 +103,15 @@ fn fs_lookup(in: FullscreenOut) -> Outputs {
         case FILTER_PCF9X9: { visibility = grid_pcf(p, frame, texel, 9); }
         case FILTER_POISSON: { visibility = poisson_pcf(p, frame, sl.kernel_texels * texel, r); }
         default: {
-            let light = PcssLight(sl.light_size, sl.near, sl.perspective == 1u, sl.search_texels);
+            let light = PcssLight(sl.light_size, sl.map.near, sl.map.perspective == 1u, sl.search_texels);
             visibility = pcss(p, frame, texel, r, light);
         }
     }
     out.visibility = vec4<f32>(visibility);
+    out.diagnostics = vec4<f32>(0.0);
+    let position = receiver.surface.position;
     if sl.debug == 1u {
-        let m = project(sl, s.position);
+        let m = project(sl, position);
         if m.inside {
             let difference = linear_depth(sl, m.depth) - linear_depth(sl, stored_map_depth(m));
             out.diagnostics = vec4<f32>(1.0, difference / texel, 0.0, 1.0);

@@ -30,6 +30,7 @@ const ESTIMATE_MINFILTER: u32 = 1u;
 // The light being looked up, for the filters' map access.
 var<private> current: SsssLight;
 var<private> current_position: vec3<f32>;
+var<private> current_axis: vec3<f32>;
 
 fn project(p: vec3<f32>) -> MapPoint {
     let layer = light_layer(current.first_layer, current.layer_count, current_position, p);
@@ -87,15 +88,7 @@ fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
 
 // World size of one map texel at p.
 fn texel_world(p: vec3<f32>) -> f32 {
-    if current.perspective == 0u {
-        return current.texel_scale;
-    }
-    let d = p - current_position;
-    if current.layer_count == 6u {
-        let a = abs(d);
-        return current.texel_scale * max(a.x, max(a.y, a.z));
-    }
-    return current.texel_scale * length(d);
+    return map_texel_world(current.perspective == 1u, current.layer_count, current.texel_scale, current_position, current_axis, p);
 }
 
 // The blocker-search radius in world units for a receiver at `receiver` along the map axis:
@@ -228,6 +221,7 @@ fn cs_penumbra(
             }
             current = sl;
             current_position = light.position;
+            current_axis = light.direction;
             let layer = sl.layer;
             let w = word_of(layer);
             // Surfaces facing away are in the light's self-shadow.

@@ -404,6 +404,10 @@ macro_rules! technique_params {
 
         impl $crate::params::TechniqueParams for $name {
             fn schema() -> Vec<$crate::params::ParamSpec> {
+                // Built once: the viewer asks every frame, and the doc texts are leaked.
+                static SCHEMA: ::std::sync::OnceLock<Vec<$crate::params::ParamSpec>> =
+                    ::std::sync::OnceLock::new();
+                SCHEMA.get_or_init(|| {
                 let defaults = Self::default();
                 vec![$(
                     $crate::params::ParamSpec {
@@ -416,6 +420,7 @@ macro_rules! technique_params {
                         default: $crate::params::ParamType::to_value(&defaults.$field),
                     },
                 )*]
+                }).clone()
             }
 
             fn to_values(&self) -> $crate::params::ParamValues {
@@ -452,7 +457,8 @@ macro_rules! technique_params {
 /// Joins doc-comment lines into one trimmed string (used by [`technique_params!`]).
 pub fn join_doc(lines: &[&'static str]) -> &'static str {
     let text = lines.iter().map(|l| l.trim()).collect::<Vec<_>>().join(" ");
-    // Schemas are built a handful of times per run; leaking keeps `ParamSpec` `'static`.
+    // Each struct's schema is built once per run (`technique_params!` keeps it); leaking keeps
+    // `ParamSpec` `'static`.
     Box::leak(text.into_boxed_str())
 }
 
@@ -498,6 +504,15 @@ mod tests {
         assert_eq!(schema[3].default, ParamValue::Choice("Exact".into()));
         assert_eq!((Mode::Fast.index(), Mode::Exact.index()), (0, 1));
         assert_eq!(Mode::NAMES[Mode::Exact.index()], Mode::Exact.name());
+    }
+
+    #[test]
+    fn schema_is_built_once() {
+        // A schema built per call leaks its doc texts: the viewer asks every frame.
+        let (first, second) = (TestParams::schema(), TestParams::schema());
+        for (a, b) in first.iter().zip(&second) {
+            assert!(std::ptr::eq(a.doc, b.doc), "`{}` doc built twice", a.key);
+        }
     }
 
     #[test]

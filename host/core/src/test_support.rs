@@ -160,6 +160,24 @@ impl JudgeRun {
         })
     }
 
+    /// Mean visibility the technique gives `light` where the area reference sees none of the
+    /// light (full umbra, contributing pixels): light leaking into shadow, the flaw of
+    /// filtered moment maps. Panics when the view holds fewer than 500 umbra pixels.
+    pub fn umbra_leak(&self, light: usize) -> f64 {
+        let reference = &self.reference.lights[light];
+        let visibility = &self.judged.visibility[light];
+        let umbra: Vec<usize> = (0..visibility.len())
+            .filter(|&i| reference.contributing[i] && reference.area[i] == 0.0)
+            .collect();
+        assert!(
+            umbra.len() > 500,
+            "{}: only {} umbra pixels of light {light} in view",
+            self.scene,
+            umbra.len()
+        );
+        umbra.iter().map(|&i| visibility[i] as f64).sum::<f64>() / umbra.len() as f64
+    }
+
     /// Metrics of `light` counted only where `mask` is true.
     pub fn metrics_masked(&self, light: usize, mask: &[bool]) -> zoo_judge::Metrics {
         let (width, height) = self.reference.size();

@@ -48,7 +48,11 @@ impl LayerCamera {
 /// `shader`, which imports `shadow-maps/depth.wgsl` and takes its `DepthVertex`.
 #[derive(Debug, Clone, Copy)]
 pub struct ColorOutput<'a> {
+    /// The library shader, or the label of `source`.
     pub shader: &'a str,
+    /// WGSL to compose instead of the file `shader` (with `#import`s of the library: a moment
+    /// method and the pass that calls it, for example).
+    pub source: Option<&'a str>,
     pub entry: &'a str,
     pub format: wgpu::TextureFormat,
     /// What texels no caster covers hold.
@@ -98,8 +102,23 @@ impl DepthPass {
         color: Option<ColorOutput<'_>>,
     ) -> Result<DepthPass, TechniqueError> {
         let device = &ctx.gpu.device;
-        let shader = color.map_or("shadow-maps/depth.wgsl", |c| c.shader);
-        let module = ctx.shaders.create_module(device, shader)?;
+        let module = match color {
+            None => ctx
+                .shaders
+                .create_module(device, "shadow-maps/depth.wgsl")?,
+            Some(ColorOutput {
+                shader,
+                source: None,
+                ..
+            }) => ctx.shaders.create_module(device, shader)?,
+            Some(ColorOutput {
+                shader,
+                source: Some(text),
+                ..
+            }) => ctx
+                .shaders
+                .create_module_from_source(device, shader, text)?,
+        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some(&format!("{label} layer camera layout")),
             entries: &[wgpu::BindGroupLayoutEntry {

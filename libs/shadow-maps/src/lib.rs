@@ -5,15 +5,18 @@
 //! colour map such as moments ([`depth`]), and a separable blur of colour map layers
 //! ([`blur`]). [`ShadowMapSet`] keeps them up to date for a technique in one call per frame.
 //!
-//! Filters that read the maps live in WGSL: `shaders/shadow-maps/`.
+//! Lookups read a light's maps through its [`MapHeader`]; the header, receivers, texel sizes,
+//! the map groups and the filters live in WGSL: `shaders/shadow-maps/`.
 
 pub mod blur;
 pub mod cascades;
 pub mod culling;
 pub mod depth;
+pub mod header;
 pub mod light_space;
 pub mod lookup;
 pub mod maps;
+pub mod moments;
 pub mod planning;
 pub mod set;
 pub mod translucent;
@@ -22,12 +25,15 @@ pub mod warped;
 pub use blur::LayerBlur;
 pub use cascades::Cascades;
 pub use depth::{CAMERA_STRIDE, ColorOutput, DepthPass, DepthState, LayerCamera};
+pub use header::MapHeader;
 pub use maps::{
     CUBE_GUARD, MAP_FORMAT, MEMORY_BUDGET, MapArray, effective_resolution, filterable_rg_format,
+    filterable_rgba_format,
 };
+pub use moments::{MomentMaps, MomentMethod, MomentSettings};
 pub use planning::{
-    LayerPlan, LightMaps, MapScale, PlanInputs, StandardLayers, layers_needed, layers_needed_with,
-    light_scissor, light_size, object_bounds, plan, plan_with,
+    LayerPlan, LightMaps, MapScale, PlanInputs, StandardLayers, layers_needed_with, light_scissor,
+    light_size, object_bounds, plan_with,
 };
 pub use set::{ShadowMapSet, layer_pass_name};
 pub use translucent::{TRANSLUCENT_FORMAT, TranslucentPass};

@@ -47,6 +47,19 @@ pub fn filterable_rg_format(device: &wgpu::Device) -> wgpu::TextureFormat {
     }
 }
 
+/// The four-channel float format for filtered colour maps (higher moments): `Rgba32Float`
+/// where the device filters 32-bit floats, `Rgba16Float` elsewhere.
+pub fn filterable_rgba_format(device: &wgpu::Device) -> wgpu::TextureFormat {
+    if device
+        .features()
+        .contains(wgpu::Features::FLOAT32_FILTERABLE)
+    {
+        wgpu::TextureFormat::Rgba32Float
+    } else {
+        wgpu::TextureFormat::Rgba16Float
+    }
+}
+
 /// `layers` square maps of `resolution` texels in one array texture (depth or colour).
 pub struct MapArray {
     pub resolution: u32,

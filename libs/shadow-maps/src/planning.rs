@@ -107,18 +107,12 @@ impl LayerPlan for StandardLayers {
     }
 }
 
-/// Layers the lights need under the standard plan: six for a point light, one otherwise (at
-/// least one in all).
-pub fn layers_needed(lights: &[Light]) -> u32 {
-    layers_needed_with(lights, &StandardLayers)
-}
-
 /// Layers the lights need under `layout` (at least one in all).
 pub fn layers_needed_with(lights: &[Light], layout: &dyn LayerPlan) -> u32 {
     lights.iter().map(|l| layout.layers(l)).sum::<u32>().max(1)
 }
 
-/// What [`plan`] fits the maps to.
+/// What [`plan_with`] fits the maps to.
 pub struct PlanInputs<'a> {
     pub lights: &'a [Light],
     pub camera: &'a Camera,
@@ -132,12 +126,6 @@ pub struct PlanInputs<'a> {
     /// centre snapped to whole texels) so edges do not shimmer as the camera moves.
     pub resolution: u32,
     pub stable: bool,
-}
-
-/// Consecutive layers for every light with their frusta under the standard plan
-/// ([`StandardLayers`]).
-pub fn plan(inputs: &PlanInputs<'_>) -> Vec<LightMaps> {
-    plan_with(inputs, &StandardLayers)
 }
 
 /// Consecutive layers for every light with the frusta `layout` fits.

@@ -224,12 +224,6 @@ impl RsmTargets {
         &self.layer_views[0][k]
     }
 
-    /// Bytes of GPU memory.
-    pub fn bytes(&self) -> u64 {
-        let texels = u64::from(self.resolution).pow(2) * u64::from(self.layers);
-        texels * (8 + 8 + 8 + 4)
-    }
-
     /// The depth array (for the memory table).
     pub fn depth(&self) -> &wgpu::Texture {
         &self.depth
@@ -412,11 +406,6 @@ impl Volumes {
                 buffer("lpv emitter moments b", light),
             ],
         }
-    }
-
-    /// Bytes of GPU memory.
-    pub fn bytes(&self) -> u64 {
-        self.cells * (2 * 12 * 4 + 2 * 4 * 4 + 6 * 3 * 16)
     }
 }
 

@@ -15,7 +15,7 @@ use zoo_host::gpu::layout::ChoiceCodes;
 use zoo_host::kit::{SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
-use zoo_shadow_maps::{DepthState, LightMaps, ShadowMapSet, light_size};
+use zoo_shadow_maps::{DepthState, LightMaps, MapHeader, ShadowMapSet, light_size};
 
 zoo_host::param_choice! {
     /// How shadow-map comparisons are filtered.
@@ -54,22 +54,13 @@ zoo_host::technique_params! {
 #[bytemuck(crate = "zoo_host::bytemuck")]
 #[repr(C)]
 struct ShadowLight {
-    first_layer: u32,
-    layer_count: u32,
+    map: MapHeader,
     filter_mode: u32,
-    light: u32,
-    texel_scale: f32,
-    perspective: u32,
-    near: f32,
-    far: f32,
-    normal_offset: f32,
     kernel_texels: f32,
     light_size: f32,
     search_texels: f32,
-    position: [f32; 3],
     debug: u32,
-    direction: [f32; 3],
-    _pad: f32,
+    _pad: [f32; 3],
 }
 
 const SHADER: &str = "sm-pcf/lookup.wgsl";
@@ -143,24 +134,14 @@ fn shadow_light(
     light: &zoo_host::Light,
     resolution: u32,
 ) -> ShadowLight {
-    let scale = maps.scale(resolution);
     ShadowLight {
-        first_layer: maps.first_layer,
-        layer_count: maps.frustums.len() as u32,
+        map: MapHeader::new(maps, resolution, p.normal_offset),
         filter_mode: 0,
-        light: maps.light as u32,
-        texel_scale: scale.texel_scale,
-        perspective: u32::from(scale.perspective),
-        near: scale.near,
-        far: scale.far,
-        normal_offset: p.normal_offset,
         kernel_texels: p.kernel_radius,
         light_size: light_size(light),
         search_texels: p.pcss_max_texels,
-        position: light.position.to_array(),
         debug: u32::from(maps.light as u32 == p.debug_light),
-        direction: light.direction.to_array(),
-        _pad: 0.0,
+        _pad: [0.0; 3],
     }
 }
 
@@ -355,21 +336,12 @@ mod tests {
     #[test]
     fn shadow_light_mirrors_the_shader() {
         let (size, fields) = zoo_host::mirror_fields!(ShadowLight {
-            first_layer,
-            layer_count,
+            map,
             filter_mode,
-            light,
-            texel_scale,
-            perspective,
-            near,
-            far,
-            normal_offset,
             kernel_texels,
             light_size,
             search_texels,
-            position,
-            debug,
-            direction
+            debug
         });
         check_mirror(&shader(), "ShadowLight", size, &fields, SizeRule::Equal).unwrap();
     }

@@ -42,18 +42,6 @@ fn curved_within_bounds_with_2048_maps() {
     assert_core_bounds(&judge("curved.ron", "vsm", &[("map_size", "2048")], SIZE));
 }
 
-/// Mean visibility the technique gives light `light` where the area reference sees none of
-/// the light (full umbra, contributing pixels): light leaking into shadow.
-pub fn umbra_leak(run: &JudgeRun, light: usize) -> f64 {
-    let reference = &run.reference.lights[light];
-    let visibility = &run.judged.visibility[light];
-    let umbra: Vec<usize> = (0..visibility.len())
-        .filter(|&i| reference.contributing[i] && reference.area[i] == 0.0)
-        .collect();
-    assert!(umbra.len() > 500, "stacked has an umbra in view");
-    umbra.iter().map(|&i| visibility[i] as f64).sum::<f64>() / umbra.len() as f64
-}
-
 #[test]
 fn light_bleeds_under_stacked_casters_and_the_reduction_removes_it() {
     // A wide blur makes the flaw easy to see: under the board, the moments around the lower
@@ -67,9 +55,9 @@ fn light_bleeds_under_stacked_casters_and_the_reduction_removes_it() {
     let (off, default, strong) = (with("0"), with("0.2"), with("0.5"));
     for light in 0..off.loaded.lights.len() {
         let leaks = [
-            umbra_leak(&off, light),
-            umbra_leak(&default, light),
-            umbra_leak(&strong, light),
+            off.umbra_leak(light),
+            default.umbra_leak(light),
+            strong.umbra_leak(light),
         ];
         eprintln!(
             "stacked light {light}: umbra leak with reduction 0 / 0.2 / 0.5: {:.5} / {:.5} / {:.5}",

@@ -34,16 +34,39 @@ impl<T: Pod> FullscreenLightPass<T> {
         groups: &[&wgpu::BindGroupLayout],
     ) -> Result<FullscreenLightPass<T>, TechniqueError> {
         let module = ctx.shaders.create_module(&ctx.gpu.device, shader)?;
+        Ok(Self::with_module(ctx, shader, &module, entry, groups))
+    }
+
+    /// As [`Self::new`] with WGSL `text` (its `#import`s resolved from the library) instead of
+    /// a library file; `label` names the module, the pipeline and the uniforms.
+    pub fn from_source(
+        ctx: &RenderContext<'_>,
+        label: &str,
+        text: &str,
+        entry: &str,
+        groups: &[&wgpu::BindGroupLayout],
+    ) -> Result<FullscreenLightPass<T>, TechniqueError> {
+        let module = (ctx.shaders).create_module_from_source(&ctx.gpu.device, label, text)?;
+        Ok(Self::with_module(ctx, label, &module, entry, groups))
+    }
+
+    fn with_module(
+        ctx: &RenderContext<'_>,
+        label: &str,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        groups: &[&wgpu::BindGroupLayout],
+    ) -> FullscreenLightPass<T> {
         let stages = wgpu::ShaderStages::FRAGMENT;
-        let uniforms = UniformSlots::new(ctx.gpu, shader, ctx.lights.len(), stages);
+        let uniforms = UniformSlots::new(ctx.gpu, label, ctx.lights.len(), stages);
         let mut layouts = vec![uniforms.layout()];
         layouts.extend_from_slice(groups);
-        let pipeline = slot_fullscreen_pipeline(ctx, shader, &module, entry, &layouts);
-        Ok(FullscreenLightPass {
+        let pipeline = slot_fullscreen_pipeline(ctx, label, module, entry, &layouts);
+        FullscreenLightPass {
             pipeline,
             uniforms,
             lights: ctx.lights.len(),
-        })
+        }
     }
 
     /// The pass in `slot`, built there first if it is empty (a technique's `prepare` keeps

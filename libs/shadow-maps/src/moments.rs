@@ -1,0 +1,215 @@
+//! Moment shadow maps as one machine: each light's casters store moments of their light depth
+//! in a filterable colour map, blurred by a separable Gaussian, and a full-screen lookup per
+//! light turns the filtered moments into visibility. A method (VSM, ESM, EVSM, MSM) is one WGSL
+//! file with two functions, called by the library's passes:
+//!
+//! ```text
+//! fn moments(z: f32, spread: f32) -> vec4<f32>            // depth pass: what a texel stores
+//! fn moment_visibility(m: vec4<f32>, z: f32) -> f32       // lookup: filtered moments, receiver
+//! ```
+//!
+//! `z` is `light_depth` (0 at the light, 1 at the far plane) and `spread` the depth's variance
+//! over the texel. A method's moments of the far plane are 1 in every channel, so the maps
+//! clear to white. The lookup (`shadow-maps/moments_lookup.wgsl`) reads the method's settings
+//! from `MomentLight` and applies the light-bleeding reduction to every method alike.
+
+use zoo_host::kit::{FullscreenLightPass, light_pass_name};
+use zoo_host::prelude::*;
+use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+
+use crate::{ColorOutput, DepthState, LayerBlur, MapHeader, ShadowMapSet};
+
+const STORE_SHADER: &str = "shadow-maps/moments_store.wgsl";
+const LOOKUP_SHADER: &str = "shadow-maps/moments_lookup.wgsl";
+
+/// `MomentLight` in `shadow-maps/moments_lookup.wgsl`: one light's lookup.
+#[derive(Debug, Clone, Copy, zoo_host::bytemuck::Pod, zoo_host::bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+struct MomentLight {
+    map: MapHeader,
+    bias: f32,
+    bleeding_reduction: f32,
+    _pad: [f32; 2],
+}
+
+/// A moment method: its WGSL and the map format it stores.
+#[derive(Debug, Clone)]
+pub struct MomentMethod {
+    /// Label of maps, pipelines and passes ("VSM", "EVSM4").
+    pub label: &'static str,
+    /// The library shader with the method's `moments` and `moment_visibility`.
+    pub shader: &'static str,
+    /// WGSL composed before the method (constants generated from parameters, for example);
+    /// a change needs a new [`MomentMaps`].
+    pub prelude: String,
+    pub format: wgpu::TextureFormat,
+}
+
+/// What a frame's lookups read of the technique's parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MomentSettings {
+    pub map_size: u32,
+    pub stable_fit: bool,
+    /// Gaussian taps on each side (0: bilinear filtering only).
+    pub blur_radius: u32,
+    /// Lookups move off the surface by this many texels.
+    pub normal_offset: f32,
+    /// The method's bias (smallest variance, moment bias), in its own units.
+    pub bias: f32,
+    /// Visibility below this becomes 0 and the rest is rescaled (0: off).
+    pub bleeding_reduction: f32,
+}
+
+/// Maps, blur and lookup of a moment technique.
+pub struct MomentMaps {
+    label: &'static str,
+    maps: ShadowMapSet,
+    blur: LayerBlur,
+    lookup: FullscreenLightPass<MomentLight>,
+    blurred: bool,
+}
+
+impl MomentMaps {
+    /// Builds the passes of `method`.
+    pub fn new(ctx: &RenderContext<'_>, method: &MomentMethod) -> TechniqueResult<MomentMaps> {
+        let compose = |pass: &str| {
+            format!(
+                "{}\n#import \"{}\"\n#import \"{pass}\"\n",
+                method.prelude, method.shader
+            )
+        };
+        let store = compose(STORE_SHADER);
+        let store_label = format!("{} depth pass", method.label);
+        let output = ColorOutput {
+            shader: &store_label,
+            source: Some(&store),
+            entry: "fs_moments",
+            format: method.format,
+            clear: wgpu::Color::WHITE,
+        };
+        let label = format!("{} moments", method.label);
+        let maps = ShadowMapSet::new(ctx, &label, DepthState::default(), Some(output))?;
+        let lookup = FullscreenLightPass::from_source(
+            ctx,
+            &format!("{} lookup", method.label),
+            &compose(LOOKUP_SHADER),
+            "fs_moment_lookup",
+            &[maps.lookup_layout()],
+        )?;
+        Ok(MomentMaps {
+            label: method.label,
+            blur: LayerBlur::new(ctx, &format!("{} blur", method.label), method.format)?,
+            maps,
+            lookup,
+            blurred: false,
+        })
+    }
+
+    /// Fits and allocates the maps for this frame.
+    pub fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes, s: &MomentSettings) {
+        self.maps.prepare(ctx, changes, s.map_size, s.stable_fit);
+    }
+
+    /// Records the depth passes, the blur and the lookups.
+    pub fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        s: &MomentSettings,
+    ) -> TechniqueResult {
+        let (Some(maps), Some(group)) = (self.maps.maps(), self.maps.lookup_group()) else {
+            return Err(TechniqueError::not_prepared());
+        };
+        let label = self.label;
+        self.maps
+            .record(ctx, recorder, &format!("{label} moments"))?;
+        let lights = self.maps.lights();
+        let blur = format!("{label} blur");
+        (self.blur).record(ctx, recorder, maps, lights, s.blur_radius, &blur);
+        self.blurred = s.blur_radius > 0;
+        let uniform = |light: usize| MomentLight {
+            map: MapHeader::new(&lights[light], maps.resolution, s.normal_offset),
+            bias: s.bias,
+            bleeding_reduction: s.bleeding_reduction,
+            _pad: [0.0; 2],
+        };
+        let bind = |_, pass: &mut wgpu::RenderPass<'_>| pass.set_bind_group(3, group, &[]);
+        let lookup = format!("{label} lookup");
+        (self.lookup).record_with(ctx, recorder, &lookup, uniform, bind);
+        Ok(())
+    }
+
+    /// The passes of the last [`Self::record`].
+    pub fn passes(&self) -> Vec<PassInfo> {
+        let label = self.label;
+        let mut names = self.maps.pass_names(&format!("{label} moments"));
+        if self.blurred {
+            names.extend(LayerBlur::pass_names(
+                self.maps.lights(),
+                &format!("{label} blur"),
+            ));
+        }
+        let lookup = format!("{label} lookup");
+        let lookups = (self.maps.lights().iter()).map(|l| light_pass_name(&lookup, l.light));
+        names
+            .into_iter()
+            .chain(lookups)
+            .map(PassInfo::render)
+            .collect()
+    }
+
+    /// The moment maps and layer cameras.
+    pub fn resources(&self) -> Vec<ResourceInfo> {
+        let moments =
+            (self.maps.maps()).map(|m| ResourceInfo::texture("moments", &m.texture, true));
+        let cameras =
+            (self.maps.cameras()).map(|c| ResourceInfo::buffer("layer cameras", c, "LayerCamera"));
+        moments.into_iter().chain(cameras).collect()
+    }
+
+    /// The first channel of the first light's first layer, for resource `"moments"`.
+    pub fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let layer = self.maps.lights().first()?.first_layer as usize;
+        let view = &self.maps.maps()?.layer_views[layer];
+        let mapping = ViewMapping::Channel {
+            channel: 0,
+            min: 0.0,
+            max: 1.0,
+        };
+        (resource == "moments").then_some(DebugImage { view, mapping })
+    }
+
+    /// The map set's counters.
+    pub fn counters(&self) -> Vec<(String, f64)> {
+        self.maps.counters()
+    }
+
+    /// The format the maps store.
+    pub fn format(&self) -> Option<wgpu::TextureFormat> {
+        self.maps.maps().map(|m| m.texture.format())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    #[test]
+    fn moment_light_mirrors_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose_source(
+                "test.wgsl",
+                "#import \"vsm/vsm.wgsl\"\n#import \"shadow-maps/moments_lookup.wgsl\"\n",
+            )
+            .unwrap()
+            .source;
+        let (size, fields) = zoo_host::mirror_fields!(MomentLight {
+            map,
+            bias,
+            bleeding_reduction
+        });
+        check_mirror(&source, "MomentLight", size, &fields, SizeRule::Equal).unwrap();
+    }
+}

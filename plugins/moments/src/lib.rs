@@ -1,0 +1,297 @@
+//! The moment family of filterable shadow maps, beside VSM: exponential shadow maps (Annen et
+//! al. 2008), exponential variance shadow maps with two and four moments (Lauritzen and McCool
+//! 2008) and Hamburger moment shadow maps (Peters and Klein 2015). Each method is one WGSL file
+//! in `shaders/moments/` (what a texel stores, and the visibility the filtered moments give)
+//! and one [`Method`] below; maps, fitting, blur and lookup are the shadow-map library's
+//! moment maps. The exponents reach the WGSL as generated constants, so changing one rebuilds
+//! the passes.
+
+use zoo_host::params::{ParamSpec, TechniqueParams, find_spec};
+use zoo_host::prelude::*;
+use zoo_host::technique::{DebugImage, ResourceInfo};
+use zoo_shadow_maps::{
+    MomentMaps, MomentMethod, MomentSettings, filterable_rg_format, filterable_rgba_format,
+};
+
+zoo_host::technique_params! {
+    /// Parameters of the moment family (each method shows the ones it reads).
+    pub struct MomentParams {
+        /// Moment-map resolution in texels per side (clamped to the device and memory budget).
+        map_size: u32 = 2048, range(256, 8192), step(256);
+        /// Gaussian blur of the moments, in taps on each side (0: bilinear filtering only).
+        blur_radius: u32 = 2, range(0, 16), step(1);
+        /// Exponent of the positive warp exp(c (z - 1)) (32-bit maps; at most 5.5 with 16-bit
+        /// ones).
+        positive_exponent: f32 = 40.0, range(1.0, 42.0), step(1.0);
+        /// Exponent of the negative warp exp(c (1 - z)) (EVSM4).
+        negative_exponent: f32 = 5.0, range(1.0, 42.0), step(1.0);
+        /// Smallest variance in squared light-depth units, scaled by each warp's slope (EVSM).
+        min_variance: f32 = 0.00001, range(0.0, 0.001), step(0.00001);
+        /// Moment bias: the filtered moments move this far towards (0.5, 0.5, 0.5, 0.5)
+        /// (MSM; at least 6e-5 with 16-bit maps).
+        moment_bias: f32 = 0.00003, range(0.0, 0.01), step(0.00001);
+        /// Light-bleeding reduction: visibility below it becomes 0 and the rest is rescaled.
+        bleeding_reduction: f32 = 0.0, range(0.0, 0.95), step(0.05);
+        /// Lookups move off the surface by this many map texels along the normal.
+        normal_offset: f32 = 1.0, range(0.0, 8.0), step(0.1);
+        /// Keep directional maps stable as the camera moves (no shimmering edges).
+        stable_fit: bool = true;
+    }
+}
+
+/// Parameters every method reads.
+const COMMON: &[&str] = &[
+    "map_size",
+    "blur_radius",
+    "bleeding_reduction",
+    "normal_offset",
+    "stable_fit",
+];
+
+/// One method of the family.
+pub struct Method {
+    label: &'static str,
+    shader: &'static str,
+    /// Stores four moments (else two).
+    four: bool,
+    /// The method's own parameters, beside [`COMMON`].
+    reads: &'static [&'static str],
+    /// Its bias, in the units its WGSL reads.
+    bias: fn(&MomentParams, bool) -> f32,
+}
+
+const ESM: Method = Method {
+    label: "ESM",
+    shader: "moments/esm.wgsl",
+    four: false,
+    reads: &["positive_exponent"],
+    bias: |_, _| 0.0,
+};
+const EVSM2: Method = Method {
+    label: "EVSM2",
+    shader: "moments/evsm2.wgsl",
+    four: false,
+    reads: &["positive_exponent", "min_variance"],
+    bias: |p, _| p.min_variance,
+};
+const EVSM4: Method = Method {
+    label: "EVSM4",
+    shader: "moments/evsm4.wgsl",
+    four: true,
+    reads: &["positive_exponent", "negative_exponent", "min_variance"],
+    bias: |p, _| p.min_variance,
+};
+const MSM: Method = Method {
+    label: "MSM",
+    shader: "moments/msm.wgsl",
+    four: true,
+    reads: &["moment_bias"],
+    bias: |p, half| {
+        if half {
+            p.moment_bias.max(6e-5)
+        } else {
+            p.moment_bias
+        }
+    },
+};
+
+impl Method {
+    /// The parameters this method reads, in declaration order.
+    fn schema(&self) -> Vec<ParamSpec> {
+        let reads = |key: &str| COMMON.contains(&key) || self.reads.contains(&key);
+        (MomentParams::schema().into_iter())
+            .filter(|spec| reads(spec.key))
+            .collect()
+    }
+
+    /// Parameters from `values`, which may name only this method's keys.
+    fn params(&self, values: &ParamValues) -> TechniqueResult<MomentParams> {
+        let schema = self.schema();
+        for (key, value) in values {
+            find_spec(&schema, key)?.check(value)?;
+        }
+        Ok(MomentParams::from_values(values)?)
+    }
+
+    /// The method's WGSL constants for maps of `format`: 16-bit maps hold the warps only
+    /// with exponents up to 5.5.
+    fn prelude(p: &MomentParams, half: bool) -> String {
+        let limit = if half { 5.5f32 } else { f32::MAX };
+        let positive = p.positive_exponent.min(limit);
+        let negative = p.negative_exponent.min(limit);
+        format!(
+            "const POSITIVE_EXPONENT: f32 = {positive:?};\nconst NEGATIVE_EXPONENT: f32 = {negative:?};\n"
+        )
+    }
+}
+
+/// A moment method's technique.
+struct MomentShadows {
+    method: &'static Method,
+    params: MomentParams,
+    maps: Option<MomentMaps>,
+}
+
+fn is_half(format: Option<wgpu::TextureFormat>) -> bool {
+    matches!(
+        format,
+        Some(wgpu::TextureFormat::Rg16Float | wgpu::TextureFormat::Rgba16Float)
+    )
+}
+
+fn settings(method: &Method, p: &MomentParams, half: bool) -> MomentSettings {
+    MomentSettings {
+        map_size: p.map_size,
+        stable_fit: p.stable_fit,
+        blur_radius: p.blur_radius,
+        normal_offset: p.normal_offset,
+        bias: (method.bias)(p, half),
+        bleeding_reduction: p.bleeding_reduction,
+    }
+}
+
+impl ShadowTechnique for MomentShadows {
+    fn passes(&self) -> Vec<PassInfo> {
+        self.maps.as_ref().map_or(Vec::new(), MomentMaps::passes)
+    }
+
+    fn resources(&self) -> Vec<ResourceInfo> {
+        self.maps.as_ref().map_or(Vec::new(), MomentMaps::resources)
+    }
+
+    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
+        let method = self.method;
+        if self.maps.is_none() {
+            let device = &ctx.gpu.device;
+            let format = if method.four {
+                filterable_rgba_format(device)
+            } else {
+                filterable_rg_format(device)
+            };
+            let maps = MomentMethod {
+                label: method.label,
+                shader: method.shader,
+                prelude: Method::prelude(&self.params, is_half(Some(format))),
+                format,
+            };
+            self.maps = Some(MomentMaps::new(ctx, &maps)?);
+        }
+        let maps = self.maps.as_mut().expect("built above");
+        let half = is_half(maps.format());
+        maps.prepare(ctx, changes, &settings(method, &self.params, half));
+        Ok(())
+    }
+
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+    ) -> TechniqueResult {
+        let maps = self
+            .maps
+            .as_mut()
+            .ok_or_else(TechniqueError::not_prepared)?;
+        let half = is_half(maps.format());
+        maps.record(ctx, recorder, &settings(self.method, &self.params, half))
+    }
+
+    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+        let next = self.method.params(values)?;
+        let exponents = |p: &MomentParams| (p.positive_exponent, p.negative_exponent);
+        if exponents(&next) != exponents(&self.params) {
+            return Ok(ParamUpdate::Rebuild);
+        }
+        self.params = next;
+        Ok(ParamUpdate::Applied)
+    }
+
+    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        self.maps.as_ref()?.debug_view(resource)
+    }
+
+    fn counters(&self) -> Vec<(String, f64)> {
+        self.maps.as_ref().map_or(Vec::new(), MomentMaps::counters)
+    }
+}
+
+fn create(
+    method: &'static Method,
+    values: &ParamValues,
+) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    Ok(Box::new(MomentShadows {
+        method,
+        params: method.params(values)?,
+        maps: None,
+    }))
+}
+
+/// Registers one method as its own technique.
+macro_rules! register_method {
+    ($method:ident, $id:literal, $name:literal, $description:literal, $source:literal) => {
+        zoo_host::register_technique! {
+            id: $id,
+            name: $name,
+            description: $description,
+            source: $source,
+            light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
+            optional_features: || wgpu::Features::FLOAT32_FILTERABLE,
+            params: || $method.schema(),
+            create: |_, values| create(&$method, values),
+        }
+    };
+}
+
+register_method!(
+    ESM,
+    "esm",
+    "Exponential shadow maps",
+    "Blurred exp(c z) per light; visibility from the filtered exponential",
+    "Annen et al. 2008 (seed 000 section 13.3's family)"
+);
+register_method!(
+    EVSM2,
+    "evsm2",
+    "Exponential variance shadow maps (2 moments)",
+    "Chebyshev's bound on exponentially warped depth: less light bleeding than VSM",
+    "Lauritzen and McCool 2008 (seed 000 section 13.3's family)"
+);
+register_method!(
+    EVSM4,
+    "evsm4",
+    "Exponential variance shadow maps (4 moments)",
+    "Positive and negative exponential warps, the tighter Chebyshev bound wins",
+    "Lauritzen and McCool 2008 (seed 000 section 13.3's family)"
+);
+register_method!(
+    MSM,
+    "msm",
+    "Moment shadow maps (Hamburger 4MSM)",
+    "Four depth moments; the sharpest bound on the lit fraction any distribution allows",
+    "Peters and Klein 2015 (seed 000 section 13.3's family)"
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_method_accepts_only_its_parameters() {
+        let mut values = ParamValues::new();
+        values.insert(
+            "moment_bias".into(),
+            zoo_host::params::ParamValue::Float(1e-4),
+        );
+        assert_eq!(MSM.params(&values).unwrap().moment_bias, 1e-4);
+        let err = ESM.params(&values).unwrap_err().to_string();
+        assert!(err.contains("unknown parameter `moment_bias`"), "{err}");
+        let keys: Vec<_> = EVSM4.schema().iter().map(|s| s.key).collect();
+        assert!(keys.contains(&"negative_exponent") && !keys.contains(&"moment_bias"));
+    }
+
+    #[test]
+    fn exponents_are_clamped_for_half_floats() {
+        let p = MomentParams::default();
+        assert!(Method::prelude(&p, false).contains("POSITIVE_EXPONENT: f32 = 40.0;"));
+        assert!(Method::prelude(&p, true).contains("POSITIVE_EXPONENT: f32 = 5.5;"));
+    }
+}
