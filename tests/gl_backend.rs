@@ -36,6 +36,24 @@ fn gl() -> Option<Arc<GpuContext>> {
     }
 }
 
+/// The largest fraction of differing pixels allowed for technique `id` between GL and Vulkan:
+/// 0.001 where both run the same way; 0.1 where GL lacks one of the technique's optional
+/// features and it falls back (the moment maps filter 16-bit floats there, and their
+/// exponential warps are clamped: measured 0.0002 for vsm up to 0.089 for esm at 128x96).
+fn parity_bound(gl: &GpuContext, id: &str) -> f64 {
+    // Rows that are not techniques (the reference) run the same way everywhere.
+    let registry = zoo_host::registry();
+    let optional = registry
+        .iter()
+        .find(|r| r.id == id)
+        .map(|r| (r.optional_features)());
+    if optional.is_none_or(|features| gl.device.features().contains(features)) {
+        0.001
+    } else {
+        0.1
+    }
+}
+
 /// Fraction of pixels that differ by more than `threshold` in any channel.
 fn differing(a: &image::RgbaImage, b: &image::RgbaImage, threshold: u8) -> f64 {
     assert_eq!(a.dimensions(), b.dimensions());
@@ -95,7 +113,7 @@ fn compare_backends(gl: &Arc<GpuContext>, scene: Scene) {
             registration.id
         );
         assert!(
-            off <= 0.001,
+            off <= parity_bound(gl, registration.id),
             "{}: GL and Vulkan differ in {off}",
             registration.id
         );
@@ -118,13 +136,13 @@ fn the_default_render_on_gl_matches_vulkan() {
         let mut renderer = Renderer::new(gpu, scene, tile).unwrap();
         contact_sheet::build(&mut renderer, &techniques, DEFAULT_SAMPLES, |_| {}).unwrap()
     };
-    let (a, b) = (sheet(gl), sheet(gpu()));
+    let (a, b) = (sheet(gl.clone()), sheet(gpu()));
     let ids = |s: &contact_sheet::Sheet| s.rows.iter().map(|r| r.id.clone()).collect::<Vec<_>>();
     assert_eq!(ids(&a), ids(&b));
     for (i, row) in a.rows.iter().enumerate() {
         let off = differing(&a.images[i], &b.images[i], 3);
         assert!(
-            off <= 0.001,
+            off <= parity_bound(&gl, &row.id),
             "tile {}: GL and Vulkan differ in {off}",
             row.id
         );
@@ -135,7 +153,15 @@ fn the_default_render_on_gl_matches_vulkan() {
             row.id
         );
         if let (Some(x), Some(y)) = (a.rows[i].summary, b.rows[i].summary) {
-            assert!((x.mae - y.mae).abs() < 1e-3, "{}: {x:?} vs {y:?}", row.id);
+            // A fallback's own error shows in the judge too (esm: mae 0.021 with 16-bit maps
+            // against 0.0046 with 32-bit ones).
+            let same = parity_bound(&gl, &row.id) <= 0.001;
+            let tolerance = if same { 1e-3 } else { 0.03 };
+            assert!(
+                (x.mae - y.mae).abs() < tolerance,
+                "{}: {x:?} vs {y:?}",
+                row.id
+            );
         }
     }
     let layout = Layout::new((tile.x, tile.y), a.images.len());

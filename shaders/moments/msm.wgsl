@@ -1,8 +1,8 @@
 // Moment shadow maps, Hamburger 4MSM (Peters and Klein 2015): a texel stores z, z², z³, z⁴.
 // From the filtered moments b (pulled towards (0.5, 0.5, 0.5, 0.5) by the moment bias, which
 // keeps the Hankel matrix invertible), the lookup finds the distribution with three depths
-// z_r, z_2, z_3 whose moments are b and which puts as much weight in front of the receiver as
-// any distribution can, and returns the weight at or behind the receiver:
+// z_r, z_2, z_3 whose moments are b and which puts as little weight in front of the receiver
+// as any distribution can, and returns the weight at or behind the receiver:
 //   1. solve [[1, b1, b2], [b1, b2, b3], [b2, b3, b4]] c = (1, z_r, z_r²) (Cholesky);
 //   2. z_2 <= z_3 are the roots of c3 z² + c2 z + c1 = 0;
 //   3. shadow = 0 if z_r <= z_2,

@@ -21,8 +21,9 @@ struct MomentLight {
 
 @group(2) @binding(0) var<uniform> moment_light: MomentLight;
 
-@fragment
-fn fs_moment_lookup(in: FullscreenOut) -> @location(0) vec4<f32> {
+// The visibility at the pixel of `in`. No entry point here: the library composes the method
+// and this file and adds `fs_moment_lookup`, which returns this.
+fn moment_lookup(in: FullscreenOut) -> vec4<f32> {
     let r = map_receiver(moment_light.map, in.position.xy);
     let s = sample_color_map(moment_light.map, r.lookup);
     if !s.inside {

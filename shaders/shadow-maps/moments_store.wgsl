@@ -10,8 +10,9 @@
 
 #import "shadow-maps/depth.wgsl"
 
-@fragment
-fn fs_moments(in: DepthVertex) -> @location(0) vec4<f32> {
+// The moments of the fragment at `in`. No entry point here: the library composes the method
+// and this file and adds `fs_moments`, which returns this.
+fn store_moments(in: DepthVertex) -> vec4<f32> {
     let z = light_depth(layer_camera, in.world);
     let dx = dpdx(z);
     let dy = dpdy(z);

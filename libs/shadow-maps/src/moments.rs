@@ -5,7 +5,7 @@
 //!
 //! ```text
 //! fn moments(z: f32, spread: f32) -> vec4<f32>            // depth pass: what a texel stores
-//! fn moment_visibility(m: vec4<f32>, z: f32) -> f32       // lookup: filtered moments, receiver
+//! fn moment_visibility(m: vec4<f32>, z: f32, bias: f32) -> f32   // lookup: moments, receiver
 //! ```
 //!
 //! `z` is `light_depth` (0 at the light, 1 at the far plane) and `spread` the depth's variance
@@ -21,6 +21,8 @@ use crate::{ColorOutput, DepthState, LayerBlur, MapHeader, ShadowMapSet};
 
 const STORE_SHADER: &str = "shadow-maps/moments_store.wgsl";
 const LOOKUP_SHADER: &str = "shadow-maps/moments_lookup.wgsl";
+const STORE_ENTRY: &str = "@fragment fn fs_moments(in: DepthVertex) -> @location(0) vec4<f32> { return store_moments(in); }";
+const LOOKUP_ENTRY: &str = "@fragment fn fs_moment_lookup(in: FullscreenOut) -> @location(0) vec4<f32> { return moment_lookup(in); }";
 
 /// `MomentLight` in `shadow-maps/moments_lookup.wgsl`: one light's lookup.
 #[derive(Debug, Clone, Copy, zoo_host::bytemuck::Pod, zoo_host::bytemuck::Zeroable)]
@@ -73,13 +75,15 @@ pub struct MomentMaps {
 impl MomentMaps {
     /// Builds the passes of `method`.
     pub fn new(ctx: &RenderContext<'_>, method: &MomentMethod) -> TechniqueResult<MomentMaps> {
-        let compose = |pass: &str| {
+        // The library files hold no entry points (they call the method's functions), so each
+        // stands as a shared module; the entry points are added here.
+        let compose = |pass: &str, entry: &str| {
             format!(
-                "{}\n#import \"{}\"\n#import \"{pass}\"\n",
+                "{}\n#import \"{}\"\n#import \"{pass}\"\n{entry}\n",
                 method.prelude, method.shader
             )
         };
-        let store = compose(STORE_SHADER);
+        let store = compose(STORE_SHADER, STORE_ENTRY);
         let store_label = format!("{} depth pass", method.label);
         let output = ColorOutput {
             shader: &store_label,
@@ -93,7 +97,7 @@ impl MomentMaps {
         let lookup = FullscreenLightPass::from_source(
             ctx,
             &format!("{} lookup", method.label),
-            &compose(LOOKUP_SHADER),
+            &compose(LOOKUP_SHADER, LOOKUP_ENTRY),
             "fs_moment_lookup",
             &[maps.lookup_layout()],
         )?;
