@@ -15,9 +15,11 @@ fn negative_warp(z: f32) -> f32 {
     return exp(NEGATIVE_EXPONENT * (1.0 - z));
 }
 
-// A warp's first two moments, its slope spreading the second like the depth's own.
+// A warp's first two moments, its slope spreading the second like the depth's own; the second
+// stays below the map format's largest finite value (MOMENT_LIMIT, generated), so that steep
+// texels never store infinity for the blur to spread.
 fn warped_moments(w: f32, slope: f32, spread: f32) -> vec2<f32> {
-    return vec2<f32>(w, w * w + slope * slope * spread);
+    return vec2<f32>(w, min(w * w + slope * slope * spread, MOMENT_LIMIT));
 }
 
 // The bound for the positive warp (moments m, receiver depth z).

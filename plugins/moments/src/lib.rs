@@ -114,13 +114,17 @@ impl Method {
     }
 
     /// The method's WGSL constants for maps of `format`: 16-bit maps hold the warps only
-    /// with exponents up to 5.5.
+    /// with exponents up to 5.5, and no moment above the format's largest finite value.
     fn prelude(p: &MomentParams, half: bool) -> String {
-        let limit = if half { 5.5f32 } else { f32::MAX };
-        let positive = p.positive_exponent.min(limit);
-        let negative = p.negative_exponent.min(limit);
+        let (exponent_limit, moment_limit) = if half {
+            (5.5f32, 65504.0f32)
+        } else {
+            (f32::MAX, 1.0e38)
+        };
+        let positive = p.positive_exponent.min(exponent_limit);
+        let negative = p.negative_exponent.min(exponent_limit);
         format!(
-            "const POSITIVE_EXPONENT: f32 = {positive:?};\nconst NEGATIVE_EXPONENT: f32 = {negative:?};\n"
+            "const POSITIVE_EXPONENT: f32 = {positive:?};\nconst NEGATIVE_EXPONENT: f32 = {negative:?};\nconst MOMENT_LIMIT: f32 = {moment_limit:?};\n"
         )
     }
 }
@@ -292,6 +296,8 @@ mod tests {
     fn exponents_are_clamped_for_half_floats() {
         let p = MomentParams::default();
         assert!(Method::prelude(&p, false).contains("POSITIVE_EXPONENT: f32 = 40.0;"));
-        assert!(Method::prelude(&p, true).contains("POSITIVE_EXPONENT: f32 = 5.5;"));
+        let half = Method::prelude(&p, true);
+        assert!(half.contains("POSITIVE_EXPONENT: f32 = 5.5;"), "{half}");
+        assert!(half.contains("MOMENT_LIMIT: f32 = 65504.0;"), "{half}");
     }
 }
