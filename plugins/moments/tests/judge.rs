@@ -1,6 +1,6 @@
 //! The moment family against the reference judge, with vsm's bounds on planar-room (point,
 //! spot and sun) and curved. Their light bleeding beside VSM is measured in the workspace's
-//! `tests/filtered_shadow_maps.rs`, which links every plugin.
+//! `tests/zoo/filtered_shadow_maps.rs`, which links every plugin.
 
 // Link the plugin so its techniques register.
 use zoo_plugin_moments as _;

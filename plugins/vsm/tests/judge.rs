@@ -2,7 +2,7 @@
 //! issue, and the method's known flaw (light bleeding) measured on stacked casters.
 
 // Link the plugin so its technique registers. Comparisons with PCF and PCSS are in the
-// workspace's `tests/filtered_shadow_maps.rs`, which links every plugin.
+// workspace's `tests/zoo/filtered_shadow_maps.rs`, which links every plugin.
 use zoo_plugin_vsm as _;
 
 use zoo_host::glam::UVec2;

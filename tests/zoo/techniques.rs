@@ -141,7 +141,7 @@ fn every_technique_renders_lit_and_finite() {
         .filter(|&i| g.positions[i].w > 0.5)
         .collect();
 
-    for registration in registry() {
+    for registration in crate::shipped_techniques() {
         let id = registration.id;
         renderer
             .set_technique(id, &ParamValues::new())
@@ -153,7 +153,7 @@ fn every_technique_renders_lit_and_finite() {
         let image = renderer.read_output();
         let raw = image.as_raw();
         // Shadows only take direct light away: never brighter than the unshadowed frame, unless
-        // the technique adds light (which `tests/indirect_light.rs` checks against the CPU
+        // the technique adds light (which `tests/zoo/indirect_light.rs` checks against the CPU
         // mirror instead).
         let brighter = (0..raw.len())
             .filter(|&k| k % 4 != 3 && raw[k] as i32 > baseline.as_raw()[k] as i32 + 2)
@@ -259,7 +259,7 @@ fn every_viewable_resource_of_every_technique_renders() {
     let scene = load("planar-room.ron");
     let mut renderer = Renderer::new(gpu(), scene, UVec2::new(96, 64)).unwrap();
     let mut shown = 0;
-    for registration in registry() {
+    for registration in crate::shipped_techniques() {
         renderer
             .set_technique(registration.id, &ParamValues::new())
             .unwrap();
@@ -283,7 +283,7 @@ fn every_viewable_resource_of_every_technique_renders() {
             shown += 1;
         }
     }
-    assert!(shown >= registry().len() - 1, "only {shown} debug views");
+    assert!(shown >= crate::shipped_techniques().len() - 1, "only {shown} debug views");
 }
 
 #[test]

@@ -1,0 +1,8 @@
+//! The reference judge's integration tests in one test binary: closed-form shadows
+//! (`analytic`), the one-bounce reference (`indirect`), ray origins at any scale (`origins`)
+//! and whole scenes rendered at any scale (`scale`, on the GPU).
+
+mod analytic;
+mod indirect;
+mod origins;
+mod scale;

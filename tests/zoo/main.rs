@@ -1,0 +1,30 @@
+//! The workspace's integration tests, one module per subject, in one test binary (each binary
+//! links wgpu, egui and every plugin, so one link instead of fifteen keeps the suite fast).
+//!
+//! Modules that register test-only techniques (`source: "test"`) share this binary's registry;
+//! tests that walk every shipped technique use `test_support::shipped_techniques`.
+
+mod bench;
+mod cli;
+mod contact_sheet;
+mod filtered_shadow_maps;
+mod gl_backend;
+mod indirect_light;
+mod judge;
+mod kit;
+mod many_lights;
+mod perspective_aliasing;
+mod plugin_failure;
+mod recorder;
+mod slots;
+mod techniques;
+mod viewer;
+
+/// The techniques a user's build registers: every one except the test-only techniques that
+/// this binary's modules register (their package is this one's).
+fn shipped_techniques() -> Vec<&'static zoo_host::technique::TechniqueRegistration> {
+    zoo_host::registry()
+        .into_iter()
+        .filter(|r| r.package != env!("CARGO_PKG_NAME"))
+        .collect()
+}
