@@ -416,11 +416,19 @@ fn render_without_a_technique_writes_the_contact_sheet_and_its_table() {
     let table_rows: Vec<&str> = all
         .lines()
         .filter(|l| {
-            l.starts_with("reference (") || crate::shipped_techniques().iter().any(|r| l.starts_with(r.id))
+            l.starts_with("reference (")
+                || crate::shipped_techniques()
+                    .iter()
+                    .any(|r| l.starts_with(r.id))
         })
         .collect();
-    assert_eq!(table_rows.len(), crate::shipped_techniques().len() + 2, "{all}");
-    let layout = shadow_zoo::contact_sheet::Layout::new((96, 64), crate::shipped_techniques().len() + 2);
+    assert_eq!(
+        table_rows.len(),
+        crate::shipped_techniques().len() + 2,
+        "{all}"
+    );
+    let layout =
+        shadow_zoo::contact_sheet::Layout::new((96, 64), crate::shipped_techniques().len() + 2);
     let image = image::open(&png).unwrap();
     assert_eq!((image.width(), image.height()), layout.size());
 }

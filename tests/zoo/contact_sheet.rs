@@ -125,7 +125,8 @@ fn the_readme_contact_sheet_is_up_to_date() {
         eprintln!("wrote {}", path.display());
         return;
     }
-    let regenerate = "regenerate it with `UPDATE_README_IMAGES=1 cargo test --test zoo contact_sheet`";
+    let regenerate =
+        "regenerate it with `UPDATE_README_IMAGES=1 cargo test --test zoo contact_sheet`";
     let committed = image::open(&path)
         .unwrap_or_else(|e| panic!("{}: {e}; {regenerate}", path.display()))
         .to_rgba8();

@@ -283,7 +283,10 @@ fn every_viewable_resource_of_every_technique_renders() {
             shown += 1;
         }
     }
-    assert!(shown >= crate::shipped_techniques().len() - 1, "only {shown} debug views");
+    assert!(
+        shown >= crate::shipped_techniques().len() - 1,
+        "only {shown} debug views"
+    );
 }
 
 #[test]
