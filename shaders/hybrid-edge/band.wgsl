@@ -14,24 +14,17 @@
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
 #import "common/fullscreen.wgsl"
+#import "shadow-maps/receiver.wgsl"
 #import "shadow-maps/depth_lookup.wgsl"
 
 struct EdgeLight {
-    // Index of the scene light.
-    light: u32,
-    first_layer: u32,
-    // 1 (spot, directional) or 6 (point: cube faces).
-    layer_count: u32,
+    map: MapHeader,
     // Neighbourhood radius r in texels.
     radius: u32,
-    // World size of a texel: per unit of distance along the layer's axis (perspective) or
-    // absolute (orthographic).
-    texel_scale: f32,
-    perspective: u32,
-    // Lookups move off the surface by this many texels.
-    normal_offset: f32,
     // Restriction (RESTRICTION_* below).
     restriction: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // Restrictions, one per variant of the Rust `Restriction` parameter.
@@ -46,11 +39,6 @@ const CLASS_LIT: vec4<f32> = vec4<f32>(0.95, 0.9, 0.6, 1.0);
 const CLASS_SHADOWED: vec4<f32> = vec4<f32>(0.15, 0.2, 0.45, 1.0);
 const CLASS_EDGE: vec4<f32> = vec4<f32>(1.0, 0.2, 0.2, 1.0);
 
-// World size of one map texel at p.
-fn texel_world(light: Light, p: vec3<f32>) -> f32 {
-    return map_texel_world(edge.perspective == 1u, edge.layer_count, edge.texel_scale, light.position, light.direction, p);
-}
-
 // Number of lit taps in the (2r + 1)² neighbourhood of p.
 fn lit_taps(light: Light, p: vec3<f32>, texel: f32) -> u32 {
     var w = light.direction;
@@ -63,7 +51,7 @@ fn lit_taps(light: Light, p: vec3<f32>, texel: f32) -> u32 {
     for (var j = -r; j <= r; j++) {
         for (var i = -r; i <= r; i++) {
             let q = p + (frame[0] * f32(i) + frame[1] * f32(j)) * texel;
-            let layer = light_layer(edge.first_layer, edge.layer_count, light.position, q);
+            let layer = header_layer(edge.map, q);
             lit += u32(compare_map(map_point(layer, q), false) > 0.5);
         }
     }
@@ -78,7 +66,7 @@ struct BandOut {
 
 // What the neighbourhood says about one pixel.
 struct Classified {
-    // 0: not lit by the light at all (or background), 1: lit, 2: shadowed, 3: edge.
+    // LIT, SHADOWED or EDGE.
     kind: u32,
     surface: Surface,
     light: Light,
@@ -87,31 +75,20 @@ struct Classified {
     texel: f32,
 }
 
-const OUTSIDE: u32 = 0u;
 const LIT: u32 = 1u;
 const SHADOWED: u32 = 2u;
 const EDGE: u32 = 3u;
 
+// Pixels without a surface or outside the light's range and cone are discarded (lit, out of
+// the band).
 fn classify(pixel: vec2<f32>) -> Classified {
+    let receiver = map_receiver(edge.map, pixel);
     var c: Classified;
-    c.kind = OUTSIDE;
-    c.surface = load_surface(vec2<i32>(pixel));
-    c.light = lights[edge.light];
-    if !c.surface.valid {
-        return c;
-    }
+    c.surface = receiver.surface;
+    c.light = lights[edge.map.light];
+    c.lookup = receiver.lookup;
+    c.texel = receiver.texel;
     let light = c.light;
-    if light.kind != LIGHT_DIRECTIONAL {
-        let to_surface = c.surface.position - light.position;
-        let d = length(to_surface);
-        let outside_cone = light.kind == LIGHT_SPOT
-            && dot(to_surface, light.direction) <= light.cos_outer * d;
-        if d >= light.range || outside_cone {
-            return c;
-        }
-    }
-    c.texel = texel_world(light, c.surface.position);
-    c.lookup = c.surface.position + c.surface.normal * (edge.normal_offset * c.texel);
     let n = (2u * edge.radius + 1u) * (2u * edge.radius + 1u);
     let lit = lit_taps(light, c.lookup, c.texel);
     if edge.restriction == RESTRICTION_EVERYWHERE || (lit > 0u && lit < n) {
@@ -128,8 +105,7 @@ fn class_colour(kind: u32) -> vec4<f32> {
     switch kind {
         case LIT: { return CLASS_LIT; }
         case SHADOWED: { return CLASS_SHADOWED; }
-        case EDGE: { return CLASS_EDGE; }
-        default: { return vec4<f32>(0.0); }
+        default: { return CLASS_EDGE; }
     }
 }
 
@@ -186,7 +162,7 @@ fn ray_hits(id: u32, origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> boo
 // (2r + 3)² texels around the surface's texel.
 fn occluded(c: Classified) -> bool {
     let light = c.light;
-    let layer = light_layer(edge.first_layer, edge.layer_count, light.position, c.lookup);
+    let layer = header_layer(edge.map, c.lookup);
     let m = map_point(layer, c.lookup);
     let size = vec2<i32>(textureDimensions(triangle_ids));
     let centre = vec2<i32>(m.uv * vec2<f32>(size));

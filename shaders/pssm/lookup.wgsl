@@ -10,32 +10,18 @@
 #import "shadow-maps/depth_lookup.wgsl"
 #import "pssm/density.wgsl"
 
-// Filter modes, one per variant of the Rust `Filter` parameter (`FILTER_` and its name in
-// capitals); the plugin reads their values from here.
-const FILTER_NONE: u32 = 0u;
-const FILTER_HARDWARE2X2: u32 = 1u;
-const FILTER_PCF3X3: u32 = 2u;
-const FILTER_PCF5X5: u32 = 3u;
-const FILTER_POISSON: u32 = 4u;
-const FILTER_PCSS: u32 = 5u;
-
 struct PssmLight {
     // Index of the scene light (directional).
     light: u32,
     first_layer: u32,
     splits: u32,
-    filter_mode: u32,
+    // 1 when this light's diagnostics are written.
+    diagnostics: u32,
+    map_filter: MapFilter,
     // Fraction of each split blended into the next.
     blend: f32,
     // Normal offset in texels of the split's map.
     normal_offset: f32,
-    // Poisson disc radius and PCSS search limit, in texels.
-    kernel_texels: f32,
-    search_texels: f32,
-    // Tangent of the light's angular radius (PCSS).
-    light_size: f32,
-    // 1 when this light's diagnostics are written.
-    diagnostics: u32,
     _pad: vec2<u32>,
     // Split distances C_0..C_8 (view depths), four per vector.
     distances: array<vec4<f32>, 3>,
@@ -89,17 +75,7 @@ fn split_visibility(s: Surface, split: u32, direction: vec3<f32>, r: mat2x2<f32>
     let texel = pssm.texel[split / 4u][split % 4u];
     let p = s.position + s.normal * (pssm.normal_offset * texel);
     let frame = tangent_frame(direction);
-    switch pssm.filter_mode {
-        case FILTER_NONE: { return shadow_tap(p, false); }
-        case FILTER_HARDWARE2X2: { return shadow_tap(p, true); }
-        case FILTER_PCF3X3: { return grid_pcf(p, frame, texel, 3); }
-        case FILTER_PCF5X5: { return grid_pcf(p, frame, texel, 5); }
-        case FILTER_POISSON: { return poisson_pcf(p, frame, pssm.kernel_texels * texel, r); }
-        default: {
-            let light = PcssLight(pssm.light_size, tap_near, false, pssm.search_texels);
-            return pcss(p, frame, texel, r, light);
-        }
-    }
+    return filter_map(pssm.map_filter, p, frame, texel, r, tap_near, false);
 }
 
 struct Outputs {

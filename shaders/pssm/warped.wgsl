@@ -10,14 +10,6 @@
 #import "shadow-maps/depth_lookup.wgsl"
 #import "pssm/density.wgsl"
 
-// Filter modes, one per variant of the Rust `Filter` parameter; the plugin reads them here.
-const FILTER_NONE: u32 = 0u;
-const FILTER_HARDWARE2X2: u32 = 1u;
-const FILTER_PCF3X3: u32 = 2u;
-const FILTER_PCF5X5: u32 = 3u;
-const FILTER_POISSON: u32 = 4u;
-const FILTER_PCSS: u32 = 5u;
-
 // Per-light settings; everything that changes from frame to frame (the layer's matrices)
 // is read from the layer cameras instead, because lavapipe recompiles a shader whose
 // uniforms it inlined whenever their values change.
@@ -25,16 +17,12 @@ struct WarpedLight {
     // Index of the scene light.
     light: u32,
     layer: u32,
-    filter_mode: u32,
     // 1 when this light's diagnostics are written.
     diagnostics: u32,
     // Map resolution in texels.
     resolution: f32,
+    map_filter: MapFilter,
     normal_offset: f32,
-    kernel_texels: f32,
-    search_texels: f32,
-    // Light radius (spot) or tangent of the angular radius (directional).
-    light_size: f32,
     _pad0: f32,
     _pad1: f32,
     _pad2: f32,
@@ -119,23 +107,12 @@ fn fs_warped(in: FullscreenOut) -> Outputs {
     let texel = texel_world(s.position, frame);
     let p = s.position + s.normal * (warped.normal_offset * texel);
     let r = rotation(in.position.xy);
-    var visibility = 1.0;
-    switch warped.filter_mode {
-        case FILTER_NONE: { visibility = shadow_tap(p, false); }
-        case FILTER_HARDWARE2X2: { visibility = shadow_tap(p, true); }
-        case FILTER_PCF3X3: { visibility = grid_pcf(p, frame, texel, 3); }
-        case FILTER_PCF5X5: { visibility = grid_pcf(p, frame, texel, 5); }
-        case FILTER_POISSON: { visibility = poisson_pcf(p, frame, warped.kernel_texels * texel, r); }
-        default: {
-            // A warped map has no single near plane to size the blocker search by: the
-            // search takes the largest radius (`search_texels`). Distances are measured from
-            // the light (spot) or along it (directional, where only differences matter).
-            let spot = light.kind != LIGHT_DIRECTIONAL;
-            let near = select(-1e30, 0.0, spot);
-            let pcss_light = PcssLight(warped.light_size, near, spot, warped.search_texels);
-            visibility = pcss(p, frame, texel, r, pcss_light);
-        }
-    }
+    // A warped map has no single near plane to size the PCSS blocker search by: the search
+    // takes the largest radius (`search_texels`). Distances are measured from the light
+    // (spot) or along it (directional, where only differences matter).
+    let spot = light.kind != LIGHT_DIRECTIONAL;
+    let near = select(-1e30, 0.0, spot);
+    let visibility = filter_map(warped.map_filter, p, frame, texel, r, near, spot);
     out.visibility = vec4<f32>(visibility);
     if warped.diagnostics == 1u {
         let depth = -(camera.view * vec4<f32>(s.position, 1.0)).z;

@@ -148,3 +148,47 @@ fn pcss(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: Pcs
     }
     return poisson_pcf(p, frame, clamp(penumbra, texel, light.max_texels * texel), r);
 }
+
+// Filters, one per variant of the library's Rust `Filter` choice (`FILTER_` and its name in
+// capitals); the library reads their values from here, so no number is kept twice.
+const FILTER_NONE: u32 = 0u;
+const FILTER_HARDWARE2X2: u32 = 1u;
+const FILTER_PCF3X3: u32 = 2u;
+const FILTER_PCF5X5: u32 = 3u;
+const FILTER_PCF7X7: u32 = 4u;
+const FILTER_PCF9X9: u32 = 5u;
+const FILTER_POISSON: u32 = 6u;
+const FILTER_PCSS: u32 = 7u;
+
+// One light's filter (`MapFilter` in the library's Rust, written by `MapFilters::filter`).
+struct MapFilter {
+    // One of the FILTER_* constants.
+    mode: u32,
+    // Poisson disc radius, in texels.
+    kernel_texels: f32,
+    // Largest PCSS blocker search and penumbra radius, in texels.
+    search_texels: f32,
+    // Radius (point, spot) or tangent of the angular radius (directional), for PCSS.
+    light_size: f32,
+}
+
+// Visibility at p (1 = lit) through filter `f`: `frame` spans the plane across the light's
+// rays, `texel` is a map texel's world size there and `r` the pixel's rotation; PCSS sizes
+// its search from the map's `near` plane (scaled by distance on `perspective` maps).
+fn filter_map(f: MapFilter, p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, near: f32, perspective: bool) -> f32 {
+    var visibility = 1.0;
+    switch f.mode {
+        case FILTER_NONE: { visibility = shadow_tap(p, false); }
+        case FILTER_HARDWARE2X2: { visibility = shadow_tap(p, true); }
+        case FILTER_PCF3X3: { visibility = grid_pcf(p, frame, texel, 3); }
+        case FILTER_PCF5X5: { visibility = grid_pcf(p, frame, texel, 5); }
+        case FILTER_PCF7X7: { visibility = grid_pcf(p, frame, texel, 7); }
+        case FILTER_PCF9X9: { visibility = grid_pcf(p, frame, texel, 9); }
+        case FILTER_POISSON: { visibility = poisson_pcf(p, frame, f.kernel_texels * texel, r); }
+        default: {
+            let light = PcssLight(f.light_size, near, perspective, f.search_texels);
+            visibility = pcss(p, frame, texel, r, light);
+        }
+    }
+    return visibility;
+}

@@ -25,7 +25,7 @@ struct MapHeader {
 }
 
 // World size of one of the header's map texels at p.
-fn texel_world(h: MapHeader, p: vec3<f32>) -> f32 {
+fn header_texel_world(h: MapHeader, p: vec3<f32>) -> f32 {
     let light = lights[h.light];
     return map_texel_world(h.perspective == 1u, h.layer_count, h.texel_scale, light.position, light.direction, p);
 }
@@ -63,7 +63,7 @@ fn map_receiver(h: MapHeader, pixel: vec2<f32>) -> Receiver {
             discard;
         }
     }
-    r.texel = texel_world(h, r.surface.position);
+    r.texel = header_texel_world(h, r.surface.position);
     r.lookup = r.surface.position + r.surface.normal * (h.normal_offset * r.texel);
     return r;
 }

@@ -1,20 +1,24 @@
-//! Shadow-map building blocks shared by techniques (sm-pcf today; VSM, PSSM, the hybrid and
-//! SSSS next): light frusta fitted to spot cones, cube faces and what the camera sees
-//! ([`light_space`]), the per-light layer plan with screen scissors ([`planning`]), the depth
-//! array under a memory budget ([`maps`]), the depth pass that fills it, optionally with a
-//! colour map such as moments ([`depth`]), and a separable blur of colour map layers
-//! ([`blur`]). [`ShadowMapSet`] keeps them up to date for a technique in one call per frame.
+//! Shadow-map building blocks shared by the shadow-map techniques (sm-pcf, the moment family,
+//! PSSM and the warped maps, the hybrid, SSSS, LPV): light frusta fitted to spot cones, cube
+//! faces and what the camera sees ([`light_space`]), the per-light layer plan with screen
+//! scissors ([`planning`]), the depth array under a memory budget ([`maps`]), the depth pass
+//! that fills it, optionally with a colour map such as moments ([`depth`]), and a separable
+//! blur of colour map layers ([`blur`]). [`ShadowMapSet`] keeps them up to date for a
+//! technique in one call per frame.
 //!
-//! Lookups read a light's maps through its [`MapHeader`]; the header, receivers, texel sizes,
-//! the map groups and the filters live in WGSL: `shaders/shadow-maps/`.
+//! Lookups read a light's maps through its [`MapHeader`] in a [`LookupPass`], filtered as one
+//! [`Filter`] choice says; the header, receivers, texel sizes, the map groups and the filters
+//! live in WGSL: `shaders/shadow-maps/`.
 
 pub mod blur;
 pub mod cascades;
 pub mod culling;
 pub mod depth;
+pub mod filter;
 pub mod header;
 pub mod light_space;
 pub mod lookup;
+pub mod lookup_pass;
 pub mod maps;
 pub mod moments;
 pub mod planning;
@@ -25,7 +29,9 @@ pub mod warped;
 pub use blur::LayerBlur;
 pub use cascades::Cascades;
 pub use depth::{CAMERA_STRIDE, ColorOutput, DepthPass, DepthState, LayerCamera};
+pub use filter::{Filter, MapFilter, MapFilters};
 pub use header::MapHeader;
+pub use lookup_pass::{Lookup, LookupPass, LookupShader};
 pub use maps::{
     CUBE_GUARD, MAP_FORMAT, MEMORY_BUDGET, MapArray, effective_resolution, filterable_rg_format,
     filterable_rgba_format,

@@ -26,13 +26,13 @@ mod tiles;
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{
-    SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name, pipeline_layout,
-};
+use zoo_host::kit::{SlotPipeline, light_pass_name, pipeline_layout};
 use zoo_host::prelude::*;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
-use zoo_shadow_maps::{DepthState, LightMaps, ShadowMapSet, layer_pass_name};
+use zoo_shadow_maps::{
+    DepthState, LightMaps, LookupPass, LookupShader, MapHeader, ShadowMapSet, layer_pass_name,
+};
 
 use ids::IdMaps;
 use tiles::Tiles;
@@ -73,14 +73,10 @@ zoo_host::technique_params! {
 #[bytemuck(crate = "zoo_host::bytemuck")]
 #[repr(C)]
 struct EdgeLight {
-    light: u32,
-    first_layer: u32,
-    layer_count: u32,
+    map: MapHeader,
     radius: u32,
-    texel_scale: f32,
-    perspective: u32,
-    normal_offset: f32,
     restriction: u32,
+    _pad: [u32; 2],
 }
 
 const SHADER: &str = "hybrid-edge/band.wgsl";
@@ -142,10 +138,9 @@ impl Targets {
 struct Gpu {
     maps: ShadowMapSet,
     generator: VolumeGenerator,
-    uniforms: UniformSlots<EdgeLight>,
-    /// Without and with the classification written: volumes next, or exact id tests.
-    band: [wgpu::RenderPipeline; 2],
-    band_ids: [wgpu::RenderPipeline; 2],
+    /// The band's classification: volumes next, or exact id tests.
+    band: LookupPass<EdgeLight>,
+    band_ids: LookupPass<EdgeLight>,
     ids: IdMaps,
     /// The tile restriction, built when first chosen.
     tiles: Option<Tiles>,
@@ -183,8 +178,6 @@ impl Gpu {
         let maps = ShadowMapSet::new(ctx, "hybrid shadow maps", state, None)?;
         let generator = VolumeGenerator::new(ctx, "hybrid")?;
         let ids = IdMaps::new(ctx, state)?;
-        let stage = wgpu::ShaderStages::FRAGMENT;
-        let uniforms = UniformSlots::new(ctx.gpu, "hybrid lights", ctx.lights.len(), stage);
         let device = &ctx.gpu.device;
         let module = ctx.shaders.create_module(device, SHADER)?;
         let draw_module = ctx
@@ -193,21 +186,18 @@ impl Gpu {
         let source = ctx.shaders.compose(SHADER)?.source;
         let restriction_codes = ChoiceCodes::read(&source, "RESTRICTION", Restriction::NAMES)
             .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
-        let groups = [uniforms.layout(), maps.lookup_layout()];
-        let id_groups = [uniforms.layout(), maps.lookup_layout(), &ids.lookup_layout];
-        let band_pipelines = |entry: &str, groups: &[&wgpu::BindGroupLayout]| {
-            let band = SlotPipeline {
-                label: &format!("hybrid {entry}"),
-                module: &module,
+        let band_pass = |entry, groups| {
+            let shader = LookupShader {
+                shader: SHADER,
                 entry,
-                groups,
-                more_targets: &[],
+                diagnostics: &[CLASS_FORMAT],
                 depth_stencil: Some(band_depth_state()),
+                groups,
             };
-            diagnostics_pipelines(ctx, band, &[CLASS_FORMAT])
+            LookupPass::new(ctx, &maps, BAND_PASS, shader)
         };
-        let band = band_pipelines("fs_band", &groups);
-        let band_ids = band_pipelines("fs_band_ids", &id_groups);
+        let band = band_pass("fs_band", &[])?;
+        let band_ids = band_pass("fs_band_ids", &[&ids.lookup_layout])?;
         let bias = wgpu::DepthBiasState {
             constant: p.volume_bias as i32,
             slope_scale: 0.0,
@@ -280,7 +270,6 @@ impl Gpu {
             count_equal,
             maps,
             generator,
-            uniforms,
             band,
             band_ids,
             ids,
@@ -356,17 +345,12 @@ fn record_counts(
 }
 
 /// The band pass's uniform for one light's maps.
-fn edge_light(p: &HybridParams, maps: &LightMaps, resolution: u32) -> EdgeLight {
-    let scale = maps.scale(resolution);
+fn edge_light(p: &HybridParams, maps: &LightMaps, resolution: u32, restriction: u32) -> EdgeLight {
     EdgeLight {
-        light: maps.light as u32,
-        first_layer: maps.first_layer,
-        layer_count: maps.frustums.len() as u32,
+        map: MapHeader::new(maps, resolution, p.normal_offset),
         radius: p.radius,
-        texel_scale: scale.texel_scale,
-        perspective: u32::from(scale.perspective),
-        normal_offset: p.normal_offset,
-        restriction: 0,
+        restriction,
+        _pad: [0; 2],
     }
 }
 
@@ -473,10 +457,6 @@ impl ShadowTechnique for Hybrid {
     ) -> TechniqueResult {
         let p = &self.params;
         let gpu = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
-        let group = gpu
-            .maps
-            .lookup_group()
-            .ok_or_else(TechniqueError::not_prepared)?;
         let exact = p.restriction == Restriction::TriangleIds;
         if exact {
             let depth = gpu.maps.maps().ok_or_else(TechniqueError::not_prepared)?;
@@ -487,17 +467,16 @@ impl ShadowTechnique for Hybrid {
             gpu.maps.record(ctx, recorder, MAP_PASS)?;
         }
         let resolution = gpu.maps.resolution();
-        let debug = gpu.maps.debug_light(p.debug_light).map(|l| l.light);
         let restriction = gpu.restriction_codes.code(p.restriction.index());
-        let values: Vec<EdgeLight> = (gpu.maps.lights().iter())
-            .map(|l| EdgeLight {
-                restriction,
-                ..edge_light(p, l, resolution)
-            })
-            .collect();
-        gpu.uniforms.write(ctx.gpu, &values);
-        for (k, light_maps) in gpu.maps.lights().iter().enumerate() {
-            let light = light_maps.light;
+        let uniform = |l: &LightMaps, _| Some(edge_light(p, l, resolution, restriction));
+        let lookups = match exact {
+            true => gpu.band_ids.write(ctx, &gpu.maps, p.debug_light, uniform),
+            false => gpu.band.write(ctx, &gpu.maps, p.debug_light, uniform),
+        };
+        let band_pass = if exact { &gpu.band_ids } else { &gpu.band };
+        let ids = gpu.ids.lookup_group();
+        for (k, lookup) in lookups.iter().enumerate() {
+            let light = lookup.maps.light;
             let band = &gpu.targets.band.1;
             {
                 let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
@@ -513,20 +492,24 @@ impl ShadowTechnique for Hybrid {
                         store: wgpu::StoreOp::Store,
                     }),
                 };
-                let name = light_pass_name(BAND_PASS, light);
-                let mut pass = ctx.light_pass_with(recorder, &name, light, &class, Some(depth));
-                let pipelines = if exact { &gpu.band_ids } else { &gpu.band };
-                pass.set_pipeline(&pipelines[usize::from(Some(light) == debug)]);
-                pass.set_bind_group(2, gpu.uniforms.bind_group(), &[gpu.uniforms.offset(k)]);
-                pass.set_bind_group(3, group, &[]);
-                if exact {
-                    let ids = gpu
-                        .ids
-                        .lookup_group()
-                        .ok_or_else(TechniqueError::not_prepared)?;
-                    pass.set_bind_group(4, ids, &[]);
+                let ids = ids.filter(|_| exact);
+                if exact && ids.is_none() {
+                    return Err(TechniqueError::not_prepared());
                 }
-                pass.draw(0..3, 0..1);
+                let bind = |pass: &mut wgpu::RenderPass<'_>| {
+                    if let Some(ids) = ids {
+                        pass.set_bind_group(4, ids, &[]);
+                    }
+                };
+                band_pass.record_one(
+                    ctx,
+                    recorder,
+                    &gpu.maps,
+                    lookup,
+                    &class,
+                    Some(depth),
+                    bind,
+                )?;
             }
             if exact {
                 continue;
@@ -536,8 +519,7 @@ impl ShadowTechnique for Hybrid {
             };
             let generation = light_pass_name(GENERATION_PASS, light);
             gpu.generator.record(ctx, recorder, light, &generation)?;
-            let is_debug = Some(light) == debug;
-            let showing = |view| is_debug && ctx.debug_view == Some(view);
+            let showing = |view| lookup.debug && ctx.debug_view == Some(view);
             // The count view reads the stencil after the volumes.
             let keep = if showing(COUNTS_VIEW) {
                 wgpu::StoreOp::Store
@@ -656,13 +638,8 @@ mod tests {
             .unwrap()
             .source;
         let (size, fields) = zoo_host::mirror_fields!(EdgeLight {
-            light,
-            first_layer,
-            layer_count,
+            map,
             radius,
-            texel_scale,
-            perspective,
-            normal_offset,
             restriction
         });
         check_mirror(&source, "EdgeLight", size, &fields, SizeRule::Equal).unwrap();

@@ -12,17 +12,13 @@ mod warped;
 
 pub use warped::{LispsmParams, PsmParams};
 
-use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::light_space::Projection;
-use zoo_shadow_maps::{Cascades, DepthState, LightMaps, ShadowMapSet};
-
-zoo_host::param_choice! {
-    /// How each split's map is filtered.
-    pub enum Filter { None, Hardware2x2, Pcf3x3, Pcf5x5, Poisson, Pcss }
-}
+use zoo_shadow_maps::{
+    Cascades, DepthState, Filter, LightMaps, LookupPass, LookupShader, MapFilter, MapFilters,
+    ShadowMapSet, light_size,
+};
 
 zoo_host::technique_params! {
     /// Parameters of parallel-split shadow maps.
@@ -37,7 +33,7 @@ zoo_host::technique_params! {
         stabilise: bool = true;
         /// Resolution of each split's map, in texels per side.
         map_size: u32 = 2048, range(256, 8192), step(256);
-        /// Filter: none, hardware 2x2, 3x3 or 5x5 grid PCF, rotated Poisson disc, or PCSS.
+        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
         filter: Filter = Filter::Pcf3x3;
         /// Constant depth bias of the depth pass, in units of the depth format's resolution.
         constant_bias: u32 = 0, range(0, 100000), step(100);
@@ -62,13 +58,10 @@ struct PssmLight {
     light: u32,
     first_layer: u32,
     splits: u32,
-    filter_mode: u32,
+    diagnostics: u32,
+    map_filter: MapFilter,
     blend: f32,
     normal_offset: f32,
-    kernel_texels: f32,
-    search_texels: f32,
-    light_size: f32,
-    diagnostics: u32,
     _pad: [u32; 2],
     distances: [f32; 12],
     texel: [f32; 8],
@@ -112,13 +105,11 @@ impl Diagnostics {
     }
 }
 
-/// Pipelines, maps and per-light uniforms, built at the first `prepare`.
+/// Maps and the lookup, built at the first `prepare`.
 struct Gpu {
     maps: ShadowMapSet,
-    uniforms: UniformSlots<PssmLight>,
-    /// Without and with diagnostics written.
-    lookup: [wgpu::RenderPipeline; 2],
-    filter_codes: ChoiceCodes,
+    lookup: LookupPass<PssmLight>,
+    filters: MapFilters,
     diagnostics: Diagnostics,
 }
 
@@ -130,29 +121,18 @@ impl Gpu {
             ..DepthState::default()
         };
         let maps = ShadowMapSet::new(ctx, "pssm maps", state, None)?;
-        let stage = wgpu::ShaderStages::FRAGMENT;
-        let uniforms = UniformSlots::new(ctx.gpu, "pssm lights", ctx.lights.len(), stage);
-        let module = ctx.shaders.create_module(&ctx.gpu.device, SHADER)?;
-        let source = ctx.shaders.compose(SHADER)?.source;
-        let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
-            .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
-        let groups = [uniforms.layout(), maps.lookup_layout()];
-        let lookup = SlotPipeline {
-            label: "pssm lookup",
-            module: &module,
+        let shader = LookupShader {
+            shader: SHADER,
             entry: "fs_pssm",
-            groups: &groups,
-            more_targets: &[],
+            // Split colours and texel density.
+            diagnostics: &[DIAGNOSTICS_FORMAT, DIAGNOSTICS_FORMAT],
             depth_stencil: None,
+            groups: &[],
         };
-        // Split colours and texel density.
-        let diagnostics = [DIAGNOSTICS_FORMAT, DIAGNOSTICS_FORMAT];
-        let lookup = diagnostics_pipelines(ctx, lookup, &diagnostics);
         Ok(Gpu {
+            lookup: LookupPass::new(ctx, &maps, LOOKUP_PASS, shader)?,
             maps,
-            uniforms,
-            lookup,
-            filter_codes,
+            filters: MapFilters::read(ctx.shaders)?,
             diagnostics: Diagnostics::new(&ctx.gpu.device, ctx.size),
         })
     }
@@ -174,10 +154,10 @@ impl Pssm {
     }
 }
 
-/// The lookup's uniform for one light's splits at `distances` (filter mode and light size
-/// left for the caller).
+/// The lookup's uniform for one light's splits at `distances`.
 fn light_uniform(
     p: &PssmParams,
+    map_filter: MapFilter,
     maps: &LightMaps,
     distances: &[f32],
     resolution: u32,
@@ -187,13 +167,10 @@ fn light_uniform(
         light: maps.light as u32,
         first_layer: maps.first_layer,
         splits: maps.frustums.len() as u32,
-        filter_mode: 0,
+        diagnostics: u32::from(debug),
+        map_filter,
         blend: p.blend,
         normal_offset: p.normal_offset,
-        kernel_texels: p.kernel_radius,
-        search_texels: p.pcss_max_texels,
-        light_size: 0.0,
-        diagnostics: u32::from(debug),
         _pad: [0; 2],
         distances: [0.0; 12],
         texel: [0.0; 8],
@@ -217,7 +194,7 @@ impl ShadowTechnique for Pssm {
             return Vec::new();
         };
         let shadowed = gpu.maps.lights().iter().filter(|l| !l.frustums.is_empty());
-        let lookups = shadowed.map(|l| light_pass_name(LOOKUP_PASS, l.light));
+        let lookups = shadowed.map(|l| gpu.lookup.pass_name(l.light));
         let names = gpu.maps.pass_names(MAP_PASS).into_iter().chain(lookups);
         names.map(PassInfo::render).collect()
     }
@@ -267,50 +244,23 @@ impl ShadowTechnique for Pssm {
         let p = &self.params;
         let Gpu {
             maps,
-            uniforms,
             lookup,
-            filter_codes,
+            filters,
             diagnostics: d,
         } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
-        let group = maps
-            .lookup_group()
-            .ok_or_else(TechniqueError::not_prepared)?;
         maps.record(ctx, recorder, MAP_PASS)?;
         let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
         let distances = cascades.distances(ctx.camera, aspect, maps.bounds().0, p.stabilise);
-        let filter_mode = filter_codes.code(p.filter.index());
-        let shadowed: Vec<&LightMaps> = (maps.lights().iter())
-            .filter(|l| !l.frustums.is_empty())
-            .collect();
-        let debug_light = maps.debug_light(p.debug_light).map(|l| l.light);
-        let values: Vec<PssmLight> = shadowed
-            .iter()
-            .map(|l| PssmLight {
-                filter_mode,
-                light_size: ctx.lights[l.light].radius.tan(),
-                ..light_uniform(
-                    p,
-                    l,
-                    &distances,
-                    maps.resolution(),
-                    Some(l.light) == debug_light,
-                )
-            })
-            .collect();
-        uniforms.write(ctx.gpu, &values);
-        for (k, light_maps) in shadowed.iter().enumerate() {
-            let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
-            let targets = [
-                zoo_host::gpu::color_attachment(&d.splits.1, clear),
-                zoo_host::gpu::color_attachment(&d.density.1, clear),
-            ];
-            let name = light_pass_name(LOOKUP_PASS, light_maps.light);
-            let mut pass = ctx.light_pass_with(recorder, &name, light_maps.light, &targets, None);
-            pass.set_pipeline(&lookup[values[k].diagnostics as usize]);
-            pass.set_bind_group(2, uniforms.bind_group(), &[uniforms.offset(k)]);
-            pass.set_bind_group(3, group, &[]);
-            pass.draw(0..3, 0..1);
-        }
+        let resolution = maps.resolution();
+        // Lights without splits (spot, point) are not shadowed.
+        let uniform = |l: &LightMaps, debug| {
+            let size = light_size(&ctx.lights[l.light]);
+            let map_filter = filters.filter(p.filter, p.kernel_radius, p.pcss_max_texels, size);
+            let shadowed = !l.frustums.is_empty();
+            shadowed.then(|| light_uniform(p, map_filter, l, &distances, resolution, debug))
+        };
+        let targets = [&d.splits.1, &d.density.1];
+        lookup.record(ctx, recorder, maps, p.debug_light, &targets, uniform)?;
         if ctx.debug_view == Some(TOP_VIEW) {
             let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
             let debug: Vec<LightMaps> = maps
@@ -396,6 +346,7 @@ zoo_host::register_technique! {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use zoo_host::bytemuck::Zeroable;
     use zoo_host::gpu::layout::{SizeRule, check_mirror};
 
     fn shader() -> String {
@@ -411,24 +362,16 @@ mod tests {
             light,
             first_layer,
             splits,
-            filter_mode,
+            diagnostics,
+            map_filter,
             blend,
             normal_offset,
-            kernel_texels,
-            search_texels,
-            light_size,
-            diagnostics,
             distances,
             texel,
             depth_near,
             depth_far
         });
         check_mirror(&shader(), "PssmLight", size, &fields, SizeRule::Equal).unwrap();
-    }
-
-    #[test]
-    fn every_filter_has_a_shader_constant() {
-        ChoiceCodes::read(&shader(), "FILTER", Filter::NAMES).unwrap();
     }
 
     #[test]
@@ -444,7 +387,7 @@ mod tests {
             layer_word: "split",
             scissor: [0; 4],
         };
-        let light = light_uniform(&p, &maps, &distances, 1024, true);
+        let light = light_uniform(&p, MapFilter::zeroed(), &maps, &distances, 1024, true);
         assert_eq!(light.distances[8], 8.0);
         assert_eq!(light.first_layer, 3);
     }

@@ -8,17 +8,16 @@
 use std::cell::Cell;
 
 use zoo_host::glam::UVec2;
-use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::scene::Light;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::cascades::visible_depth_range;
 use zoo_shadow_maps::light_space::LightFrustum;
 use zoo_shadow_maps::warped::{lispsm_frustum, psm_frustum};
-use zoo_shadow_maps::{DepthState, LayerPlan, PlanInputs, ShadowMapSet, StandardLayers};
-
-use crate::Filter;
+use zoo_shadow_maps::{
+    DepthState, Filter, LayerPlan, LightMaps, LookupPass, LookupShader, MapFilter, MapFilters,
+    PlanInputs, ShadowMapSet, StandardLayers, light_size,
+};
 
 zoo_host::technique_params! {
     /// Parameters of light-space perspective shadow maps.
@@ -28,7 +27,7 @@ zoo_host::technique_params! {
         /// Warp strength: 1 puts the warp's centre at the optimal n, larger values nearer
         /// (stronger warp), 0 gives a uniform map.
         strength: f32 = 1.0, range(0.0, 4.0), step(0.05);
-        /// Filter: none, hardware 2x2, 3x3 or 5x5 grid PCF, rotated Poisson disc, or PCSS.
+        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
         filter: Filter = Filter::Pcf3x3;
         /// Slope-scaled depth bias of the depth pass.
         slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
@@ -51,7 +50,7 @@ zoo_host::technique_params! {
         /// Smallest near plane of the virtual camera, as a fraction of the view's far depth
         /// (a nearer plane warps harder and loses depth precision).
         near_fraction: f32 = 0.002, range(0.0001, 0.1), step(0.0001);
-        /// Filter: none, hardware 2x2, 3x3 or 5x5 grid PCF, rotated Poisson disc, or PCSS.
+        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
         filter: Filter = Filter::Pcf3x3;
         /// Slope-scaled depth bias of the depth pass.
         slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
@@ -178,13 +177,10 @@ impl LayerPlan for WarpedLayers {
 struct WarpedLight {
     light: u32,
     layer: u32,
-    filter_mode: u32,
     diagnostics: u32,
     resolution: f32,
+    map_filter: MapFilter,
     normal_offset: f32,
-    kernel_texels: f32,
-    search_texels: f32,
-    light_size: f32,
     _pad: [f32; 3],
 }
 
@@ -192,13 +188,11 @@ const SHADER: &str = "pssm/warped.wgsl";
 const DIAGNOSTICS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const DENSITY_VIEW: &str = "texel density";
 
-/// Pipelines, maps and uniforms, built at the first `prepare`.
+/// Maps and the lookup, built at the first `prepare`.
 struct Gpu {
     maps: ShadowMapSet,
-    uniforms: UniformSlots<WarpedLight>,
-    /// Without and with diagnostics written.
-    lookup: [wgpu::RenderPipeline; 2],
-    filter_codes: ChoiceCodes,
+    lookup: LookupPass<WarpedLight>,
+    filters: MapFilters,
     density: (wgpu::Texture, wgpu::TextureView),
     fallbacks: u32,
 }
@@ -239,28 +233,17 @@ impl WarpedMaps {
         };
         let label = format!("{} maps", self.id);
         let maps = ShadowMapSet::new(ctx, &label, state, None)?;
-        let stage = wgpu::ShaderStages::FRAGMENT;
-        let uniforms = UniformSlots::new(ctx.gpu, &format!("{} lights", self.id), 1, stage);
-        let module = ctx.shaders.create_module(&ctx.gpu.device, SHADER)?;
-        let source = ctx.shaders.compose(SHADER)?.source;
-        let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
-            .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
-        let groups = [uniforms.layout(), maps.lookup_layout()];
-        let label = format!("{} lookup", self.id);
-        let lookup = SlotPipeline {
-            label: &label,
-            module: &module,
+        let shader = LookupShader {
+            shader: SHADER,
             entry: "fs_warped",
-            groups: &groups,
-            more_targets: &[],
+            diagnostics: &[DIAGNOSTICS_FORMAT],
             depth_stencil: None,
+            groups: &[],
         };
-        let lookup = diagnostics_pipelines(ctx, lookup, &[DIAGNOSTICS_FORMAT]);
         Ok(Gpu {
+            lookup: LookupPass::new(ctx, &maps, &self.lookup_pass(), shader)?,
             maps,
-            uniforms,
-            lookup,
-            filter_codes,
+            filters: MapFilters::read(ctx.shaders)?,
             density: density_target(&ctx.gpu.device, ctx.size),
             fallbacks: 0,
         })
@@ -272,9 +255,8 @@ impl ShadowTechnique for WarpedMaps {
         let Some(gpu) = &self.gpu else {
             return Vec::new();
         };
-        let lookup = self.lookup_pass();
         let shadowed = gpu.maps.lights().iter().filter(|l| !l.frustums.is_empty());
-        let lookups = shadowed.map(|l| light_pass_name(&lookup, l.light));
+        let lookups = shadowed.map(|l| gpu.lookup.pass_name(l.light));
         let names = gpu
             .maps
             .pass_names(&self.map_pass())
@@ -336,63 +318,31 @@ impl ShadowTechnique for WarpedMaps {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
-        let (map_pass, lookup_pass) = (self.map_pass(), self.lookup_pass());
+        let map_pass = self.map_pass();
         let s = self.settings;
         let Gpu {
             maps,
-            uniforms,
             lookup,
-            filter_codes,
+            filters,
             density,
             ..
         } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
-        let group = maps
-            .lookup_group()
-            .ok_or_else(TechniqueError::not_prepared)?;
         maps.record(ctx, recorder, &map_pass)?;
-        let filter_mode = filter_codes.code(s.filter.index());
-        let debug_light = maps.debug_light(s.debug_light).map(|l| l.light);
-        let shadowed: Vec<_> = (maps.lights().iter())
-            .filter(|l| !l.frustums.is_empty())
-            .collect();
-        let values: Vec<WarpedLight> = shadowed
-            .iter()
-            .map(|l| {
-                let light = &ctx.lights[l.light];
-                let size = match light.kind {
-                    LightKind::Directional => light.radius.tan(),
-                    _ => light.radius,
-                };
-                WarpedLight {
-                    light: l.light as u32,
-                    layer: l.first_layer,
-                    filter_mode,
-                    diagnostics: u32::from(Some(l.light) == debug_light),
-                    resolution: maps.resolution() as f32,
-                    normal_offset: s.normal_offset,
-                    kernel_texels: s.kernel_radius,
-                    search_texels: s.pcss_max_texels,
-                    light_size: size,
-                    _pad: [0.0; 3],
-                }
+        let resolution = maps.resolution() as f32;
+        // Lights without a layer (point lights, spot lights under LiSPSM) are not shadowed.
+        let uniform = |l: &LightMaps, debug| {
+            let size = light_size(&ctx.lights[l.light]);
+            (!l.frustums.is_empty()).then(|| WarpedLight {
+                light: l.light as u32,
+                layer: l.first_layer,
+                diagnostics: u32::from(debug),
+                resolution,
+                map_filter: filters.filter(s.filter, s.kernel_radius, s.pcss_max_texels, size),
+                normal_offset: s.normal_offset,
+                _pad: [0.0; 3],
             })
-            .collect();
-        uniforms.write(ctx.gpu, &values);
-        for (k, light_maps) in shadowed.iter().enumerate() {
-            let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
-            let targets = [zoo_host::gpu::color_attachment(&density.1, clear)];
-            let name = light_pass_name(&lookup_pass, light_maps.light);
-            let mut pass = ctx.light_pass_with(recorder, &name, light_maps.light, &targets, None);
-            pass.set_pipeline(&lookup[values[k].diagnostics as usize]);
-            pass.set_bind_group(2, uniforms.bind_group(), &[uniforms.offset(k)]);
-            pass.set_bind_group(3, group, &[]);
-            let [x, y, width, height] = light_maps.scissor;
-            if width > 0 && height > 0 {
-                pass.set_scissor_rect(x, y, width, height);
-                pass.draw(0..3, 0..1);
-            }
-        }
-        Ok(())
+        };
+        lookup.record(ctx, recorder, maps, s.debug_light, &[&density.1], uniform)
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -486,15 +436,11 @@ mod tests {
         let (size, fields) = zoo_host::mirror_fields!(WarpedLight {
             light,
             layer,
-            filter_mode,
             diagnostics,
             resolution,
-            normal_offset,
-            kernel_texels,
-            search_texels,
-            light_size
+            map_filter,
+            normal_offset
         });
         check_mirror(&source, "WarpedLight", size, &fields, SizeRule::Equal).unwrap();
-        ChoiceCodes::read(&source, "FILTER", Filter::NAMES).unwrap();
     }
 }

@@ -11,16 +11,12 @@
 //! come from the shadow-map library.
 
 use zoo_host::glam::UVec2;
-use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
-use zoo_shadow_maps::{DepthState, LightMaps, MapHeader, ShadowMapSet, light_size};
-
-zoo_host::param_choice! {
-    /// How shadow-map comparisons are filtered.
-    pub enum Filter { None, Hardware2x2, Pcf3x3, Pcf5x5, Pcf7x7, Pcf9x9, Poisson, Pcss }
-}
+use zoo_shadow_maps::{
+    DepthState, Filter, LightMaps, LookupPass, LookupShader, MapFilter, MapFilters, MapHeader,
+    ShadowMapSet, light_size,
+};
 
 zoo_host::technique_params! {
     /// Parameters of shadow maps with PCF.
@@ -55,10 +51,7 @@ zoo_host::technique_params! {
 #[repr(C)]
 struct ShadowLight {
     map: MapHeader,
-    filter_mode: u32,
-    kernel_texels: f32,
-    light_size: f32,
-    search_texels: f32,
+    map_filter: MapFilter,
     debug: u32,
     _pad: [f32; 3],
 }
@@ -69,14 +62,11 @@ const DEPTH_PASS: &str = "Shadow map";
 const LOOKUP_PASS: &str = "Shadow lookup";
 const DIAGNOSTICS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// Maps, pipelines and per-light uniforms, built at the first `prepare`.
+/// Maps and the lookup, built at the first `prepare`.
 struct Gpu {
     maps: ShadowMapSet,
-    uniforms: UniformSlots<ShadowLight>,
-    /// Without and with diagnostics written.
-    lookup: [wgpu::RenderPipeline; 2],
-    /// The lookup's value of each `Filter` (its `FILTER_*` constants).
-    filter_codes: ChoiceCodes,
+    lookup: LookupPass<ShadowLight>,
+    filters: MapFilters,
     /// Coverage (r) and receiver minus stored depth in texels (g), for the debug light.
     diagnostics: (wgpu::Texture, wgpu::TextureView),
 }
@@ -101,27 +91,17 @@ impl Gpu {
             ..DepthState::default()
         };
         let maps = ShadowMapSet::new(ctx, "sm-pcf shadow maps", state, None)?;
-        let stage = wgpu::ShaderStages::FRAGMENT;
-        let uniforms = UniformSlots::new(ctx.gpu, "sm-pcf lights", ctx.lights.len(), stage);
-        let module = ctx.shaders.create_module(&ctx.gpu.device, SHADER)?;
-        let source = ctx.shaders.compose(SHADER)?.source;
-        let filter_codes = ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
-            .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
-        let groups = [uniforms.layout(), maps.lookup_layout()];
-        let lookup = SlotPipeline {
-            label: "sm-pcf lookup",
-            module: &module,
+        let shader = LookupShader {
+            shader: SHADER,
             entry: "fs_lookup",
-            groups: &groups,
-            more_targets: &[],
+            diagnostics: &[DIAGNOSTICS_FORMAT],
             depth_stencil: None,
+            groups: &[],
         };
-        let lookup = diagnostics_pipelines(ctx, lookup, &[DIAGNOSTICS_FORMAT]);
         Ok(Gpu {
+            lookup: LookupPass::new(ctx, &maps, LOOKUP_PASS, shader)?,
             maps,
-            uniforms,
-            lookup,
-            filter_codes,
+            filters: MapFilters::read(ctx.shaders)?,
             diagnostics: diagnostics_target(&ctx.gpu.device, ctx.size),
         })
     }
@@ -130,17 +110,17 @@ impl Gpu {
 /// The lookup's uniform for one light's maps.
 fn shadow_light(
     p: &SmParams,
+    filters: &MapFilters,
     maps: &LightMaps,
     light: &zoo_host::Light,
     resolution: u32,
+    debug: bool,
 ) -> ShadowLight {
+    let size = light_size(light);
     ShadowLight {
         map: MapHeader::new(maps, resolution, p.normal_offset),
-        filter_mode: 0,
-        kernel_texels: p.kernel_radius,
-        light_size: light_size(light),
-        search_texels: p.pcss_max_texels,
-        debug: u32::from(maps.light as u32 == p.debug_light),
+        map_filter: filters.filter(p.filter, p.kernel_radius, p.pcss_max_texels, size),
+        debug: u32::from(debug),
         _pad: [0.0; 3],
     }
 }
@@ -160,7 +140,7 @@ impl ShadowTechnique for ShadowMaps {
             .maps
             .lights()
             .iter()
-            .map(|l| light_pass_name(LOOKUP_PASS, l.light));
+            .map(|l| gpu.lookup.pass_name(l.light));
         let names = gpu.maps.pass_names(DEPTH_PASS).into_iter().chain(lookups);
         names.map(PassInfo::render).collect()
     }
@@ -191,7 +171,7 @@ impl ShadowTechnique for ShadowMaps {
         }
         out.push(ResourceInfo::buffer(
             "shadow lights",
-            gpu.uniforms.buffer(),
+            gpu.lookup.uniform_buffer(),
             "ShadowLight",
         ));
         out
@@ -227,38 +207,24 @@ impl ShadowTechnique for ShadowMaps {
         let p = &self.params;
         let Gpu {
             maps,
-            uniforms,
             lookup,
-            filter_codes,
+            filters,
             diagnostics,
         } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
-        let group = maps
-            .lookup_group()
-            .ok_or_else(TechniqueError::not_prepared)?;
         maps.record(ctx, recorder, DEPTH_PASS)?;
-        let filter_mode = filter_codes.code(p.filter.index());
-        let values: Vec<ShadowLight> = (maps.lights().iter())
-            .map(|l| ShadowLight {
-                filter_mode,
-                ..shadow_light(p, l, &ctx.lights[l.light], maps.resolution())
-            })
-            .collect();
-        uniforms.write(ctx.gpu, &values);
-        for (k, light_maps) in maps.lights().iter().enumerate() {
-            let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
-            let targets = [zoo_host::gpu::color_attachment(&diagnostics.1, clear)];
-            let name = light_pass_name(LOOKUP_PASS, light_maps.light);
-            let mut pass = ctx.light_pass_with(recorder, &name, light_maps.light, &targets, None);
-            pass.set_pipeline(&lookup[values[k].debug as usize]);
-            pass.set_bind_group(2, uniforms.bind_group(), &[uniforms.offset(k)]);
-            pass.set_bind_group(3, group, &[]);
-            let [x, y, width, height] = light_maps.scissor;
-            if width > 0 && height > 0 {
-                pass.set_scissor_rect(x, y, width, height);
-                pass.draw(0..3, 0..1);
-            }
-        }
-        Ok(())
+        let resolution = maps.resolution();
+        let uniform = |l: &LightMaps, debug| {
+            let light = &ctx.lights[l.light];
+            Some(shadow_light(p, filters, l, light, resolution, debug))
+        };
+        lookup.record(
+            ctx,
+            recorder,
+            maps,
+            p.debug_light,
+            &[&diagnostics.1],
+            uniform,
+        )
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -325,22 +291,10 @@ mod tests {
     }
 
     #[test]
-    fn every_filter_has_a_distinct_shader_constant() {
-        let codes = ChoiceCodes::read(&shader(), "FILTER", Filter::NAMES).unwrap();
-        let mut values: Vec<u32> = (0..Filter::NAMES.len()).map(|i| codes.code(i)).collect();
-        values.sort();
-        values.dedup();
-        assert_eq!(values.len(), Filter::NAMES.len());
-    }
-
-    #[test]
     fn shadow_light_mirrors_the_shader() {
         let (size, fields) = zoo_host::mirror_fields!(ShadowLight {
             map,
-            filter_mode,
-            kernel_texels,
-            light_size,
-            search_texels,
+            map_filter,
             debug
         });
         check_mirror(&shader(), "ShadowLight", size, &fields, SizeRule::Equal).unwrap();

@@ -1,0 +1,96 @@
+//! The shadow-map filters as one choice: [`Filter`] for parameters, [`MapFilter`] (the WGSL
+//! `MapFilter` of `shaders/shadow-maps/filters.wgsl`) in a light's lookup uniform, and
+//! [`MapFilters`], which reads the shader's `FILTER_*` codes so no number is kept twice.
+
+use zoo_host::ShaderLibrary;
+use zoo_host::gpu::layout::ChoiceCodes;
+use zoo_host::prelude::*;
+
+/// The library shader that declares the filters and their codes (`filters.wgsl`), composed
+/// with a map access (the filters call the importer's taps, so they do not stand alone).
+const FILTERS: &str = "shadow-maps/header_lookup.wgsl";
+
+zoo_host::param_choice! {
+    /// How shadow-map comparisons are filtered: one tap, the hardware's bilinear 2x2, an N x N
+    /// grid, a rotated Poisson disc, or PCSS (penumbrae sized by the blocker distance).
+    pub enum Filter { None, Hardware2x2, Pcf3x3, Pcf5x5, Pcf7x7, Pcf9x9, Poisson, Pcss }
+}
+
+/// One light's filter as a lookup reads it (`MapFilter` in `shadow-maps/filters.wgsl`).
+#[derive(Debug, Clone, Copy, PartialEq, zoo_host::bytemuck::Pod, zoo_host::bytemuck::Zeroable)]
+#[bytemuck(crate = "zoo_host::bytemuck")]
+#[repr(C)]
+pub struct MapFilter {
+    /// The shader's code of the [`Filter`].
+    pub mode: u32,
+    /// Poisson disc radius, in texels.
+    pub kernel_texels: f32,
+    /// Largest PCSS blocker search and penumbra radius, in texels.
+    pub search_texels: f32,
+    /// Radius (point, spot) or tangent of the angular radius (directional), for PCSS.
+    pub light_size: f32,
+}
+
+/// The filters' shader codes, read from the shader library in use.
+#[derive(Debug, Clone)]
+pub struct MapFilters(ChoiceCodes);
+
+impl MapFilters {
+    /// Reads the `FILTER_*` constants of `shadow-maps/filters.wgsl`.
+    pub fn read(shaders: &ShaderLibrary) -> TechniqueResult<MapFilters> {
+        let source = shaders.compose(FILTERS)?.source;
+        ChoiceCodes::read(&source, "FILTER", Filter::NAMES)
+            .map(MapFilters)
+            .map_err(|e| TechniqueError::Other(format!("{FILTERS}: {e}")))
+    }
+
+    /// `filter` with its radii in texels and the light's size (see [`crate::light_size`]).
+    pub fn filter(
+        &self,
+        filter: Filter,
+        kernel_texels: f32,
+        search_texels: f32,
+        light_size: f32,
+    ) -> MapFilter {
+        MapFilter {
+            mode: self.0.code(filter.index()),
+            kernel_texels,
+            search_texels,
+            light_size,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    fn shader() -> String {
+        ShaderLibrary::embedded().compose(FILTERS).unwrap().source
+    }
+
+    #[test]
+    fn every_filter_has_a_distinct_shader_code() {
+        let filters = MapFilters::read(&ShaderLibrary::embedded()).unwrap();
+        let mut codes: Vec<u32> = Filter::NAMES
+            .iter()
+            .enumerate()
+            .map(|(i, _)| filters.0.code(i))
+            .collect();
+        codes.sort();
+        codes.dedup();
+        assert_eq!(codes.len(), Filter::NAMES.len());
+    }
+
+    #[test]
+    fn map_filter_mirrors_the_shader() {
+        let (size, fields) = zoo_host::mirror_fields!(MapFilter {
+            mode,
+            kernel_texels,
+            search_texels,
+            light_size
+        });
+        check_mirror(&shader(), "MapFilter", size, &fields, SizeRule::Equal).unwrap();
+    }
+}
