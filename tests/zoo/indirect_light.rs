@@ -8,8 +8,8 @@ use zoo_host::judging::{SceneReference, judge_technique, shade_on_cpu};
 use zoo_host::params::ParamValues;
 use zoo_host::test_support::{gpu, scene_path};
 use zoo_host::{
-    Changes, DebugVolume, GpuContext, LightKind, PassInfo, PassRecorder, RenderContext, Renderer,
-    Scene, ShadowTechnique, TechniqueResult, View, ViewMapping, VolumeAxis, VolumeSlice,
+    Changes, DebugVolume, GpuContext, LightKind, PassRecorder, RenderContext, Renderer, Scene,
+    ShadowTechnique, TechniqueResult, View, ViewMapping, VolumeAxis, VolumeSlice,
 };
 
 const INDIRECT: [f64; 3] = [0.3, 0.2, 0.1];
@@ -18,9 +18,6 @@ const INDIRECT: [f64; 3] = [0.3, 0.2, 0.1];
 struct ConstantIndirect;
 
 impl ShadowTechnique for ConstantIndirect {
-    fn passes(&self) -> Vec<PassInfo> {
-        vec![PassInfo::render("Constant indirect")]
-    }
     fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> TechniqueResult {
         Ok(())
     }
@@ -46,9 +43,6 @@ struct Volume {
 }
 
 impl ShadowTechnique for Volume {
-    fn passes(&self) -> Vec<PassInfo> {
-        Vec::new()
-    }
     fn prepare(&mut self, ctx: &RenderContext<'_>, _: Changes) -> TechniqueResult {
         use zoo_host::wgpu;
         let size = wgpu::Extent3d {

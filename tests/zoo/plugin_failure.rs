@@ -6,8 +6,8 @@ use zoo_host::params::{ParamSpec, ParamValues};
 use zoo_host::technique::TechniqueRegistration;
 use zoo_host::test_support::{gpu, scene_path};
 use zoo_host::{
-    Changes, GpuContext, LightKind, PassInfo, PassRecorder, RenderContext, Renderer, Scene,
-    ShadowTechnique, TechniqueError, View, render::RenderError,
+    Changes, GpuContext, LightKind, PassRecorder, RenderContext, Renderer, Scene, ShadowTechnique,
+    TechniqueError, View, render::RenderError,
 };
 
 enum Failure {
@@ -18,9 +18,6 @@ enum Failure {
 struct Failing(Failure);
 
 impl ShadowTechnique for Failing {
-    fn passes(&self) -> Vec<PassInfo> {
-        vec![PassInfo::render("Failing pass")]
-    }
     fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> Result<(), TechniqueError> {
         Ok(())
     }

@@ -9,8 +9,8 @@ use zoo_host::params::ParamValues;
 use zoo_host::render::{SlotAssignment, SlotRequest};
 use zoo_host::test_support::{gpu, scene_from_ron};
 use zoo_host::{
-    Changes, GpuContext, LightKind, PassInfo, PassRecorder, RenderContext, Renderer, Scene,
-    ShadowTechnique, TechniqueError, TechniqueResult, View, render::RenderError,
+    Changes, GpuContext, LightKind, PassRecorder, RenderContext, Renderer, Scene, ShadowTechnique,
+    TechniqueError, TechniqueResult, View, render::RenderError,
 };
 
 static ASKED: AtomicUsize = AtomicUsize::new(0);
@@ -19,9 +19,6 @@ static ASKED: AtomicUsize = AtomicUsize::new(0);
 struct ByCamera;
 
 impl ShadowTechnique for ByCamera {
-    fn passes(&self) -> Vec<PassInfo> {
-        Vec::new()
-    }
     fn assign_slots(&self, request: &SlotRequest<'_>) -> TechniqueResult<SlotAssignment> {
         ASKED.fetch_add(1, Ordering::SeqCst);
         if request.camera.position.x > 0.0 {
@@ -47,9 +44,6 @@ impl ShadowTechnique for ByCamera {
 struct RedFilter;
 
 impl ShadowTechnique for RedFilter {
-    fn passes(&self) -> Vec<PassInfo> {
-        vec![PassInfo::render("Red filter")]
-    }
     fn writes_transmittance(&self, _: &Scene) -> bool {
         true
     }

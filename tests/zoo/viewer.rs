@@ -9,7 +9,7 @@ use zoo_host::glam::UVec2;
 use zoo_host::params::{ParamSpec, ParamValue, ParamValues};
 use zoo_host::test_support::{gpu, scene_path};
 use zoo_host::{
-    Changes, GpuContext, LightKind, PassInfo, PassRecorder, RenderContext, Scene, ShadowTechnique,
+    Changes, GpuContext, LightKind, PassRecorder, RenderContext, Scene, ShadowTechnique,
     TechniqueError,
 };
 
@@ -17,9 +17,6 @@ use zoo_host::{
 struct Panics;
 
 impl ShadowTechnique for Panics {
-    fn passes(&self) -> Vec<PassInfo> {
-        Vec::new()
-    }
     fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> Result<(), TechniqueError> {
         Ok(())
     }

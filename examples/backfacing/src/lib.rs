@@ -24,10 +24,6 @@ struct Backfacing {
 }
 
 impl ShadowTechnique for Backfacing {
-    fn passes(&self) -> Vec<PassInfo> {
-        self.pass.as_ref().map_or(Vec::new(), |p| p.passes(NAME))
-    }
-
     fn prepare(&mut self, ctx: &RenderContext<'_>, _: Changes) -> TechniqueResult {
         FullscreenLightPass::ensure(&mut self.pass, ctx, "backfacing/mask.wgsl", "fs_main")?;
         Ok(())

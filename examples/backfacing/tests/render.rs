@@ -26,16 +26,16 @@ fn surfaces_facing_away_get_the_darkness_and_the_others_stay_lit() {
         "backfacing",
         "the technique was disabled"
     );
-    // One pass per light, recorded under the names it declares.
+    // One pass per light.
     let recorded = timings.technique_pass_names();
-    let declared: Vec<String> = renderer
-        .technique_instance()
-        .passes()
-        .into_iter()
-        .map(|p| p.name)
-        .collect();
-    assert_eq!(recorded, declared);
-    assert_eq!(declared.len(), 3);
+    assert_eq!(
+        recorded,
+        [
+            "Back-facing test: light 0",
+            "Back-facing test: light 1",
+            "Back-facing test: light 2"
+        ]
+    );
     let g = renderer.read_gbuffer();
     // The three lights share one layer's channels: each pass must leave the others alone.
     assert_eq!(renderer.slots().slot_count(), 3);

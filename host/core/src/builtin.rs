@@ -3,7 +3,7 @@
 use crate::gpu::{GpuContext, PassRecorder};
 use crate::params::{ParamSpec, ParamValues};
 use crate::scene::LightKind;
-use crate::technique::{Changes, PassInfo, RenderContext, ShadowTechnique, TechniqueError};
+use crate::technique::{Changes, RenderContext, ShadowTechnique, TechniqueError};
 
 /// Id of the baseline technique.
 pub const UNSHADOWED_ID: &str = "unshadowed";
@@ -12,10 +12,6 @@ pub const UNSHADOWED_ID: &str = "unshadowed";
 pub struct Unshadowed;
 
 impl ShadowTechnique for Unshadowed {
-    fn passes(&self) -> Vec<PassInfo> {
-        Vec::new()
-    }
-
     fn assign_slots(
         &self,
         request: &crate::render::SlotRequest<'_>,

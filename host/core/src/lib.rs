@@ -24,9 +24,9 @@ pub use params::{ParamSpec, ParamValue, ParamValues, TechniqueParams};
 pub use render::{Renderer, View};
 pub use scene::{Camera, Light, LightKind, MAX_LIGHTS, Scene};
 pub use technique::{
-    Changes, DebugImage, DebugVolume, ParamUpdate, PassInfo, RenderContext, ResourceInfo,
-    ShadowTechnique, TechniqueError, TechniqueRegistration, TechniqueResult, ViewMapping,
-    VolumeAxis, VolumeSlice, find_technique, registry,
+    Changes, DebugImage, DebugVolume, ParamUpdate, RenderContext, ResourceInfo, ShadowTechnique,
+    TechniqueError, TechniqueRegistration, TechniqueResult, ViewMapping, VolumeAxis, VolumeSlice,
+    find_technique, registry,
 };
 
 /// What a technique's crate usually needs: `use zoo_host::prelude::*;`.
@@ -34,8 +34,8 @@ pub mod prelude {
     pub use crate::kit::{self, FullscreenLightPass, LightSlot, UniformSlots};
     pub use crate::params::TechniqueParams;
     pub use crate::{
-        Changes, GpuContext, LightKind, ParamUpdate, ParamValues, PassInfo, PassRecorder,
-        RenderContext, ShadowTechnique, TechniqueError, TechniqueResult,
+        Changes, GpuContext, LightKind, ParamUpdate, ParamValues, PassRecorder, RenderContext,
+        ShadowTechnique, TechniqueError, TechniqueResult,
     };
     pub use crate::{bytemuck, glam, wgpu};
 }
@@ -46,8 +46,3 @@ pub use zoo_judge as judge;
 /// Scenes, lights, meshes and adjacency (the GPU-free `zoo-scene` crate).
 pub use zoo_scene as scene;
 pub use {bytemuck, glam, image, inventory, log, serde, wgpu};
-
-/// Compiles the README's code examples ("Writing a technique") as doctests.
-#[cfg(doctest)]
-#[doc = include_str!("../../../README.md")]
-pub struct ReadmeDoctests;

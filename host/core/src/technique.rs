@@ -232,39 +232,6 @@ impl TechniqueError {
 /// The result of a technique's methods and factory (`()` unless given).
 pub type TechniqueResult<T = ()> = Result<T, TechniqueError>;
 
-/// A declared pass.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct PassInfo {
-    /// Name, equal to the label the pass is recorded with.
-    pub name: String,
-    /// Render or compute.
-    pub kind: PassKind,
-}
-
-/// Kind of GPU pass.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PassKind {
-    Render,
-    Compute,
-}
-
-impl PassInfo {
-    /// A render pass called `name`.
-    pub fn render(name: impl Into<String>) -> PassInfo {
-        PassInfo {
-            name: name.into(),
-            kind: PassKind::Render,
-        }
-    }
-    /// A compute pass called `name`.
-    pub fn compute(name: impl Into<String>) -> PassInfo {
-        PassInfo {
-            name: name.into(),
-            kind: PassKind::Compute,
-        }
-    }
-}
-
 /// What a resource is, for debug views and the memory table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ResourceKind {
@@ -446,9 +413,6 @@ pub struct RenderContext<'a> {
 /// A shadow technique instance. Created by its registration's factory; dropping it frees its
 /// GPU resources.
 pub trait ShadowTechnique: Send {
-    /// Its passes, in recording order (the names it records them with).
-    fn passes(&self) -> Vec<PassInfo>;
-
     /// Its GPU resources, for debug views and the memory table.
     fn resources(&self) -> Vec<ResourceInfo> {
         Vec::new()

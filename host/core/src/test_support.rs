@@ -24,9 +24,6 @@ pub fn gpu() -> Arc<GpuContext> {
 pub struct Inert;
 
 impl crate::ShadowTechnique for Inert {
-    fn passes(&self) -> Vec<crate::PassInfo> {
-        Vec::new()
-    }
     fn prepare(
         &mut self,
         _: &crate::RenderContext<'_>,

@@ -85,15 +85,6 @@ impl LayerBlur {
         })
     }
 
-    /// The names of the passes [`Self::record`] records for `lights`: each layer's
-    /// [`layer_pass_name`] with `base`, followed by ` (horizontal)` and ` (vertical)`.
-    pub fn pass_names(lights: &[LightMaps], base: &str) -> Vec<String> {
-        crate::depth::DepthPass::pass_names(lights, |l, k| layer_pass_name(base, l, k))
-            .into_iter()
-            .flat_map(|n| [format!("{n} (horizontal)"), format!("{n} (vertical)")])
-            .collect()
-    }
-
     /// Blurs every layer of `lights` in `maps` with a Gaussian of `radius` texels on each side
     /// (standard deviation radius / 2); nothing for radius 0. Once per frame.
     pub fn record(

@@ -84,18 +84,9 @@ pub struct DepthPass {
 }
 
 impl DepthPass {
-    /// Builds the pipeline (`label` names it and its layouts).
+    /// Builds the pipeline (`label` names it and its layouts), with a colour map written by
+    /// `color` when given.
     pub fn new(
-        ctx: &RenderContext<'_>,
-        label: &str,
-        state: DepthState,
-    ) -> Result<DepthPass, TechniqueError> {
-        Self::with_color(ctx, label, state, None)
-    }
-
-    /// As [`Self::new`], with a colour map written by `color` (record with
-    /// [`Self::record_color`]).
-    pub fn with_color(
         ctx: &RenderContext<'_>,
         label: &str,
         state: DepthState,
@@ -245,66 +236,13 @@ impl DepthPass {
         self.cameras.as_ref().map(|(buffer, _)| buffer)
     }
 
-    /// The names of the passes [`Self::record`] records for `lights`, in order.
-    pub fn pass_names(
-        lights: &[LightMaps],
-        name: impl Fn(&LightMaps, usize) -> String,
-    ) -> Vec<String> {
-        let mut names = Vec::new();
-        for light_maps in lights {
-            for layer in 0..light_maps.frustums.len() {
-                names.push(name(light_maps, layer));
-            }
-        }
-        names
-    }
-
-    /// Records one depth pass per layer of `lights` into `maps`, named by
-    /// `name(light_maps, layer)` (`layer` counts within the light's layers).
+    /// Records one pass per layer of `lights` that `keep` accepts (by layer index), into the
+    /// depth layers of `depth` and, for a pass with a [`ColorOutput`], the colour layers of
+    /// `color` (`depth` is then one scratch layer of the same resolution, cleared for every
+    /// layer). Passes are named by `name(light_maps, layer)` (`layer` counts within the
+    /// light's layers).
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
-        &self,
-        ctx: &RenderContext<'_>,
-        recorder: &mut PassRecorder<'_>,
-        maps: &MapArray,
-        lights: &[LightMaps],
-        name: impl Fn(&LightMaps, usize) -> String,
-    ) -> Result<(), TechniqueError> {
-        self.record_into(ctx, recorder, None, maps, lights, name, &|_| true)
-    }
-
-    /// As [`Self::record`] for a pass with a [`ColorOutput`]: the colour goes into the layers
-    /// of `color`, and `depth` (one layer of the same resolution, cleared for every layer) is
-    /// the depth test's scratch.
-    pub fn record_color(
-        &self,
-        ctx: &RenderContext<'_>,
-        recorder: &mut PassRecorder<'_>,
-        color: &MapArray,
-        depth: &MapArray,
-        lights: &[LightMaps],
-        name: impl Fn(&LightMaps, usize) -> String,
-    ) -> Result<(), TechniqueError> {
-        self.record_into(ctx, recorder, Some(color), depth, lights, name, &|_| true)
-    }
-
-    /// As [`Self::record`] or [`Self::record_color`] (with `color`), rendering only the layers
-    /// `keep` accepts (by layer index), for techniques that cull layers the view cannot see.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_kept(
-        &self,
-        ctx: &RenderContext<'_>,
-        recorder: &mut PassRecorder<'_>,
-        color: Option<&MapArray>,
-        depth: &MapArray,
-        lights: &[LightMaps],
-        name: impl Fn(&LightMaps, usize) -> String,
-        keep: &dyn Fn(u32) -> bool,
-    ) -> Result<(), TechniqueError> {
-        self.record_into(ctx, recorder, color, depth, lights, name, keep)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn record_into(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
@@ -320,7 +258,7 @@ impl DepthPass {
             .ok_or_else(TechniqueError::not_prepared)?;
         if color.is_some() != self.clear.is_some() {
             return Err(TechniqueError::Other(
-                "depth pass: colour maps go with a ColorOutput (record_color)".into(),
+                "depth pass: colour maps go with a ColorOutput".into(),
             ));
         }
         for light_maps in lights {

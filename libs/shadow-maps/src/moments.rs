@@ -13,7 +13,7 @@
 //! clear to white. The lookup (`shadow-maps/moments_lookup.wgsl`) reads the method's settings
 //! from `MomentLight` and applies the light-bleeding reduction to every method alike.
 
-use zoo_host::kit::{FullscreenLightPass, light_pass_name};
+use zoo_host::kit::FullscreenLightPass;
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 
@@ -69,7 +69,6 @@ pub struct MomentMaps {
     maps: ShadowMapSet,
     blur: LayerBlur,
     lookup: FullscreenLightPass<MomentLight>,
-    blurred: bool,
 }
 
 impl MomentMaps {
@@ -106,7 +105,6 @@ impl MomentMaps {
             blur: LayerBlur::new(ctx, &format!("{} blur", method.label), method.format)?,
             maps,
             lookup,
-            blurred: false,
         })
     }
 
@@ -131,7 +129,6 @@ impl MomentMaps {
         let lights = self.maps.lights();
         let blur = format!("{label} blur");
         (self.blur).record(ctx, recorder, maps, lights, s.blur_radius, &blur);
-        self.blurred = s.blur_radius > 0;
         let uniform = |light: usize| MomentLight {
             map: MapHeader::new(&lights[light], maps.resolution, s.normal_offset),
             bias: s.bias,
@@ -142,25 +139,6 @@ impl MomentMaps {
         let lookup = format!("{label} lookup");
         (self.lookup).record_with(ctx, recorder, &lookup, uniform, bind);
         Ok(())
-    }
-
-    /// The passes of the last [`Self::record`].
-    pub fn passes(&self) -> Vec<PassInfo> {
-        let label = self.label;
-        let mut names = self.maps.pass_names(&format!("{label} moments"));
-        if self.blurred {
-            names.extend(LayerBlur::pass_names(
-                self.maps.lights(),
-                &format!("{label} blur"),
-            ));
-        }
-        let lookup = format!("{label} lookup");
-        let lookups = (self.maps.lights().iter()).map(|l| light_pass_name(&lookup, l.light));
-        names
-            .into_iter()
-            .chain(lookups)
-            .map(PassInfo::render)
-            .collect()
     }
 
     /// The moment maps and layer cameras.

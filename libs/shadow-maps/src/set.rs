@@ -64,7 +64,7 @@ impl ShadowMapSet {
         let lookup = LookupGroup::new(&ctx.gpu.device, label, color.is_none());
         Ok(ShadowMapSet {
             label: label.to_string(),
-            depth_pass: DepthPass::with_color(ctx, label, state, color)?,
+            depth_pass: DepthPass::new(ctx, label, state, color)?,
             color_format: color.map(|c| c.format),
             lookup,
             objects: Vec::new(),
@@ -254,19 +254,6 @@ impl ShadowMapSet {
         self.kept.get(layer as usize).copied().unwrap_or(true)
     }
 
-    /// The passes [`Self::record`] records, named by [`layer_pass_name`] with `base`.
-    pub fn pass_names(&self, base: &str) -> Vec<String> {
-        let mut names = Vec::new();
-        for l in &self.lights {
-            for k in 0..l.frustums.len() {
-                if self.is_kept(l.first_layer + k as u32) {
-                    names.push(layer_pass_name(base, l, k));
-                }
-            }
-        }
-        names
-    }
-
     /// The depth maps (the depth-test scratch layer when the set has colour maps).
     pub fn depth_maps(&self) -> Option<&MapArray> {
         self.depth.as_ref()
@@ -286,6 +273,6 @@ impl ShadowMapSet {
         let name = |l: &LightMaps, k| layer_pass_name(base, l, k);
         let keep = |layer| self.is_kept(layer);
         let color = self.color.as_ref();
-        (self.depth_pass).record_kept(ctx, recorder, color, depth, &self.lights, name, &keep)
+        (self.depth_pass).record(ctx, recorder, color, depth, &self.lights, name, &keep)
     }
 }

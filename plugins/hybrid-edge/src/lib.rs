@@ -361,33 +361,6 @@ pub struct Hybrid {
 }
 
 impl ShadowTechnique for Hybrid {
-    fn passes(&self) -> Vec<PassInfo> {
-        let Some(gpu) = &self.gpu else {
-            return Vec::new();
-        };
-        let exact = self.params.restriction == Restriction::TriangleIds;
-        let mut names = gpu.maps.pass_names(if exact { IDS_PASS } else { MAP_PASS });
-        let per_light: &[&str] = match self.params.restriction {
-            Restriction::TriangleIds => &[BAND_PASS],
-            Restriction::Tiles => &[BAND_PASS, GENERATION_PASS, TILES_PASS, VOLUME_PASS],
-            _ => &[BAND_PASS, GENERATION_PASS, VOLUME_PASS],
-        };
-        for l in gpu.maps.lights() {
-            for base in per_light {
-                names.push(light_pass_name(base, l.light));
-            }
-        }
-        names
-            .into_iter()
-            .map(
-                |name| match name.starts_with(GENERATION_PASS) || name.starts_with(TILES_PASS) {
-                    true => PassInfo::compute(name),
-                    false => PassInfo::render(name),
-                },
-            )
-            .collect()
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         let Some(gpu) = &self.gpu else {
             return Vec::new();

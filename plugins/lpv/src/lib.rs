@@ -22,7 +22,7 @@ pub mod gpu;
 pub mod sh;
 
 use zoo_host::glam::Vec3;
-use zoo_host::kit::{ComputeStage, FullscreenLightPass, StageGroups, light_pass_name};
+use zoo_host::kit::{ComputeStage, FullscreenLightPass, StageGroups};
 use zoo_host::prelude::*;
 use zoo_host::technique::{
     DebugImage, DebugVolume, ResourceInfo, ViewMapping, VolumeAxis, VolumeSlice,
@@ -289,8 +289,6 @@ struct Gpu {
     groups: Option<Groups>,
     /// Lights with a reflective shadow map, one per layer.
     rsm_lights: Vec<usize>,
-    /// What the debug pass draws this frame: the volume (true) or the bounds (false).
-    debug_pass: Option<bool>,
 }
 
 impl Gpu {
@@ -322,7 +320,6 @@ impl Gpu {
             debug: None,
             groups: None,
             rsm_lights: Vec::new(),
-            debug_pass: None,
         })
     }
 }
@@ -368,46 +365,6 @@ fn light_scale(
 }
 
 impl ShadowTechnique for Lpv {
-    fn passes(&self) -> Vec<PassInfo> {
-        let Some(gpu) = &self.gpu else {
-            return Vec::new();
-        };
-        let mut passes: Vec<PassInfo> = gpu
-            .maps
-            .pass_names(MAP_PASS)
-            .into_iter()
-            .map(PassInfo::render)
-            .collect();
-        passes.extend(
-            gpu.rsm_lights
-                .iter()
-                .map(|&l| PassInfo::render(light_pass_name(gpu::RSM_PASS, l))),
-        );
-        passes.push(PassInfo::compute(gpu::INJECT_PASS));
-        if self.params.occlusion && self.params.camera_occluders {
-            passes.push(PassInfo::compute(gpu::CAMERA_OCCLUDERS_PASS));
-        }
-        passes.push(PassInfo::compute(gpu::RESOLVE_PASS));
-        if self.params.emitter_orientation {
-            passes.extend(spread_pass_names().into_iter().map(PassInfo::compute));
-        }
-        for i in 0..self.params.iterations {
-            passes.push(PassInfo::compute(format!(
-                "{} {}",
-                gpu::PROPAGATE_PASS,
-                i + 1
-            )));
-        }
-        passes.push(PassInfo::compute(gpu::LOOKUP_PASS));
-        passes.extend(gpu.shadows.passes(SHADOW_PASS));
-        match gpu.debug_pass {
-            Some(true) => passes.push(PassInfo::compute(gpu::DEBUG_VOLUME_PASS)),
-            Some(false) => passes.push(PassInfo::compute(gpu::DEBUG_BOUNDS_PASS)),
-            None => {}
-        }
-        passes
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         let Some(gpu) = &self.gpu else {
             return Vec::new();
@@ -633,7 +590,6 @@ impl ShadowTechnique for Lpv {
             .record_with(ctx, recorder, SHADOW_PASS, shadow, bind);
         // Debug views.
         let shown = ctx.debug_view;
-        gpu.debug_pass = None;
         if let Some(name) = shown {
             let volume = VOLUME_VIEWS.iter().position(|v| *v == name);
             if let Some(source) = volume {
@@ -652,7 +608,6 @@ impl ShadowTechnique for Lpv {
                     &[],
                     [g, g, g],
                 );
-                gpu.debug_pass = Some(true);
             } else if name == "cascade bounds" {
                 let stage = &gpu.stages.debug_bounds;
                 stage.dispatch(
@@ -663,7 +618,6 @@ impl ShadowTechnique for Lpv {
                     &[],
                     screen,
                 );
-                gpu.debug_pass = Some(false);
             }
         }
         Ok(())

@@ -155,10 +155,6 @@ fn settings(method: &Method, p: &MomentParams, half: bool) -> MomentSettings {
 }
 
 impl ShadowTechnique for MomentShadows {
-    fn passes(&self) -> Vec<PassInfo> {
-        self.maps.as_ref().map_or(Vec::new(), MomentMaps::passes)
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         self.maps.as_ref().map_or(Vec::new(), MomentMaps::resources)
     }

@@ -19,8 +19,8 @@ use zoo_host::render::visibility::VISIBILITY_FORMAT;
 use zoo_host::scene::{LightKind, Scene};
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
-    Changes, GpuContext, ParamUpdate, ParamValues, PassInfo, PassRecorder, RenderContext,
-    ShadowTechnique, TechniqueError, wgpu,
+    Changes, GpuContext, ParamUpdate, ParamValues, PassRecorder, RenderContext, ShadowTechnique,
+    TechniqueError, wgpu,
 };
 
 use crate::matrix::shadow_matrix;
@@ -289,13 +289,6 @@ fn pass_name(light: usize) -> String {
 }
 
 impl ShadowTechnique for Planar {
-    fn passes(&self) -> Vec<PassInfo> {
-        self.lights
-            .iter()
-            .map(|l| PassInfo::render(pass_name(l.light)))
-            .collect()
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         let mut out = Vec::new();
         if let Some((texture, _)) = &self.plane_ids {

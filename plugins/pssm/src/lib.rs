@@ -189,16 +189,6 @@ fn light_uniform(
 }
 
 impl ShadowTechnique for Pssm {
-    fn passes(&self) -> Vec<PassInfo> {
-        let Some(gpu) = &self.gpu else {
-            return Vec::new();
-        };
-        let shadowed = gpu.maps.lights().iter().filter(|l| !l.frustums.is_empty());
-        let lookups = shadowed.map(|l| gpu.lookup.pass_name(l.light));
-        let names = gpu.maps.pass_names(MAP_PASS).into_iter().chain(lookups);
-        names.map(PassInfo::render).collect()
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         let Some(gpu) = &self.gpu else {
             return Vec::new();

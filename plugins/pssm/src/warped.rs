@@ -251,20 +251,6 @@ impl WarpedMaps {
 }
 
 impl ShadowTechnique for WarpedMaps {
-    fn passes(&self) -> Vec<PassInfo> {
-        let Some(gpu) = &self.gpu else {
-            return Vec::new();
-        };
-        let shadowed = gpu.maps.lights().iter().filter(|l| !l.frustums.is_empty());
-        let lookups = shadowed.map(|l| gpu.lookup.pass_name(l.light));
-        let names = gpu
-            .maps
-            .pass_names(&self.map_pass())
-            .into_iter()
-            .chain(lookups);
-        names.map(PassInfo::render).collect()
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         let Some(gpu) = &self.gpu else {
             return Vec::new();

@@ -132,19 +132,6 @@ pub struct ShadowMaps {
 }
 
 impl ShadowTechnique for ShadowMaps {
-    fn passes(&self) -> Vec<PassInfo> {
-        let Some(gpu) = &self.gpu else {
-            return Vec::new();
-        };
-        let lookups = gpu
-            .maps
-            .lights()
-            .iter()
-            .map(|l| gpu.lookup.pass_name(l.light));
-        let names = gpu.maps.pass_names(DEPTH_PASS).into_iter().chain(lookups);
-        names.map(PassInfo::render).collect()
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         let Some(gpu) = &self.gpu else {
             return Vec::new();

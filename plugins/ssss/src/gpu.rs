@@ -53,8 +53,6 @@ pub const DEBUG_MODE_OFFSET: u64 = std::mem::offset_of!(Settings, debug_mode) as
 pub struct Layered {
     pub texture: wgpu::Texture,
     pub view: wgpu::TextureView,
-    /// Layers in use.
-    pub layers: u32,
 }
 
 impl Layered {
@@ -86,11 +84,7 @@ impl Layered {
             array_layer_count: Some(layers),
             ..Default::default()
         });
-        Layered {
-            texture,
-            view,
-            layers,
-        }
+        Layered { texture, view }
     }
 }
 

@@ -201,8 +201,6 @@ pub struct Ssss {
     gpu: Option<Gpu>,
     /// The layers of the current lights and camera (as assigned to the visibility slots).
     layers: Layers,
-    /// Whether the last frame drew a debug view (its pass is then among the passes).
-    debug_drawn: bool,
 }
 
 impl Ssss {
@@ -260,38 +258,6 @@ fn layer_visible(layers: &Layers, view_proj: Mat4, light: usize, frustum: Mat4) 
 }
 
 impl ShadowTechnique for Ssss {
-    fn passes(&self) -> Vec<PassInfo> {
-        let Some(gpu) = &self.gpu else {
-            return Vec::new();
-        };
-        let mut passes: Vec<PassInfo> = gpu
-            .maps
-            .pass_names(MAP_PASS)
-            .into_iter()
-            .map(PassInfo::render)
-            .collect();
-        if gpu.translucent.is_some() {
-            let names = gpu.maps.pass_names(TRANSLUCENT_PASS);
-            passes.extend(names.into_iter().map(PassInfo::render));
-        }
-        if self.params.estimate == Estimate::MinFilter && gpu.min_filter.has_work() {
-            passes.push(PassInfo::compute(gpu::MIN_FILTER_PASS));
-        }
-        passes.extend(
-            [
-                gpu::PENUMBRA_PASS,
-                gpu::BLUR_FIRST_PASS,
-                gpu::BLUR_SECOND_PASS,
-                gpu::RESOLVE_PASS,
-            ]
-            .map(PassInfo::compute),
-        );
-        if self.debug_drawn {
-            passes.push(PassInfo::compute(gpu::DEBUG_PASS));
-        }
-        passes
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         let Some(gpu) = &self.gpu else {
             return Vec::new();
@@ -466,9 +432,6 @@ impl ShadowTechnique for Ssss {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
-        self.debug_drawn = ctx
-            .debug_view
-            .is_some_and(|name| DEBUG_VIEWS.contains(&name));
         let gpu = self.gpu.as_ref().ok_or_else(TechniqueError::not_prepared)?;
         gpu.maps.record(ctx, recorder, MAP_PASS)?;
         if let Some(translucent) = &gpu.translucent {
@@ -540,7 +503,6 @@ fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn Shado
         params,
         gpu: None,
         layers: Layers::default(),
-        debug_drawn: false,
     }))
 }
 
@@ -673,7 +635,6 @@ mod tests {
             params: SsssParams::from_values(values).unwrap(),
             gpu: None,
             layers: Layers::default(),
-            debug_drawn: false,
         }
     }
 }

@@ -14,8 +14,8 @@ use zoo_host::params::TechniqueParams;
 use zoo_host::scene::LightKind;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
-    Changes, GpuContext, ParamUpdate, ParamValues, PassInfo, PassRecorder, RenderContext,
-    ShadowTechnique, TechniqueError, wgpu,
+    Changes, GpuContext, ParamUpdate, ParamValues, PassRecorder, RenderContext, ShadowTechnique,
+    TechniqueError, wgpu,
 };
 
 mod pipelines;
@@ -93,16 +93,6 @@ fn debug_pass_name(light: usize) -> String {
 }
 
 impl ShadowTechnique for ShadowVolumes {
-    fn passes(&self) -> Vec<PassInfo> {
-        let mut out = Vec::new();
-        for light in 0..self.lights {
-            out.push(PassInfo::compute(generation_pass_name(light)));
-            out.push(PassInfo::render(volume_pass_name(light)));
-            // The debug pass is recorded only while a debug view is shown.
-        }
-        out
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         let mut out = self
             .pipelines

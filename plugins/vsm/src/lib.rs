@@ -52,10 +52,6 @@ fn settings(p: &VsmParams, format: Option<wgpu::TextureFormat>) -> MomentSetting
 }
 
 impl ShadowTechnique for Vsm {
-    fn passes(&self) -> Vec<PassInfo> {
-        self.maps.as_ref().map_or(Vec::new(), MomentMaps::passes)
-    }
-
     fn resources(&self) -> Vec<ResourceInfo> {
         self.maps.as_ref().map_or(Vec::new(), MomentMaps::resources)
     }

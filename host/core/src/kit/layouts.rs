@@ -151,26 +151,12 @@ pub fn slot_fullscreen_pipeline(
     entry: &str,
     groups: &[&wgpu::BindGroupLayout],
 ) -> wgpu::RenderPipeline {
-    slot_fullscreen_pipeline_with(ctx, label, module, entry, groups, &[])
-}
-
-/// As [`slot_fullscreen_pipeline`], with more colour targets after the slot (locations 1, 2,
-/// ...), for example diagnostics a debug view shows; open its passes with
-/// [`RenderContext::light_pass_with`].
-pub fn slot_fullscreen_pipeline_with(
-    ctx: &RenderContext<'_>,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    groups: &[&wgpu::BindGroupLayout],
-    more_targets: &[Option<wgpu::ColorTargetState>],
-) -> wgpu::RenderPipeline {
     SlotPipeline {
         label,
         module,
         entry,
         groups,
-        more_targets,
+        more_targets: &[],
         depth_stencil: None,
     }
     .build(ctx)

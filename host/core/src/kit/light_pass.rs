@@ -14,8 +14,6 @@ use crate::technique::{RenderContext, TechniqueError};
 pub struct FullscreenLightPass<T: Pod> {
     pipeline: wgpu::RenderPipeline,
     uniforms: UniformSlots<T>,
-    /// Lights at the last `new`, `ensure` or `record`.
-    lights: usize,
 }
 
 /// The name of light `light`'s pass: `"{base}: light {light}"` (passes of one family share
@@ -62,11 +60,7 @@ impl<T: Pod> FullscreenLightPass<T> {
         let mut layouts = vec![uniforms.layout()];
         layouts.extend_from_slice(groups);
         let pipeline = slot_fullscreen_pipeline(ctx, label, module, entry, &layouts);
-        FullscreenLightPass {
-            pipeline,
-            uniforms,
-            lights: ctx.lights.len(),
-        }
+        FullscreenLightPass { pipeline, uniforms }
     }
 
     /// The pass in `slot`, built there first if it is empty (a technique's `prepare` keeps
@@ -80,16 +74,7 @@ impl<T: Pod> FullscreenLightPass<T> {
         if slot.is_none() {
             *slot = Some(Self::new(ctx, shader, entry, &[])?);
         }
-        let pass = slot.as_mut().expect("just filled");
-        pass.lights = ctx.lights.len();
-        Ok(pass)
-    }
-
-    /// The passes [`Self::record`] records, one per light, named by [`light_pass_name`].
-    pub fn passes(&self, base: &str) -> Vec<crate::PassInfo> {
-        (0..self.lights)
-            .map(|light| crate::PassInfo::render(light_pass_name(base, light)))
-            .collect()
+        Ok(slot.as_mut().expect("just filled"))
     }
 
     /// Records one pass per light, named `"{base}: light {l}"` ([`light_pass_name`]), with
@@ -114,7 +99,6 @@ impl<T: Pod> FullscreenLightPass<T> {
         bind: impl Fn(usize, &mut wgpu::RenderPass<'_>),
     ) {
         let values: Vec<T> = (0..ctx.lights.len()).map(per_light).collect();
-        self.lights = values.len();
         self.uniforms.write(ctx.gpu, &values);
         for light in 0..values.len() {
             let name = light_pass_name(base, light);

@@ -23,8 +23,7 @@ pub mod uniforms;
 pub use compute::{ComputeStage, StageGroups};
 pub use layouts::{
     SlotPipeline, bind_group, bind_group_layout, diagnostics_pipelines, pipeline_layout, sampler,
-    slot_fullscreen_pipeline, slot_fullscreen_pipeline_with, storage, storage_texture, texture,
-    uniform,
+    slot_fullscreen_pipeline, storage, storage_texture, texture, uniform,
 };
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use slot::{LightSlot, slot_target};
