@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use shadow_zoo::bench::{self, BenchPlan, PathMode, parse_sweep, run_configuration};
+use zoo_host::ShaderLibrary;
 use zoo_host::glam::UVec2;
 use zoo_host::test_support::{gpu, scene_path, workspace_root};
 
@@ -41,7 +42,7 @@ fn a_tiny_run_writes_well_formed_csv_markdown_and_plots() {
     let mut p = plan(&["unshadowed", "planar"], PathMode::Camera, 3, &[]);
     p.sweeps = vec![parse_sweep("size", &["64x64".into(), "96x96".into()]).unwrap()];
     let out = temp_dir("tiny");
-    let results = bench::run_plans(&[p], &out, None).unwrap();
+    let results = bench::run_plans(&[p], &ShaderLibrary::embedded(), &out, None).unwrap();
     assert_eq!(results.len(), 4, "2 techniques x 2 sizes");
 
     let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
@@ -137,7 +138,8 @@ fn flicker_is_zero_for_a_static_camera_and_positive_for_an_unstable_configuratio
         &[("sm-pcf", "map_size", "256"), ("sm-pcf", "filter", "None")],
     );
     let config = bench::expand(&unstable).unwrap().remove(0);
-    let moving = run_configuration(&gpu, &unstable, &config, || {}).unwrap();
+    let moving =
+        run_configuration(&gpu, &ShaderLibrary::embedded(), &unstable, &config, || {}).unwrap();
     let static_plan = BenchPlan {
         path: PathMode::Static,
         ..plan(
@@ -148,7 +150,14 @@ fn flicker_is_zero_for_a_static_camera_and_positive_for_an_unstable_configuratio
         )
     };
     let config = bench::expand(&static_plan).unwrap().remove(0);
-    let still = run_configuration(&gpu, &static_plan, &config, || {}).unwrap();
+    let still = run_configuration(
+        &gpu,
+        &ShaderLibrary::embedded(),
+        &static_plan,
+        &config,
+        || {},
+    )
+    .unwrap();
     eprintln!(
         "flicker: moving {:?}, static {:?}",
         moving.flicker, still.flicker

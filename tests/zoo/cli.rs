@@ -2,6 +2,8 @@
 
 use std::process::{Command, Output};
 
+use zoo_host::ShaderLibrary;
+
 fn shadow_zoo(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_shadow-zoo"))
         .args(args)
@@ -64,6 +66,61 @@ fn render_writes_a_png_and_prints_the_adapter_and_timings() {
     );
     let image = image::open(&png).unwrap();
     assert_eq!((image.width(), image.height()), (96, 64));
+}
+
+/// `--shaders DIR` reads edited WGSL without a rebuild: a lookup edited to shadow everything
+/// darkens the frame; files DIR lacks come from the built-in copies; a missing DIR is an
+/// error naming it.
+#[test]
+fn render_takes_edited_shaders_from_a_folder() {
+    let dir = std::env::temp_dir().join(format!("zoo-cli-shaders-{}", std::process::id()));
+    let lookup = dir.join("shaders/sm-pcf/lookup.wgsl");
+    std::fs::create_dir_all(lookup.parent().unwrap()).unwrap();
+    let original = ShaderLibrary::embedded()
+        .source("sm-pcf/lookup.wgsl")
+        .unwrap();
+    let visibility = "out.visibility = vec4<f32>(look_up(";
+    assert!(
+        original.contains(visibility),
+        "the lookup's visibility line moved"
+    );
+    let edited = original.replace(visibility, "out.visibility = vec4<f32>(0.0 * look_up(");
+    std::fs::write(&lookup, edited).unwrap();
+    let render = |png: &str, shaders: Option<&std::path::Path>| {
+        let png = dir.join(png);
+        let mut args = vec!["render", "--technique", "sm-pcf", "--size", "64x48"];
+        args.extend(["--out", png.to_str().unwrap()]);
+        if let Some(shaders) = shaders {
+            args.extend(["--shaders", shaders.to_str().unwrap()]);
+        }
+        let out = shadow_zoo(&args);
+        assert!(out.status.success(), "{}", text(&out));
+        let image = image::open(&png).unwrap().to_luma8();
+        let sum: u64 = image.pixels().map(|p| p.0[0] as u64).sum();
+        (text(&out), sum)
+    };
+    let (_, built_in) = render("built-in.png", None);
+    let (log, edited) = render("edited.png", Some(&dir.join("shaders")));
+    assert!(log.contains("shaders: "), "{log}");
+    assert!(
+        (edited as f64) < 0.9 * built_in as f64,
+        "the edited lookup was not used: brightness {edited} against {built_in}"
+    );
+    let missing = dir.join("no-such-folder");
+    let out = shadow_zoo(&[
+        "render",
+        "--out",
+        dir.join("x.png").to_str().unwrap(),
+        "--shaders",
+        missing.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out).contains("no-such-folder: no such folder"),
+        "{}",
+        text(&out)
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

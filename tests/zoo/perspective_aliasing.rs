@@ -3,6 +3,7 @@
 //! camera path.
 
 use shadow_zoo::bench::{self, BenchPlan, PathMode, parse_sweep, run_configuration};
+use zoo_host::ShaderLibrary;
 use zoo_host::glam::UVec2;
 use zoo_host::test_support::{gpu, judge, scene_path};
 
@@ -49,7 +50,8 @@ fn stabilised_splits_flicker_less_along_the_vista_walk() {
     let gpu = gpu();
     let mut flicker = std::collections::HashMap::new();
     for config in bench::expand(&plan).unwrap() {
-        let result = run_configuration(&gpu, &plan, &config, || {}).unwrap();
+        let result =
+            run_configuration(&gpu, &ShaderLibrary::embedded(), &plan, &config, || {}).unwrap();
         eprintln!("{}: flicker {:?}", config.label(), result.flicker);
         flicker.insert(config.label(), result.flicker.unwrap());
     }

@@ -389,3 +389,28 @@ fn values_for(id: &str, assignments: &[(&str, &str)]) -> ParamValues {
     zoo_host::params::apply_assignments(&schema, &mut values, &assignments).unwrap();
     values
 }
+
+/// Every shipped technique carries its crate's README for the viewer: a title, then its
+/// parameters by name.
+#[test]
+fn every_shipped_technique_has_its_readme() {
+    for r in crate::shipped_techniques() {
+        if r.id == "unshadowed" {
+            continue;
+        }
+        assert!(
+            r.readme.starts_with("# "),
+            "{} ({}) has no README (plugins/<name>/README.md)",
+            r.id,
+            r.package
+        );
+        for spec in (r.params)() {
+            assert!(
+                r.readme.contains(&format!("`{}`", spec.key)),
+                "{}: its README does not document parameter `{}`",
+                r.id,
+                spec.key
+            );
+        }
+    }
+}

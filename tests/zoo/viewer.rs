@@ -90,6 +90,11 @@ fn clicking_a_technique_switches_it_on_the_next_frame() {
     // Its parameter panel is generated from the schema.
     assert!(harness.query_all_by_label("map_size").next().is_some());
     harness.get_by_label("cull_front");
+    // Its README opens under "About sm-pcf".
+    harness.get_by_label("About sm-pcf").click();
+    harness.run();
+    let readme = zoo_host::find_technique("sm-pcf").unwrap().readme;
+    harness.get_by_label(readme);
 }
 
 #[test]

@@ -69,6 +69,10 @@ pub struct BenchArgs {
     /// (for CPU drivers such as lavapipe, whose timestamps miss compute work).
     #[arg(long)]
     pub cpu_timing: bool,
+    /// Read WGSL from DIR first (laid out as `shaders/`; files it lacks come from the
+    /// copies built in), so edited shaders take effect without a rebuild.
+    #[arg(long, value_name = "DIR")]
+    pub shaders: Option<PathBuf>,
     /// Folder for bench.csv, summary.csv, bench.md and the plots.
     #[arg(long)]
     pub out: PathBuf,
@@ -101,6 +105,10 @@ pub struct CompareArgs {
     /// and mean over views (every view's frames stay in memory until the report: at most 64).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub views: u32,
+    /// Read WGSL from DIR first (laid out as `shaders/`; files it lacks come from the
+    /// copies built in), so edited shaders take effect without a rebuild.
+    #[arg(long, value_name = "DIR")]
+    pub shaders: Option<PathBuf>,
 }
 
 /// Arguments of `shadow-zoo render`.
@@ -133,6 +141,10 @@ pub struct RenderArgs {
     /// Print per-pass GPU times.
     #[arg(long)]
     pub timings: bool,
+    /// Read WGSL from DIR first (laid out as `shaders/`; files it lacks come from the
+    /// copies built in), so edited shaders take effect without a rebuild.
+    #[arg(long, value_name = "DIR")]
+    pub shaders: Option<PathBuf>,
 }
 
 /// What moves during a run.

@@ -106,6 +106,7 @@ fn render_sheet(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(args.scene.as_deref())?;
     check_out_folder(&args.out)?;
     let gpu = headless_gpu()?;
+    let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
     print_scene(&scene);
     let (available, unavailable) = contact_sheet::available_techniques(&gpu);
     for (id, reason) in &unavailable {
@@ -116,7 +117,7 @@ fn render_sheet(args: &RenderArgs) -> anyhow::Result<()> {
         .zip(params)
         .filter(|(r, _)| available.iter().any(|a| a.id == r.id))
         .collect();
-    let mut renderer = Renderer::new(gpu, scene, args.size)?;
+    let mut renderer = Renderer::with_shaders(gpu, scene, args.size, shaders)?;
     let sheet = contact_sheet::build(&mut renderer, &techniques, args.samples, |step| {
         println!("rendering {step}...");
     })?;
@@ -169,6 +170,7 @@ fn render_one(args: &RenderArgs, id: &str) -> anyhow::Result<()> {
     check_out_folder(&args.out)?;
 
     let gpu = headless_gpu()?;
+    let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
     print_scene(&scene);
     let unsupported: Vec<String> = scene
         .lights
@@ -177,7 +179,7 @@ fn render_one(args: &RenderArgs, id: &str) -> anyhow::Result<()> {
         .filter(|(_, l)| !technique.supports(l.kind))
         .map(|(i, l)| format!("{i} ({})", l.kind.name()))
         .collect();
-    let mut renderer = Renderer::new(gpu, scene, args.size)?;
+    let mut renderer = Renderer::with_shaders(gpu, scene, args.size, shaders)?;
     renderer.set_technique(technique.id, &values)?;
     println!("technique: {} ({})", technique.id, technique.name);
     if !unsupported.is_empty() {

@@ -140,6 +140,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         .with_context(|| format!("output folder {} is not writable", args.out.display()))?;
 
     let gpu = headless_gpu()?;
+    let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
     let adapter = gpu.describe();
     println!(
         "scene: {} ({} triangles, {} lights); {} techniques at {}x{}, {} view{}",
@@ -155,7 +156,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let light_count = scene.lights.len();
     let scene_name = scene.name.clone();
     let triangles = scene.triangle_count();
-    let mut renderer = Renderer::new(gpu, scene, args.size)?;
+    let mut renderer = Renderer::with_shaders(gpu, scene, args.size, shaders)?;
 
     let bar = ProgressBar::new((times.len() * (light_count + techniques.len())) as u64);
     bar.set_style(

@@ -3,7 +3,8 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use zoo_host::{GpuContext, Scene};
+use anyhow::bail;
+use zoo_host::{GpuContext, Scene, ShaderLibrary};
 
 /// Loads `path`, or the built-in default scene when `None`.
 pub fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
@@ -22,4 +23,21 @@ pub fn headless_gpu() -> anyhow::Result<Arc<GpuContext>> {
     let gpu = GpuContext::new_headless()?;
     println!("adapter: {}", gpu.describe());
     Ok(Arc::new(gpu))
+}
+
+/// The shaders of `--shaders DIR` (read from there first, the built-in copies otherwise), or
+/// the built-in ones; prints where they come from.
+pub fn shader_library(dir: Option<&Path>) -> anyhow::Result<ShaderLibrary> {
+    let Some(dir) = dir else {
+        return Ok(ShaderLibrary::embedded());
+    };
+    if !dir.is_dir() {
+        bail!("--shaders {}: no such folder", dir.display());
+    }
+    let root = dir.canonicalize()?;
+    println!(
+        "shaders: {} first, then the built-in copies",
+        root.display()
+    );
+    Ok(ShaderLibrary::from_disk(root))
 }

@@ -31,7 +31,7 @@ pub use technique::{
 
 /// What a technique's crate usually needs: `use zoo_host::prelude::*;`.
 pub mod prelude {
-    pub use crate::kit::{self, FullscreenLightPass, LightSlot, UniformSlots};
+    pub use crate::kit::{self, FullscreenLightPass, LazyGpu, LightSlot, UniformSlots};
     pub use crate::params::TechniqueParams;
     pub use crate::{
         Changes, GpuContext, LightKind, ParamUpdate, ParamValues, PassRecorder, RenderContext,

@@ -29,6 +29,9 @@ pub struct TechniqueRegistration {
     pub description: &'static str,
     /// The seed, paper or thesis it follows.
     pub source: &'static str,
+    /// Its documentation (parameters, debug views, measured accuracy and cost, limits): the
+    /// crate's `README.md` through `include_str!`, shown by the viewer; empty without one.
+    pub readme: &'static str,
     /// Light kinds it computes visibility for; others are reported as unsupported.
     pub light_kinds: &'static [LightKind],
     /// Whether it adds light (indirect illumination into [`RenderContext::indirect`]) besides
@@ -72,6 +75,7 @@ impl TechniqueRegistration {
         name: "",
         description: "",
         source: "",
+        readme: "",
         light_kinds: &[],
         adds_light: false,
         required_features: wgpu::Features::empty,

@@ -234,6 +234,26 @@ impl JudgeRun {
         );
     }
 
+    /// Asserts the shadow-map family's core bounds for every light the technique scores
+    /// (lights of kinds it does not support are skipped): `false_shadow_core` at most
+    /// `false_shadow` and `false_lit_core` at most `false_lit`, printing each light's metrics.
+    pub fn assert_core_bounds(&self, false_shadow: f64, false_lit: f64) {
+        for (light, score) in self.judged.scores.iter().enumerate() {
+            let Some(m) = score.metrics else { continue };
+            eprintln!(
+                "{} {} light {light} ({}): {m:?}",
+                self.judged.technique,
+                self.scene,
+                score.kind.name()
+            );
+            let bounds = [
+                (Metric::FalseShadowCore, false_shadow),
+                (Metric::FalseLitCore, false_lit),
+            ];
+            self.assert_bounds(light, &m, &bounds);
+        }
+    }
+
     /// Mask of pixels that belong to the scene's receiver planes.
     pub fn receiver_mask(&self) -> Vec<bool> {
         let scene = &self.loaded;

@@ -357,12 +357,12 @@ fn edge_light(p: &HybridParams, maps: &LightMaps, resolution: u32, restriction: 
 /// Hybrid shadow maps and shadow volumes.
 pub struct Hybrid {
     params: HybridParams,
-    gpu: Option<Gpu>,
+    gpu: LazyGpu<Gpu>,
 }
 
 impl ShadowTechnique for Hybrid {
     fn resources(&self) -> Vec<ResourceInfo> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         let mut out = gpu.generator.resources();
@@ -396,10 +396,7 @@ impl ShadowTechnique for Hybrid {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.gpu.is_none() {
-            self.gpu = Some(Gpu::new(ctx, &self.params)?);
-        }
-        let gpu = self.gpu.as_mut().expect("built above");
+        let gpu = self.gpu.prepare(false, || Gpu::new(ctx, &self.params))?;
         if changes.resolution {
             gpu.targets = Targets::new(&ctx.gpu.device, ctx.size);
         }
@@ -429,7 +426,7 @@ impl ShadowTechnique for Hybrid {
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
         let p = &self.params;
-        let gpu = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        let gpu = self.gpu.get_mut()?;
         let exact = p.restriction == Restriction::TriangleIds;
         if exact {
             let depth = gpu.maps.maps().ok_or_else(TechniqueError::not_prepared)?;
@@ -553,7 +550,7 @@ impl ShadowTechnique for Hybrid {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        let gpu = self.gpu.as_ref()?;
+        let gpu = self.gpu.built()?;
         match resource {
             CLASS_VIEW => Some(DebugImage {
                 view: &gpu.targets.class.1,
@@ -575,7 +572,10 @@ impl ShadowTechnique for Hybrid {
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
     let params = HybridParams::from_values(values)?;
-    Ok(Box::new(Hybrid { params, gpu: None }))
+    Ok(Box::new(Hybrid {
+        params,
+        gpu: LazyGpu::default(),
+    }))
 }
 
 zoo_host::register_technique! {
@@ -583,6 +583,7 @@ zoo_host::register_technique! {
     name: "Hybrid shadow maps and volumes",
     description: "Shadow maps classify lit, shadowed and edge pixels; shadow volumes (or exact tests against the map's triangle ids) resolve only the edge band",
     source: "seed 003 (hybrid SM/SV at shadow edges)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     required_features: || wgpu::Features::DEPTH_CLIP_CONTROL,
     required_limits: || wgpu::Limits {

@@ -12,10 +12,10 @@
 //! the shadow-map library (3 x 3 PCF).
 //!
 //! Three additions to the published scheme, each measured against the judge's one-bounce
-//! reference (README, `lpv`): cells sized so that light in the coarsest grid reaches `reach`
-//! of the scene; coarser grids adding only the light beyond the next finer grid's reach; and
-//! lookups that restore the flux direction propagation diffuses away, from the mean normal of
-//! the virtual point lights nearby, so that a lit plane does not light itself.
+//! reference (`plugins/lpv/README.md`): cells sized so that light in the coarsest grid reaches
+//! `reach` of the scene; coarser grids adding only the light beyond the next finer grid's
+//! reach; and lookups that restore the flux direction propagation diffuses away, from the mean
+//! normal of the virtual point lights nearby, so that a lit plane does not light itself.
 
 pub mod cascades;
 pub mod gpu;
@@ -327,7 +327,7 @@ impl Gpu {
 /// Cascaded light propagation volumes.
 pub struct Lpv {
     params: LpvParams,
-    gpu: Option<Gpu>,
+    gpu: LazyGpu<Gpu>,
 }
 
 impl Lpv {
@@ -366,7 +366,7 @@ fn light_scale(
 
 impl ShadowTechnique for Lpv {
     fn resources(&self) -> Vec<ResourceInfo> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         let mut out = Vec::new();
@@ -409,12 +409,10 @@ impl ShadowTechnique for Lpv {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.gpu.is_none() || changes.scene {
-            self.gpu = Some(Gpu::new(ctx)?);
-        }
+        self.gpu.prepare(changes.scene, || Gpu::new(ctx))?;
         let rsm_lights = self.rsm_lights(ctx.lights);
         let p = self.params.clone();
-        let gpu = self.gpu.as_mut().expect("built above");
+        let gpu = self.gpu.get_mut()?;
         gpu.maps.prepare(ctx, changes, p.map_size, true);
         // Reflective shadow maps over the whole scene.
         let objects = object_bounds(ctx.scene, false);
@@ -489,7 +487,7 @@ impl ShadowTechnique for Lpv {
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
         let p = self.params.clone();
-        let gpu = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        let gpu = self.gpu.get_mut()?;
         let (Some(groups), Some(volumes), Some(targets)) =
             (&gpu.groups, &gpu.volumes, &gpu.rsm.targets)
         else {
@@ -624,7 +622,7 @@ impl ShadowTechnique for Lpv {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        let gpu = self.gpu.as_ref()?;
+        let gpu = self.gpu.built()?;
         if resource == "shadow maps" {
             return gpu.maps.debug_image(0);
         }
@@ -659,7 +657,7 @@ impl ShadowTechnique for Lpv {
 
     fn debug_volume(&self, resource: &str) -> Option<DebugVolume<'_>> {
         let source = VOLUME_VIEWS.iter().position(|v| *v == resource)?;
-        let gpu = self.gpu.as_ref()?;
+        let gpu = self.gpu.built()?;
         let axis = match self.params.slice_axis {
             SliceAxis::X => VolumeAxis::X,
             SliceAxis::Y => VolumeAxis::Y,
@@ -683,7 +681,7 @@ impl ShadowTechnique for Lpv {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         let mut counters = gpu.maps.counters();
@@ -806,7 +804,10 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
     let params = LpvParams::from_values(values)?;
-    Ok(Box::new(Lpv { params, gpu: None }))
+    Ok(Box::new(Lpv {
+        params,
+        gpu: LazyGpu::default(),
+    }))
 }
 
 zoo_host::register_technique! {
@@ -814,6 +815,7 @@ zoo_host::register_technique! {
     name: "Light propagation volumes",
     description: "Reflective shadow maps injected into cascaded SH grids, propagated cell to cell with a geometry volume's occlusion: one diffuse bounce; direct shadows from shadow maps",
     source: "seed 002 (Kaplanyan and Dachsbacher 2010; Dachsbacher and Stamminger 2005)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     adds_light: true,
     required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS,

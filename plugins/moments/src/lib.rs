@@ -133,7 +133,7 @@ impl Method {
 struct MomentShadows {
     method: &'static Method,
     params: MomentParams,
-    maps: Option<MomentMaps>,
+    maps: LazyGpu<MomentMaps>,
 }
 
 fn is_half(format: Option<wgpu::TextureFormat>) -> bool {
@@ -156,12 +156,13 @@ fn settings(method: &Method, p: &MomentParams, half: bool) -> MomentSettings {
 
 impl ShadowTechnique for MomentShadows {
     fn resources(&self) -> Vec<ResourceInfo> {
-        self.maps.as_ref().map_or(Vec::new(), MomentMaps::resources)
+        self.maps.built().map_or(Vec::new(), MomentMaps::resources)
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
         let method = self.method;
-        if self.maps.is_none() {
+        let params = &self.params;
+        let maps = self.maps.prepare(false, || {
             let device = &ctx.gpu.device;
             let format = if method.four {
                 filterable_rgba_format(device)
@@ -171,12 +172,11 @@ impl ShadowTechnique for MomentShadows {
             let maps = MomentMethod {
                 label: method.label,
                 shader: method.shader,
-                prelude: Method::prelude(&self.params, is_half(Some(format))),
+                prelude: Method::prelude(params, is_half(Some(format))),
                 format,
             };
-            self.maps = Some(MomentMaps::new(ctx, &maps)?);
-        }
-        let maps = self.maps.as_mut().expect("built above");
+            MomentMaps::new(ctx, &maps)
+        })?;
         let half = is_half(maps.format());
         maps.prepare(ctx, changes, &settings(method, &self.params, half));
         Ok(())
@@ -187,10 +187,7 @@ impl ShadowTechnique for MomentShadows {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
-        let maps = self
-            .maps
-            .as_mut()
-            .ok_or_else(TechniqueError::not_prepared)?;
+        let maps = self.maps.get_mut()?;
         let half = is_half(maps.format());
         maps.record(ctx, recorder, &settings(self.method, &self.params, half))
     }
@@ -206,11 +203,11 @@ impl ShadowTechnique for MomentShadows {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        self.maps.as_ref()?.debug_view(resource)
+        self.maps.built()?.debug_view(resource)
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        self.maps.as_ref().map_or(Vec::new(), MomentMaps::counters)
+        self.maps.built().map_or(Vec::new(), MomentMaps::counters)
     }
 }
 
@@ -221,7 +218,7 @@ fn create(
     Ok(Box::new(MomentShadows {
         method,
         params: method.params(values)?,
-        maps: None,
+        maps: LazyGpu::default(),
     }))
 }
 
@@ -233,6 +230,7 @@ macro_rules! register_method {
             name: $name,
             description: $description,
             source: $source,
+            readme: include_str!("../README.md"),
             light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
             optional_features: || wgpu::Features::FLOAT32_FILTERABLE,
             params: || $method.schema(),

@@ -413,6 +413,7 @@ zoo_host::register_technique! {
     name: "Planar projected shadows",
     description: "Casters flattened onto receiver planes (Blinn's matrix), stencil-limited",
     source: "seed 000 sections 5 and 14 (Blinn 1988)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     required_features: wgpu::Features::empty,
     optional_features: wgpu::Features::empty,

@@ -141,7 +141,7 @@ impl Gpu {
 /// Parallel-split shadow maps.
 pub struct Pssm {
     params: PssmParams,
-    gpu: Option<Gpu>,
+    gpu: LazyGpu<Gpu>,
 }
 
 impl Pssm {
@@ -190,7 +190,7 @@ fn light_uniform(
 
 impl ShadowTechnique for Pssm {
     fn resources(&self) -> Vec<ResourceInfo> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         let mut out = Vec::new();
@@ -212,11 +212,9 @@ impl ShadowTechnique for Pssm {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.gpu.is_none() {
-            self.gpu = Some(Gpu::new(ctx, &self.params)?);
-        }
+        self.gpu.prepare(false, || Gpu::new(ctx, &self.params))?;
         let cascades = self.cascades();
-        let gpu = self.gpu.as_mut().expect("built above");
+        let gpu = self.gpu.get_mut()?;
         if changes.resolution {
             gpu.diagnostics = Diagnostics::new(&ctx.gpu.device, ctx.size);
         }
@@ -237,7 +235,7 @@ impl ShadowTechnique for Pssm {
             lookup,
             filters,
             diagnostics: d,
-        } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        } = self.gpu.get_mut()?;
         maps.record(ctx, recorder, MAP_PASS)?;
         let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
         let distances = cascades.distances(ctx.camera, aspect, maps.bounds().0, p.stabilise);
@@ -276,7 +274,7 @@ impl ShadowTechnique for Pssm {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        let gpu = self.gpu.as_ref()?;
+        let gpu = self.gpu.built()?;
         let colour = ViewMapping::Color { min: 0.0, max: 1.0 };
         let image = |view| {
             Some(DebugImage {
@@ -295,7 +293,7 @@ impl ShadowTechnique for Pssm {
 
     fn counters(&self) -> Vec<(String, f64)> {
         self.gpu
-            .as_ref()
+            .built()
             .map_or(Vec::new(), |gpu| gpu.maps.counters())
     }
 }
@@ -320,7 +318,10 @@ fn write_top_view(gpu: &GpuContext, texture: &wgpu::Texture, pixels: &[u8]) {
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
     let params = PssmParams::from_values(values)?;
-    Ok(Box::new(Pssm { params, gpu: None }))
+    Ok(Box::new(Pssm {
+        params,
+        gpu: LazyGpu::default(),
+    }))
 }
 
 zoo_host::register_technique! {
@@ -328,6 +329,7 @@ zoo_host::register_technique! {
     name: "Parallel-split shadow maps",
     description: "Directional lights: the view's depth range split by the practical scheme, one stable orthographic crop per split, blended split borders",
     source: "seed 000 sections 7.6 and 13.1 (Zhang et al. 2006); seed 004",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional],
     params: PssmParams::schema,
     create: create,

@@ -202,7 +202,7 @@ struct WarpedMaps {
     /// `lispsm` or `psm`: names its passes and resources.
     id: &'static str,
     settings: Settings,
-    gpu: Option<Gpu>,
+    gpu: LazyGpu<Gpu>,
 }
 
 fn density_target(device: &wgpu::Device, size: UVec2) -> (wgpu::Texture, wgpu::TextureView) {
@@ -220,18 +220,17 @@ impl WarpedMaps {
     fn map_pass(&self) -> String {
         format!("{} map", self.id.to_uppercase())
     }
+}
 
-    fn lookup_pass(&self) -> String {
-        format!("{} lookup", self.id.to_uppercase())
-    }
-
-    fn create_gpu(&self, ctx: &RenderContext<'_>) -> TechniqueResult<Gpu> {
+impl Gpu {
+    /// The maps and lookup of technique `id` (`lispsm` or `psm`).
+    fn new(ctx: &RenderContext<'_>, id: &str, settings: &Settings) -> TechniqueResult<Gpu> {
         let state = DepthState {
             constant_bias: 0,
-            slope_bias: self.settings.slope_bias,
+            slope_bias: settings.slope_bias,
             ..DepthState::default()
         };
-        let label = format!("{} maps", self.id);
+        let label = format!("{id} maps");
         let maps = ShadowMapSet::new(ctx, &label, state, None)?;
         let shader = LookupShader {
             shader: SHADER,
@@ -241,7 +240,7 @@ impl WarpedMaps {
             groups: &[],
         };
         Ok(Gpu {
-            lookup: LookupPass::new(ctx, &maps, &self.lookup_pass(), shader)?,
+            lookup: LookupPass::new(ctx, &maps, &format!("{} lookup", id.to_uppercase()), shader)?,
             maps,
             filters: MapFilters::read(ctx.shaders)?,
             density: density_target(&ctx.gpu.device, ctx.size),
@@ -252,7 +251,7 @@ impl WarpedMaps {
 
 impl ShadowTechnique for WarpedMaps {
     fn resources(&self) -> Vec<ResourceInfo> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         let mut out = vec![ResourceInfo::texture(DENSITY_VIEW, &gpu.density.0, true)];
@@ -279,15 +278,14 @@ impl ShadowTechnique for WarpedMaps {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.gpu.is_none() {
-            self.gpu = Some(self.create_gpu(ctx)?);
-        }
+        let (id, settings) = (self.id, self.settings);
+        self.gpu.prepare(false, || Gpu::new(ctx, id, &settings))?;
         let layout = WarpedLayers {
             warp: self.settings.warp,
             fitted: Cell::new(0),
             fallbacks: Cell::new(0),
         };
-        let gpu = self.gpu.as_mut().expect("built above");
+        let gpu = self.gpu.get_mut()?;
         if changes.resolution {
             gpu.density = density_target(&ctx.gpu.device, ctx.size);
         }
@@ -312,7 +310,7 @@ impl ShadowTechnique for WarpedMaps {
             filters,
             density,
             ..
-        } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        } = self.gpu.get_mut()?;
         maps.record(ctx, recorder, &map_pass)?;
         let resolution = maps.resolution() as f32;
         // Lights without a layer (point lights, spot lights under LiSPSM) are not shadowed.
@@ -345,7 +343,7 @@ impl ShadowTechnique for WarpedMaps {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        let gpu = self.gpu.as_ref()?;
+        let gpu = self.gpu.built()?;
         match resource {
             DENSITY_VIEW => Some(DebugImage {
                 view: &gpu.density.1,
@@ -357,7 +355,7 @@ impl ShadowTechnique for WarpedMaps {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         vec![
@@ -375,7 +373,7 @@ fn create_lispsm(
     Ok(Box::new(WarpedMaps {
         id: "lispsm",
         settings,
-        gpu: None,
+        gpu: LazyGpu::default(),
     }))
 }
 
@@ -384,7 +382,7 @@ fn create_psm(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn S
     Ok(Box::new(WarpedMaps {
         id: "psm",
         settings,
-        gpu: None,
+        gpu: LazyGpu::default(),
     }))
 }
 
@@ -393,6 +391,7 @@ zoo_host::register_technique! {
     name: "Light-space perspective shadow maps",
     description: "Directional lights: one map warped by a perspective in light space along the view direction (n_opt), uniform as light and view align",
     source: "seed 000 section 13.2 (Wimmer, Scherzer and Purgathofer 2004)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional],
     params: LispsmParams::schema,
     create: create_lispsm,
@@ -403,6 +402,7 @@ zoo_host::register_technique! {
     name: "Perspective shadow maps",
     description: "Directional and spot lights: one map in the camera's post-perspective space, virtual camera slid back for casters behind the viewer, inverted lights handled",
     source: "seed 000 section 7.9 (Stamminger and Drettakis 2002)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Spot],
     params: PsmParams::schema,
     create: create_psm,

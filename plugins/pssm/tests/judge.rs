@@ -4,39 +4,20 @@
 use zoo_plugin_pssm as _;
 
 use zoo_host::glam::UVec2;
-use zoo_host::test_support::{JudgeRun, Metric, judge};
+use zoo_host::test_support::judge;
 
 const SIZE: UVec2 = UVec2::new(256, 256);
-
-fn assert_core_bounds(run: &JudgeRun) {
-    for light in 0..run.loaded.lights.len() {
-        let kind = run.loaded.lights[light].kind;
-        if kind != zoo_host::LightKind::Directional {
-            continue;
-        }
-        let m = run.metrics(light);
-        eprintln!("{} light {light} ({}): {m:?}", run.scene, kind.name());
-        run.assert_bounds(
-            light,
-            &m,
-            &[
-                (Metric::FalseShadowCore, 0.005),
-                (Metric::FalseLitCore, 0.01),
-            ],
-        );
-    }
-}
 
 const FOUR_BY_2048: [(&str, &str); 2] = [("splits", "4"), ("map_size", "2048")];
 
 #[test]
 fn vista_within_bounds_with_four_2048_splits() {
-    assert_core_bounds(&judge("vista.ron", "pssm", &FOUR_BY_2048, SIZE));
+    judge("vista.ron", "pssm", &FOUR_BY_2048, SIZE).assert_core_bounds(0.005, 0.01);
 }
 
 #[test]
 fn atrium_within_bounds_with_four_2048_splits() {
-    assert_core_bounds(&judge("atrium.ron", "pssm", &FOUR_BY_2048, SIZE));
+    judge("atrium.ron", "pssm", &FOUR_BY_2048, SIZE).assert_core_bounds(0.005, 0.01);
 }
 
 #[test]
@@ -55,7 +36,7 @@ fn more_splits_lower_the_core_error_on_vista() {
     );
     // Eight logarithmic splits hold the bounds too.
     let (run, _) = core_error("8", "1");
-    assert_core_bounds(&run);
+    run.assert_core_bounds(0.005, 0.01);
 }
 
 #[test]
@@ -73,33 +54,13 @@ fn spot_and_point_lights_are_declared_unsupported() {
         .map(|s| s.metrics.is_some())
         .collect();
     assert_eq!(scored, [false, false, true]);
-    assert_core_bounds(&run);
-}
-
-fn assert_bounds_for_scored_lights(run: &JudgeRun) {
-    for (light, score) in run.judged.scores.iter().enumerate() {
-        let Some(m) = score.metrics else { continue };
-        eprintln!(
-            "{} {} light {light} ({}): {m:?}",
-            run.scene,
-            run.judged.technique,
-            score.kind.name()
-        );
-        run.assert_bounds(
-            light,
-            &m,
-            &[
-                (Metric::FalseShadowCore, 0.005),
-                (Metric::FalseLitCore, 0.01),
-            ],
-        );
-    }
+    run.assert_core_bounds(0.005, 0.01);
 }
 
 #[test]
 fn lispsm_within_bounds_on_vista_atrium_and_planar_room() {
     for scene in ["vista.ron", "atrium.ron", "planar-room.ron"] {
-        assert_bounds_for_scored_lights(&judge(scene, "lispsm", &[("map_size", "2048")], SIZE));
+        judge(scene, "lispsm", &[("map_size", "2048")], SIZE).assert_core_bounds(0.005, 0.01);
     }
 }
 
@@ -107,7 +68,7 @@ fn lispsm_within_bounds_on_vista_atrium_and_planar_room() {
 fn psm_within_bounds_on_atrium_and_planar_room_spot_included() {
     for scene in ["atrium.ron", "planar-room.ron"] {
         let run = judge(scene, "psm", &[("map_size", "2048")], SIZE);
-        assert_bounds_for_scored_lights(&run);
+        run.assert_core_bounds(0.005, 0.01);
     }
     let registration = zoo_host::find_technique("psm").unwrap();
     assert!(registration.supports(zoo_host::LightKind::Spot));

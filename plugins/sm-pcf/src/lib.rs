@@ -128,12 +128,12 @@ fn shadow_light(
 /// Shadow maps with PCF.
 pub struct ShadowMaps {
     params: SmParams,
-    gpu: Option<Gpu>,
+    gpu: LazyGpu<Gpu>,
 }
 
 impl ShadowTechnique for ShadowMaps {
     fn resources(&self) -> Vec<ResourceInfo> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         let mut out = Vec::new();
@@ -173,10 +173,7 @@ impl ShadowTechnique for ShadowMaps {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.gpu.is_none() {
-            self.gpu = Some(Gpu::new(ctx, &self.params)?);
-        }
-        let gpu = self.gpu.as_mut().expect("built above");
+        let gpu = self.gpu.prepare(false, || Gpu::new(ctx, &self.params))?;
         if changes.resolution {
             gpu.diagnostics = diagnostics_target(&ctx.gpu.device, ctx.size);
         }
@@ -197,7 +194,7 @@ impl ShadowTechnique for ShadowMaps {
             lookup,
             filters,
             diagnostics,
-        } = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        } = self.gpu.get_mut()?;
         maps.record(ctx, recorder, DEPTH_PASS)?;
         let resolution = maps.resolution();
         let uniform = |l: &LightMaps, debug| {
@@ -228,7 +225,7 @@ impl ShadowTechnique for ShadowMaps {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        let gpu = self.gpu.as_ref()?;
+        let gpu = self.gpu.built()?;
         let channel = |channel, min, max| {
             Some(DebugImage {
                 view: &gpu.diagnostics.1,
@@ -245,14 +242,17 @@ impl ShadowTechnique for ShadowMaps {
 
     fn counters(&self) -> Vec<(String, f64)> {
         self.gpu
-            .as_ref()
+            .built()
             .map_or(Vec::new(), |gpu| gpu.maps.counters())
     }
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
     let params = SmParams::from_values(values)?;
-    Ok(Box::new(ShadowMaps { params, gpu: None }))
+    Ok(Box::new(ShadowMaps {
+        params,
+        gpu: LazyGpu::default(),
+    }))
 }
 
 zoo_host::register_technique! {
@@ -260,6 +260,7 @@ zoo_host::register_technique! {
     name: "Shadow maps + PCF",
     description: "Depth maps from each light (spot frustum, fitted directional box, point cube) with PCF or PCSS",
     source: "seed 000 section 7; seed 004 sections 3.4 and 9.1 (Williams 1978; Reeves 1987; Fernando 2005)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     params: SmParams::schema,
     create: create,

@@ -198,7 +198,7 @@ fn placeholder(gpu: &GpuContext) -> (wgpu::Texture, wgpu::TextureView) {
 /// Layered screen-space soft shadows.
 pub struct Ssss {
     params: SsssParams,
-    gpu: Option<Gpu>,
+    gpu: LazyGpu<Gpu>,
     /// The layers of the current lights and camera (as assigned to the visibility slots).
     layers: Layers,
 }
@@ -259,7 +259,7 @@ fn layer_visible(layers: &Layers, view_proj: Mat4, light: usize, frustum: Mat4) 
 
 impl ShadowTechnique for Ssss {
     fn resources(&self) -> Vec<ResourceInfo> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         let mut out = Vec::new();
@@ -322,9 +322,8 @@ impl ShadowTechnique for Ssss {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.gpu.is_none() || changes.scene {
-            self.gpu = Some(Gpu::new(ctx, &self.params)?);
-        }
+        self.gpu
+            .prepare(changes.scene, || Gpu::new(ctx, &self.params))?;
         let aspect = ctx.size.x as f32 / ctx.size.y as f32;
         let request = SlotRequest {
             lights: ctx.lights,
@@ -343,7 +342,7 @@ impl ShadowTechnique for Ssss {
                 )));
             }
         }
-        let gpu = self.gpu.as_mut().expect("built above");
+        let gpu = self.gpu.get_mut()?;
         let min_filter = self.params.estimate == Estimate::MinFilter;
         let code = gpu.estimate_codes.code(self.params.estimate.index());
         let settings = settings(&self.params, self.layers.count, ctx, code);
@@ -432,7 +431,7 @@ impl ShadowTechnique for Ssss {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
-        let gpu = self.gpu.as_ref().ok_or_else(TechniqueError::not_prepared)?;
+        let gpu = self.gpu.get()?;
         gpu.maps.record(ctx, recorder, MAP_PASS)?;
         if let Some(translucent) = &gpu.translucent {
             translucent.record(ctx, recorder, &gpu.maps, TRANSLUCENT_PASS)?;
@@ -455,7 +454,7 @@ impl ShadowTechnique for Ssss {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        let gpu = self.gpu.as_ref()?;
+        let gpu = self.gpu.built()?;
         if resource == "shadow maps" {
             return gpu.maps.debug_image(self.params.debug_light);
         }
@@ -478,7 +477,7 @@ impl ShadowTechnique for Ssss {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        let Some(gpu) = &self.gpu else {
+        let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
         let mut counters = gpu.maps.counters();
@@ -501,7 +500,7 @@ fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn Shado
     let params = SsssParams::from_values(values)?;
     Ok(Box::new(Ssss {
         params,
-        gpu: None,
+        gpu: LazyGpu::default(),
         layers: Layers::default(),
     }))
 }
@@ -511,6 +510,7 @@ zoo_host::register_technique! {
     name: "Layered screen-space soft shadows",
     description: "Shadow maps for many lights, penumbrae estimated per light and blurred in screen space, one layer per group of lights that never overlap on screen; coloured translucent shadows",
     source: "seed 001 (Tamás and Heisenberger, practical SSSS; Gumbau et al. 2010)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS,
     params: SsssParams::schema,
@@ -633,7 +633,7 @@ mod tests {
     fn create_for_test(values: &ParamValues) -> Ssss {
         Ssss {
             params: SsssParams::from_values(values).unwrap(),
-            gpu: None,
+            gpu: LazyGpu::default(),
             layers: Layers::default(),
         }
     }

@@ -274,6 +274,7 @@ zoo_host::register_technique! {
     name: "Stencil shadow volumes (z-fail)",
     description: "Silhouette volumes built on the GPU, extruded to infinity, counted with two-sided z-fail stencil",
     source: "seed 000 section 8; seed 004 sections 2.4-3.5 and 9.2 (Crow 1977; Carmack, Everitt & Kilgard 2002)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     required_features: || wgpu::Features::DEPTH_CLIP_CONTROL,
     optional_features: wgpu::Features::empty,

@@ -30,7 +30,7 @@ zoo_host::technique_params! {
 
 struct Vsm {
     params: VsmParams,
-    maps: Option<MomentMaps>,
+    maps: LazyGpu<MomentMaps>,
 }
 
 /// The moment maps' settings for `p`, with maps of `format`.
@@ -53,20 +53,19 @@ fn settings(p: &VsmParams, format: Option<wgpu::TextureFormat>) -> MomentSetting
 
 impl ShadowTechnique for Vsm {
     fn resources(&self) -> Vec<ResourceInfo> {
-        self.maps.as_ref().map_or(Vec::new(), MomentMaps::resources)
+        self.maps.built().map_or(Vec::new(), MomentMaps::resources)
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.maps.is_none() {
+        let maps = self.maps.prepare(false, || {
             let method = MomentMethod {
                 label: "VSM",
                 shader: "vsm/vsm.wgsl",
                 prelude: String::new(),
                 format: filterable_rg_format(&ctx.gpu.device),
             };
-            self.maps = Some(MomentMaps::new(ctx, &method)?);
-        }
-        let maps = self.maps.as_mut().expect("built above");
+            MomentMaps::new(ctx, &method)
+        })?;
         maps.prepare(ctx, changes, &settings(&self.params, maps.format()));
         Ok(())
     }
@@ -76,10 +75,7 @@ impl ShadowTechnique for Vsm {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
-        let maps = self
-            .maps
-            .as_mut()
-            .ok_or_else(TechniqueError::not_prepared)?;
+        let maps = self.maps.get_mut()?;
         maps.record(ctx, recorder, &settings(&self.params, maps.format()))
     }
 
@@ -90,17 +86,20 @@ impl ShadowTechnique for Vsm {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        self.maps.as_ref()?.debug_view(resource)
+        self.maps.built()?.debug_view(resource)
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        self.maps.as_ref().map_or(Vec::new(), MomentMaps::counters)
+        self.maps.built().map_or(Vec::new(), MomentMaps::counters)
     }
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
     let params = VsmParams::from_values(values)?;
-    Ok(Box::new(Vsm { params, maps: None }))
+    Ok(Box::new(Vsm {
+        params,
+        maps: LazyGpu::default(),
+    }))
 }
 
 zoo_host::register_technique! {
@@ -108,6 +107,7 @@ zoo_host::register_technique! {
     name: "Variance shadow maps",
     description: "Blurred depth moments per light (spot, directional, point cube); Chebyshev bound with light-bleeding reduction",
     source: "seed 000 section 13.3 (Donnelly and Lauritzen 2006)",
+    readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     optional_features: || wgpu::Features::FLOAT32_FILTERABLE,
     params: VsmParams::schema,

@@ -6,40 +6,19 @@
 use zoo_plugin_vsm as _;
 
 use zoo_host::glam::UVec2;
-use zoo_host::test_support::{JudgeRun, Metric, judge};
+use zoo_host::test_support::judge;
 
 const SIZE: UVec2 = UVec2::new(256, 256);
-
-fn assert_core_bounds(run: &JudgeRun) {
-    for light in 0..run.loaded.lights.len() {
-        let m = run.metrics(light);
-        let kind = run.loaded.lights[light].kind.name();
-        eprintln!("{} light {light} ({kind}): {m:?}", run.scene);
-        run.assert_bounds(
-            light,
-            &m,
-            &[
-                (Metric::FalseShadowCore, 0.005),
-                (Metric::FalseLitCore, 0.01),
-            ],
-        );
-    }
-}
 
 #[test]
 fn planar_room_within_bounds_with_2048_maps() {
     // planar-room has a point light (cube map), a spot light and a sun.
-    assert_core_bounds(&judge(
-        "planar-room.ron",
-        "vsm",
-        &[("map_size", "2048")],
-        SIZE,
-    ));
+    judge("planar-room.ron", "vsm", &[("map_size", "2048")], SIZE).assert_core_bounds(0.005, 0.01);
 }
 
 #[test]
 fn curved_within_bounds_with_2048_maps() {
-    assert_core_bounds(&judge("curved.ron", "vsm", &[("map_size", "2048")], SIZE));
+    judge("curved.ron", "vsm", &[("map_size", "2048")], SIZE).assert_core_bounds(0.005, 0.01);
 }
 
 #[test]

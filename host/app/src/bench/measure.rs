@@ -8,7 +8,7 @@ use zoo_host::gpu::{PassOwner, TimingSource};
 use zoo_host::judge::{Occluders, Surfaces, reference_visibility};
 use zoo_host::judging::surface_points;
 use zoo_host::scene::paths;
-use zoo_host::{GpuContext, Renderer, Scene, View};
+use zoo_host::{GpuContext, Renderer, Scene, ShaderLibrary, View};
 
 use super::flicker::{Flicker, FrameVisibility};
 use super::stats::Summary;
@@ -44,6 +44,7 @@ struct PassSamples {
 /// Renders one configuration along the path and measures it.
 pub fn run_configuration(
     gpu: &Arc<GpuContext>,
+    shaders: &ShaderLibrary,
     plan: &BenchPlan,
     config: &Configuration,
     mut tick: impl FnMut(),
@@ -66,7 +67,8 @@ pub fn run_configuration(
     let occluders = plan
         .flicker
         .then(|| (Occluders::new(&scene), Surfaces::new(&scene)));
-    let mut renderer = Renderer::new(gpu.clone(), scene.clone(), config.size)?;
+    let mut renderer =
+        Renderer::with_shaders(gpu.clone(), scene.clone(), config.size, shaders.clone())?;
     renderer.set_technique(config.technique.id, &config.params)?;
     renderer.set_pipeline_statistics(!plan.cpu_timing);
     renderer.set_cpu_timing(plan.cpu_timing);

@@ -15,6 +15,7 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
+use zoo_host::ShaderLibrary;
 
 use crate::cli::BenchArgs;
 pub use crate::cli::PathMode;
@@ -23,9 +24,10 @@ pub use measure::*;
 pub use plan::*;
 pub use report::*;
 
-/// Runs plans, writes the outputs, and returns the results.
+/// Runs plans with `shaders`, writes the outputs, and returns the results.
 pub fn run_plans(
     plans: &[BenchPlan],
+    shaders: &ShaderLibrary,
     out: &Path,
     suite: Option<&suite::Suite>,
 ) -> anyhow::Result<Vec<ConfigResult>> {
@@ -55,7 +57,7 @@ pub fn run_plans(
     let mut results = Vec::new();
     for (i, config) in &configs {
         bar.set_message(config.label());
-        let result = run_configuration(&gpu, &plans[*i], config, || bar.inc(1))
+        let result = run_configuration(&gpu, shaders, &plans[*i], config, || bar.inc(1))
             .with_context(|| format!("{} in run {}", config.label(), config.run))?;
         results.push(result);
     }
@@ -121,7 +123,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if plans.iter().any(|p| p.frames == 0) {
         bail!("--frames must be at least 1");
     }
-    let results = run_plans(&plans, &args.out, suite.as_ref())?;
+    let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
+    let results = run_plans(&plans, &shaders, &args.out, suite.as_ref())?;
     for r in &results {
         println!(
             "  {:10} {:50} frame {:8.2} ms  {}  flicker {}",

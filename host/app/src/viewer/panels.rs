@@ -34,6 +34,7 @@ impl ViewerState {
             self.select_technique(id);
         }
         self.parameter_panel(ui);
+        self.about_panel(ui);
         self.view_panel(ui);
         self.settings_panel(ui);
         if !self.status.is_empty() {
@@ -70,6 +71,30 @@ impl ViewerState {
             .show(ui, |ui| {
                 if let Some(e) = self.reference.panel(ui, &mut self.renderer) {
                     self.error = Some(e);
+                }
+            });
+    }
+
+    /// The selected technique's documentation (its crate's README), collapsed at first.
+    fn about_panel(&self, ui: &mut egui::Ui) {
+        let Ok(registration) = zoo_host::find_technique(&self.technique) else {
+            return;
+        };
+        egui::CollapsingHeader::new(format!("About {}", registration.id))
+            .id_salt("about technique")
+            .show(ui, |ui| {
+                ui.label(format!(
+                    "{}
+
+Source: {}",
+                    registration.description, registration.source
+                ));
+                if !registration.readme.is_empty() {
+                    ui.separator();
+                    egui::ScrollArea::vertical()
+                        .id_salt("technique readme")
+                        .max_height(320.0)
+                        .show(ui, |ui| ui.label(registration.readme));
                 }
             });
     }

@@ -6,6 +6,7 @@
 //!   offset alignment.
 //! - [`layouts`]: terse bind group layout entries, bind groups by position, and pipeline
 //!   layouts that put the frame (group 0) and G-buffer (group 1) layouts first.
+//! - [`lazy`]: GPU state built at the first `prepare`, with the not-prepared error once.
 //! - [`light_pass`]: a full-screen fragment shader run once per light into its slot, with
 //!   per-light uniforms.
 //! - [`compute`]: a compute pass with the technique's own group, after the host's groups or
@@ -16,6 +17,7 @@
 
 pub mod compute;
 pub mod layouts;
+pub mod lazy;
 pub mod light_pass;
 pub mod slot;
 pub mod uniforms;
@@ -25,6 +27,7 @@ pub use layouts::{
     SlotPipeline, bind_group, bind_group_layout, diagnostics_pipelines, pipeline_layout, sampler,
     slot_fullscreen_pipeline, storage, storage_texture, texture, uniform,
 };
+pub use lazy::LazyGpu;
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use slot::{LightSlot, slot_target};
 pub use uniforms::UniformSlots;
