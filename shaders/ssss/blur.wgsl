@@ -61,7 +61,7 @@ fn blur_layer(q: vec2<i32>, layer: u32, sigma: f32, direction: vec2<f32>, depth:
         let x = f32(i) * spacing;
         let t = clamp(q + vec2<i32>(round(direction * x)), vec2<i32>(0), size - vec2<i32>(1));
         let d = view_depth_at(screen_pixel(t));
-        if d <= 0.0 || abs(d - depth) > settings.depth_threshold * depth {
+        if d <= 0.0 || abs(d - depth) > settings.params.depth_threshold * depth {
             continue;
         }
         let u = x / sigma;

@@ -8,7 +8,12 @@
 const MAX_GROUPS: u32 = 16u;
 const MAX_WORDS: u32 = 2u;
 
+#import "ssss/params.wgsl"
+
 struct Settings {
+    // The plugin's parameters the shaders read (generated from their declaration, with the
+    // `ESTIMATE_*` constants of its `estimate` choice).
+    params: SsssParams,
     // Layers in use.
     layer_count: u32,
     // Blur taps on each side of the centre (kernel = 2 * half_taps + 1).
@@ -17,24 +22,8 @@ struct Settings {
     translucent: u32,
     // Pixels per world unit at unit view depth: proj[1][1] * height / 2.
     pixel_scale: f32,
-    // Depth rejection: taps farther than this fraction of the centre's view depth are skipped.
-    depth_threshold: f32,
-    // Grazing-angle clamp of the kernel's sqrt(n_view.z) factor.
-    grazing_clamp: f32,
-    // Largest blur sigma, in pixels.
-    max_sigma: f32,
-    // Blocker-search radius limit, in map texels.
-    search_texels: f32,
-    // Scales the estimated penumbra (1: the calibrated width).
-    penumbra_scale: f32,
-    // Lookups move off the surface by this many map texels along the normal.
-    normal_offset: f32,
     // What the debug pass shows (`DEBUG_*` in `ssss/debug.wgsl`).
     debug_mode: u32,
-    // How blockers are found (`ESTIMATE_*` in `ssss/penumbra.wgsl`).
-    estimate: u32,
-    // 1 when the blur runs at half resolution (its grid pixel covers 2 x 2 screen pixels).
-    half_resolution: u32,
     // To 64 bytes, where the light array starts (its 16-byte alignment).
     _pad0: u32,
     _pad1: u32,
@@ -75,7 +64,7 @@ struct SsssData {
 
 // Screen pixels per blur-grid pixel along each side.
 fn grid_step() -> i32 {
-    return select(1, 2, data.settings.half_resolution == 1u);
+    return select(1, 2, data.settings.params.half_resolution == 1u);
 }
 
 // The blur grid: the screen, or half of it (rounded up).

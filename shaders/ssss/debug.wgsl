@@ -79,7 +79,7 @@ fn cs_debug(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
         if settings.debug_mode == DEBUG_PENUMBRA {
-            color = heat(max_sigma / max(settings.max_sigma, 1.0)) * 0.8 + 0.2 * shade;
+            color = heat(max_sigma / max(settings.params.max_blur, 1.0)) * 0.8 + 0.2 * shade;
         } else if covering > 0.0 {
             color = sum / covering * shade;
         } else {

@@ -22,11 +22,6 @@
 // Min-filtered depth maps (`ssss/min_depth.wgsl`), for the min-filter estimate.
 @group(2) @binding(5) var min_maps: texture_2d_array<f32>;
 
-// Blocker estimates, one per variant of the plugin's `Estimate` parameter (`ESTIMATE_` and its
-// name in capitals).
-const ESTIMATE_BLOCKERSEARCH: u32 = 0u;
-const ESTIMATE_MINFILTER: u32 = 1u;
-
 // The light being looked up, for the filters' map access.
 var<private> current: SsssLight;
 var<private> current_position: vec3<f32>;
@@ -98,7 +93,7 @@ fn search_radius(receiver: f32, texel: f32) -> f32 {
     if current.perspective == 1u {
         search /= max(current.near, 1e-30);
     }
-    return clamp(search, texel, data.settings.search_texels * texel);
+    return clamp(search, texel, data.settings.params.search_texels * texel);
 }
 
 // The penumbra width for blockers at `blocker` and a receiver at `receiver` (along the map
@@ -207,7 +202,7 @@ fn cs_penumbra(
         // Screen pixels per world unit on this surface: distance and the seed's
         // anisotropic factor sqrt(max(n_view.z, clamp)).
         let to_pixels = settings.pixel_scale / view_depth
-            * sqrt(max(view_normal.z, settings.grazing_clamp));
+            * sqrt(max(view_normal.z, settings.params.grazing_clamp));
         let r = rotation(vec2<f32>(pixel));
         for (var k = 0u; k < visits; k++) {
             let i = select(tile_lights[k], k, visit_all);
@@ -231,7 +226,7 @@ fn cs_penumbra(
                 continue;
             }
             let texel = texel_world(s.position);
-            let p = s.position + s.normal * (settings.normal_offset * texel);
+            let p = s.position + s.normal * (settings.params.normal_offset * texel);
             let m = project(p);
             if !m.inside {
                 continue;
@@ -246,18 +241,18 @@ fn cs_penumbra(
                 textureStore(tint_out, pixel, layer, vec4<f32>(translucency_at(m).rgb, 1.0));
             }
             var width = 0.0;
-            if settings.estimate == ESTIMATE_MINFILTER {
+            if settings.params.estimate == ESTIMATE_MINFILTER {
                 width = width_by_min_filter(m, receiver, texel);
             } else {
                 width = width_by_search(p, receiver, tangent_frame(-l), texel, r);
             }
             // A disk light's penumbra across a straight edge has a standard deviation of a
             // quarter of its width: the Gaussian's sigma.
-            var px = 0.25 * width * settings.penumbra_scale * to_pixels;
+            var px = 0.25 * width * settings.params.penumbra_scale * to_pixels;
             if px < 0.5 {
                 px = 0.0;
             }
-            sigma[group_of(layer)][layer % 4u] = min(px, settings.max_sigma);
+            sigma[group_of(layer)][layer % 4u] = min(px, settings.params.max_blur);
         }
     }
     for (var g = 0u; g < groups; g++) {

@@ -45,7 +45,7 @@ fn grid_taps(p: vec2<i32>, depth: f32) -> Taps {
         let q = clamp(base + o, vec2<i32>(0), size - vec2<i32>(1));
         taps.at[k] = q;
         let d = view_depth_at(min(q * 2, vec2<i32>(camera.size) - vec2<i32>(1)));
-        if d <= 0.0 || abs(d - depth) > data.settings.depth_threshold * depth {
+        if d <= 0.0 || abs(d - depth) > data.settings.params.depth_threshold * depth {
             continue;
         }
         let w = mix(1.0 - f.x, f.x, f32(o.x)) * mix(1.0 - f.y, f.y, f32(o.y)) + 1e-4;

@@ -2,6 +2,7 @@
 //! the copy embedded in the README.
 
 use std::path::PathBuf;
+use std::sync::OnceLock;
 
 use glam::UVec2;
 use shadow_zoo::contact_sheet::{self, Layout, Sheet};
@@ -11,12 +12,21 @@ use zoo_host::test_support::{gpu, workspace_root};
 
 /// Tile size of the README's contact sheet.
 const README_TILE: UVec2 = UVec2::new(320, 240);
+/// Tile size of the sheet the other tests share.
+pub const SHARED_TILE: UVec2 = UVec2::new(96, 64);
 /// The README's contact sheet, relative to the workspace root.
 const README_IMAGE: &str = "host/app/docs/contact-sheet.png";
 
-fn sheet(size: UVec2) -> Sheet {
+/// The default scene's sheet at [`SHARED_TILE`] on the test adapter, built once for every test
+/// that reads it (a sheet renders and judges every technique).
+pub fn shared_sheet() -> &'static Sheet {
+    static SHEET: OnceLock<Sheet> = OnceLock::new();
+    SHEET.get_or_init(|| sheet(gpu(), SHARED_TILE))
+}
+
+/// The default scene's sheet of every shipped technique available on `gpu`.
+pub fn sheet(gpu: std::sync::Arc<zoo_host::GpuContext>, size: UVec2) -> Sheet {
     let scene = shadow_zoo::setup::load_scene(None).unwrap();
-    let gpu = gpu();
     let (available, _) = contact_sheet::available_techniques(&gpu);
     let techniques: Vec<_> = available
         .into_iter()
@@ -62,7 +72,7 @@ fn differing(a: &image::RgbaImage, b: &image::RgbaImage, threshold: u8) -> f64 {
 
 #[test]
 fn the_sheet_shows_every_technique_beside_a_reference_that_exact_techniques_match() {
-    let sheet = sheet(UVec2::new(128, 128));
+    let sheet = shared_sheet();
     let ids: Vec<&str> = sheet.rows.iter().map(|r| r.id.as_str()).collect();
     assert_eq!(&ids[..2], ["reference (hard)", "reference (area)"]);
     for r in crate::shipped_techniques() {
@@ -74,7 +84,7 @@ fn the_sheet_shows_every_technique_beside_a_reference_that_exact_techniques_matc
     // shaded on the CPU except in the one-pixel band along the reference's shadow edges.
     let hard = &sheet.images[0];
     let volumes = &sheet.images[row("sv-zfail")];
-    let band = edge_band(UVec2::new(128, 128));
+    let band = edge_band(SHARED_TILE);
     let off_edges = hard
         .pixels()
         .zip(volumes.pixels())
@@ -93,17 +103,18 @@ fn the_sheet_shows_every_technique_beside_a_reference_that_exact_techniques_matc
 
     let u = sheet.rows[row("unshadowed")].summary.unwrap();
     assert_eq!(u.false_shadow_core, 0.0);
-    assert!(u.false_lit_core > 0.02, "{u:?}");
+    // Measured 0.0136 at the shared 96x64 tiles (the core excludes a band along every edge).
+    assert!(u.false_lit_core > 0.01, "{u:?}");
     let sv = sheet.rows[row("sv-zfail")].summary.unwrap();
     assert!(sv.false_shadow_core + sv.false_lit_core <= 0.002, "{sv:?}");
     assert!(sheet.rows[row("sm-pcf")].frame_ms.unwrap() > 0.0);
 
-    let table = contact_sheet::table(&sheet);
+    let table = contact_sheet::table(sheet);
     for id in &ids {
         assert!(table.contains(id), "{id} missing from\n{table}");
     }
-    let image = contact_sheet::draw(&sheet).unwrap();
-    let layout = Layout::new((128, 128), sheet.images.len());
+    let image = contact_sheet::draw(sheet).unwrap();
+    let layout = Layout::new((SHARED_TILE.x, SHARED_TILE.y), sheet.images.len());
     assert_eq!(image.dimensions(), layout.size());
 }
 
@@ -117,7 +128,7 @@ fn the_readme_contact_sheet_is_up_to_date() {
         readme.contains(&format!("]({README_IMAGE})")),
         "README.md must embed {README_IMAGE}"
     );
-    let sheet = sheet(README_TILE);
+    let sheet = sheet(gpu(), README_TILE);
     let fresh = contact_sheet::draw(&sheet).unwrap();
     if std::env::var_os("UPDATE_README_IMAGES").is_some() {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();

@@ -255,9 +255,8 @@ fn every_viewable_resource_of_every_technique_renders() {
     let mut renderer = Renderer::new(gpu(), scene, UVec2::new(96, 64)).unwrap();
     let mut shown = 0;
     for registration in crate::shipped_techniques() {
-        renderer
-            .set_technique(registration.id, &ParamValues::new())
-            .unwrap();
+        let values = zoo_host::test_support::small_map_params(&(registration.params)());
+        renderer.set_technique(registration.id, &values).unwrap();
         renderer.render(&View::Final).unwrap();
         let viewable: Vec<String> = renderer
             .technique_instance()
@@ -408,6 +407,53 @@ fn every_shipped_technique_has_its_readme() {
             assert!(
                 r.readme.contains(&format!("`{}`", spec.key)),
                 "{}: its README does not document parameter `{}`",
+                r.id,
+                spec.key
+            );
+        }
+    }
+}
+
+/// Every shader of the library validates, with the modules the plugins generate from their
+/// `flags(shader)` parameters (which no file may shadow).
+#[test]
+fn every_shader_validates_with_the_generated_modules() {
+    use zoo_host::ShaderLibrary;
+    use zoo_host::params::shader::generated_shader_names;
+    let library = ShaderLibrary::embedded();
+    let names: Vec<_> = ShaderLibrary::names().collect();
+    assert!(names.contains(&"host/lighting.wgsl"), "{names:?}");
+    assert!(library.is_shared_module("common/gbuffer.wgsl"));
+    assert!(library.is_shared_module("shadow-maps/filters.wgsl"));
+    assert!(!library.is_shared_module("sm-pcf/lookup.wgsl"));
+    let generated = generated_shader_names();
+    assert!(generated.contains(&"ssss/params.wgsl"), "{generated:?}");
+    for name in &generated {
+        assert!(
+            !names.contains(name),
+            "the file {name} shadows a generated module"
+        );
+    }
+    for name in names {
+        // Shared modules are checked through the shaders that import them.
+        if library.is_shared_module(name) {
+            continue;
+        }
+        if let Err(e) = library.validate(name) {
+            panic!("{e}");
+        }
+    }
+}
+
+/// Parameter keys are unique within each technique (shared groups included).
+#[test]
+fn every_technique_has_unique_parameter_keys() {
+    for r in crate::shipped_techniques() {
+        let schema = (r.params)();
+        for (k, spec) in schema.iter().enumerate() {
+            assert!(
+                !schema[..k].iter().any(|s| s.key == spec.key),
+                "{}: `{}` declared twice",
                 r.id,
                 spec.key
             );

@@ -6,6 +6,7 @@
 //! passes, and shades every technique identically from the visibility it wrote.
 
 use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
+pub use crate::params::ParamUpdate;
 use crate::params::{ParamError, ParamSpec, ParamValues};
 use crate::render::{
     FrameBindings, GBuffer, IndirectTarget, SceneBuffers, SlotAssignment, SlotRequest,
@@ -373,16 +374,6 @@ impl Changes {
         camera: true,
         params: true,
     };
-}
-
-/// What [`ShadowTechnique::update_params`] did with new parameter values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ParamUpdate {
-    /// Taken over by the live instance; the next `prepare` sees `changes.params`.
-    Applied,
-    /// They change resources or pipelines the instance cannot adjust: the host creates a new
-    /// instance with them.
-    Rebuild,
 }
 
 /// Everything a technique may read while preparing and recording a frame.

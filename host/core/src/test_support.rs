@@ -110,8 +110,42 @@ pub fn scene_from_ron(name: &str, text: &str) -> crate::scene::Scene {
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// A technique's defaults with its shadow maps (`map_size`, where it has one) at the smallest
+/// size it allows: for tests of what renders, not of how accurately (big depth maps are the
+/// dearest work on a software rasterizer).
+pub fn small_map_params(schema: &[crate::params::ParamSpec]) -> crate::params::ParamValues {
+    let mut values = crate::params::defaults(schema);
+    for spec in schema {
+        if let (true, crate::params::ParamKind::Int { min, .. }) =
+            (spec.key == "map_size", &spec.kind)
+        {
+            values.insert(spec.key.to_string(), crate::params::ParamValue::Int(*min));
+        }
+    }
+    values
+}
+
+/// A new context on the test adapter without `removed` features (to test a technique's
+/// fallback where a device lacks them).
+pub fn gpu_without(removed: wgpu::Features) -> Arc<GpuContext> {
+    GpuContext::new_headless_without(removed)
+        .map(Arc::new)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// As [`judge`], for a scene built in the test.
 pub fn judge_scene(
+    loaded: crate::scene::Scene,
+    technique: &str,
+    params: &[(&str, &str)],
+    size: glam::UVec2,
+) -> JudgeRun {
+    judge_scene_on(gpu(), loaded, technique, params, size)
+}
+
+/// As [`judge_scene`], on the context `gpu`.
+pub fn judge_scene_on(
+    gpu: Arc<GpuContext>,
     loaded: crate::scene::Scene,
     technique: &str,
     params: &[(&str, &str)],
@@ -128,7 +162,7 @@ pub fn judge_scene(
     crate::params::apply_assignments(&schema, &mut values, &assignments)
         .unwrap_or_else(|e| panic!("{technique}: {e}"));
     let mut renderer =
-        crate::Renderer::new(gpu(), loaded.clone(), size).unwrap_or_else(|e| panic!("{e}"));
+        crate::Renderer::new(gpu, loaded.clone(), size).unwrap_or_else(|e| panic!("{e}"));
     let reference = crate::judging::SceneReference::compute(
         &mut renderer,
         crate::judging::DEFAULT_SAMPLES,

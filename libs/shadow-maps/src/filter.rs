@@ -6,6 +6,8 @@ use zoo_host::ShaderLibrary;
 use zoo_host::gpu::layout::ChoiceCodes;
 use zoo_host::prelude::*;
 
+use crate::FilterParams;
+
 /// The library shader that declares the filters and their codes (`filters.wgsl`), composed
 /// with a map access (the filters call the importer's taps, so they do not stand alone).
 const FILTERS: &str = "shadow-maps/header_lookup.wgsl";
@@ -44,18 +46,12 @@ impl MapFilters {
             .map_err(|e| TechniqueError::Other(format!("{FILTERS}: {e}")))
     }
 
-    /// `filter` with its radii in texels and the light's size (see [`crate::light_size`]).
-    pub fn filter(
-        &self,
-        filter: Filter,
-        kernel_texels: f32,
-        search_texels: f32,
-        light_size: f32,
-    ) -> MapFilter {
+    /// The filter `p` chooses, for a light of `light_size` (see [`crate::light_size`]).
+    pub fn filter(&self, p: &FilterParams, light_size: f32) -> MapFilter {
         MapFilter {
-            mode: self.0.code(filter.index()),
-            kernel_texels,
-            search_texels,
+            mode: self.0.code(p.filter.index()),
+            kernel_texels: p.kernel_radius,
+            search_texels: p.pcss_max_texels,
             light_size,
         }
     }

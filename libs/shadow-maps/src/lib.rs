@@ -21,6 +21,7 @@ pub mod lookup;
 pub mod lookup_pass;
 pub mod maps;
 pub mod moments;
+pub mod params;
 pub mod planning;
 pub mod set;
 pub mod translucent;
@@ -37,6 +38,7 @@ pub use maps::{
     filterable_rgba_format,
 };
 pub use moments::{MomentMaps, MomentMethod, MomentSettings};
+pub use params::{FilterParams, MapParams};
 pub use planning::{
     LayerPlan, LightMaps, MapScale, PlanInputs, StandardLayers, layers_needed_with, light_scissor,
     light_size, object_bounds, plan_with,

@@ -58,11 +58,11 @@ zoo_host::technique_params! {
         /// volumes everywhere.
         restriction: Restriction = Restriction::DepthBand;
         /// Slope-scaled depth bias of the shadow map.
-        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
+        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1), flags(rebuild);
         /// Normal offset of the classification taps, in texels.
         normal_offset: f32 = 1.0, range(0.0, 8.0), step(0.1);
         /// Constant depth bias pushing volume faces back (depth-buffer units).
-        volume_bias: u32 = 16, range(0, 65536), step(1);
+        volume_bias: u32 = 16, range(0, 65536), step(1), flags(rebuild);
         /// Light whose classification the debug view shows.
         debug_light: u32 = 0, range(0, 1023), step(1);
     }
@@ -539,14 +539,9 @@ impl ShadowTechnique for Hybrid {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
-        let next = HybridParams::from_values(values)?;
-        // Biases live in the map and volume pipelines; the rest applies at the next frame.
-        let built = |p: &HybridParams| (p.slope_bias.to_bits(), p.volume_bias);
-        if built(&next) != built(&self.params) {
-            return Ok(ParamUpdate::Rebuild);
-        }
-        self.params = next;
-        Ok(ParamUpdate::Applied)
+        // Biases live in the map and volume pipelines (`flags(rebuild)`); the rest applies at
+        // the next frame.
+        Ok(self.params.update(values)?)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

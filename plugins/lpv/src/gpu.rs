@@ -409,30 +409,6 @@ impl Volumes {
     }
 }
 
-/// A compute storage buffer at `binding`.
-pub fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    kit::storage(binding, wgpu::ShaderStages::COMPUTE, read_only)
-}
-
-/// An unfilterable float 2D array texture at `binding`, for compute.
-pub fn texture_array(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    kit::texture(
-        binding,
-        wgpu::ShaderStages::COMPUTE,
-        wgpu::TextureSampleType::Float { filterable: false },
-        wgpu::TextureViewDimension::D2Array,
-    )
-}
-
-/// A write-only storage texture at `binding`, for compute.
-pub fn storage_texture(
-    binding: u32,
-    format: wgpu::TextureFormat,
-    dimension: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    kit::storage_texture(binding, wgpu::ShaderStages::COMPUTE, format, dimension)
-}
-
 /// The debug images: one grid as a volume, and the grid bounds on screen.
 pub struct DebugTargets {
     pub volume: (wgpu::Texture, wgpu::TextureView),

@@ -30,10 +30,7 @@ use zoo_host::technique::{
 use zoo_shadow_maps::light_space::{directional_frustum_over, spot_frustum};
 use zoo_shadow_maps::{DepthState, ShadowMapSet, object_bounds};
 
-use gpu::{
-    DebugTargets, LpvData, LpvSettings, Rsm, RsmCamera, Volumes, storage, storage_texture,
-    texture_array,
-};
+use gpu::{DebugTargets, LpvData, LpvSettings, Rsm, RsmCamera, Volumes};
 
 zoo_host::param_choice! {
     /// The axis the volume debug views cut across.
@@ -144,122 +141,25 @@ struct Stages {
 }
 
 impl Stages {
+    /// Every stage's pipeline, its group as the shader declares it.
     fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Stages> {
-        use wgpu::TextureFormat as F;
-        use wgpu::TextureViewDimension as D;
-        let spread = |entry: &str| {
-            ComputeStage::new(
-                ctx,
-                "lpv/spread.wgsl",
-                entry,
-                &[storage(0, true), storage(1, true), storage(2, false)],
-                StageGroups::Alone,
-                &[],
-            )
-        };
+        let alone = |shader, entry| ComputeStage::new(ctx, shader, entry, StageGroups::Alone, &[]);
+        let screen =
+            |shader, entry| ComputeStage::new(ctx, shader, entry, StageGroups::AfterHost, &[]);
+        let spread = |entry| alone("lpv/spread.wgsl", entry);
         Ok(Stages {
-            inject: ComputeStage::new(
-                ctx,
-                "lpv/inject.wgsl",
-                "cs_inject",
-                &[
-                    storage(0, true),
-                    texture_array(1),
-                    texture_array(2),
-                    texture_array(3),
-                    storage(4, false),
-                    storage(5, false),
-                    storage(6, false),
-                ],
-                StageGroups::Alone,
-                &[],
-            )?,
-            camera_occluders: ComputeStage::new(
-                ctx,
-                "lpv/inject_camera.wgsl",
-                "cs_inject_camera",
-                &[storage(0, true), storage(1, false)],
-                StageGroups::AfterHost,
-                &[],
-            )?,
-            resolve: ComputeStage::new(
-                ctx,
-                "lpv/resolve.wgsl",
-                "cs_resolve",
-                &[
-                    storage(0, true),
-                    storage(1, true),
-                    storage(2, false),
-                    storage(3, false),
-                    storage(4, true),
-                    storage(5, false),
-                ],
-                StageGroups::Alone,
-                &[],
-            )?,
+            inject: alone("lpv/inject.wgsl", "cs_inject")?,
+            camera_occluders: screen("lpv/inject_camera.wgsl", "cs_inject_camera")?,
+            resolve: alone("lpv/resolve.wgsl", "cs_resolve")?,
             spread: [
                 spread("cs_spread_x")?,
                 spread("cs_spread_y")?,
                 spread("cs_spread_z")?,
             ],
-            propagate: ComputeStage::new(
-                ctx,
-                "lpv/propagate.wgsl",
-                "cs_propagate",
-                &[
-                    storage(0, true),
-                    storage(1, true),
-                    storage(2, false),
-                    storage(3, false),
-                    storage(4, true),
-                ],
-                StageGroups::Alone,
-                &[],
-            )?,
-            lookup: ComputeStage::new(
-                ctx,
-                "lpv/lookup.wgsl",
-                "cs_lookup",
-                &[
-                    storage(0, true),
-                    storage(1, true),
-                    storage_texture(2, F::Rgba16Float, D::D2),
-                    storage(3, true),
-                    storage(4, true),
-                ],
-                StageGroups::AfterHost,
-                &[],
-            )?,
-            debug_volume: ComputeStage::new(
-                ctx,
-                "lpv/debug.wgsl",
-                "cs_volume",
-                &[
-                    storage(0, true),
-                    storage(1, true),
-                    storage(2, true),
-                    storage_texture(3, F::Rgba16Float, D::D3),
-                    storage_texture(4, F::Rgba8Unorm, D::D2),
-                    storage(5, true),
-                ],
-                StageGroups::AfterHost,
-                &[],
-            )?,
-            debug_bounds: ComputeStage::new(
-                ctx,
-                "lpv/debug.wgsl",
-                "cs_bounds",
-                &[
-                    storage(0, true),
-                    storage(1, true),
-                    storage(2, true),
-                    storage_texture(3, F::Rgba16Float, D::D3),
-                    storage_texture(4, F::Rgba8Unorm, D::D2),
-                    storage(5, true),
-                ],
-                StageGroups::AfterHost,
-                &[],
-            )?,
+            propagate: alone("lpv/propagate.wgsl", "cs_propagate")?,
+            lookup: screen("lpv/lookup.wgsl", "cs_lookup")?,
+            debug_volume: screen("lpv/debug.wgsl", "cs_volume")?,
+            debug_bounds: screen("lpv/debug.wgsl", "cs_bounds")?,
         })
     }
 }
@@ -274,7 +174,8 @@ struct Groups {
     /// Moments a to b, and b to a.
     spread: [wgpu::BindGroup; 2],
     lookup: wgpu::BindGroup,
-    debug: wgpu::BindGroup,
+    debug_volume: wgpu::BindGroup,
+    debug_bounds: wgpu::BindGroup,
 }
 
 /// Everything built at the first `prepare`.
@@ -477,7 +378,7 @@ impl ShadowTechnique for Lpv {
         ctx.gpu
             .queue
             .write_buffer(&gpu.data, 0, bytemuck::bytes_of(&data));
-        gpu.groups = Some(bind(ctx, gpu));
+        gpu.groups = Some(bind(ctx, gpu)?);
         Ok(())
     }
 
@@ -500,7 +401,6 @@ impl ShadowTechnique for Lpv {
         encoder.clear_buffer(&volumes.occluder_sums, 0, None);
         encoder.clear_buffer(&volumes.moment_sums, 0, None);
         let s = &gpu.stages;
-        let rsm_groups = targets.resolution.div_ceil(8);
         let layers = gpu.rsm_lights.len() as u32;
         if layers > 0 {
             s.inject.dispatch(
@@ -509,12 +409,12 @@ impl ShadowTechnique for Lpv {
                 gpu::INJECT_PASS,
                 &groups.inject,
                 &[],
-                [rsm_groups, rsm_groups, layers],
+                [targets.resolution, targets.resolution, layers],
             );
         } else {
             drop(recorder.compute_pass(gpu::INJECT_PASS));
         }
-        let screen = [ctx.size.x.div_ceil(8), ctx.size.y.div_ceil(8), 1];
+        let screen = [ctx.size.x, ctx.size.y, 1];
         if p.occlusion && p.camera_occluders {
             s.camera_occluders.dispatch(
                 ctx,
@@ -532,9 +432,9 @@ impl ShadowTechnique for Lpv {
             gpu::RESOLVE_PASS,
             &groups.resolve,
             &[],
-            [entries.div_ceil(64), 1, 1],
+            [entries, 1, 1],
         );
-        let n = p.grid_size.div_ceil(4);
+        let n = p.grid_size;
         if p.emitter_orientation {
             // Two boxes along each axis make a tent: a -> b -> a -> b -> a -> b -> a, so the
             // spread moments end in a.
@@ -596,13 +496,13 @@ impl ShadowTechnique for Lpv {
                 ctx.gpu
                     .queue
                     .write_buffer(&gpu.data, offset, bytemuck::bytes_of(&code));
-                let g = p.grid_size.div_ceil(4);
+                let g = p.grid_size;
                 let stage = &gpu.stages.debug_volume;
                 stage.dispatch(
                     ctx,
                     recorder,
                     gpu::DEBUG_VOLUME_PASS,
-                    &groups.debug,
+                    &groups.debug_volume,
                     &[],
                     [g, g, g],
                 );
@@ -612,7 +512,7 @@ impl ShadowTechnique for Lpv {
                     ctx,
                     recorder,
                     gpu::DEBUG_BOUNDS_PASS,
-                    &groups.debug,
+                    &groups.debug_bounds,
                     &[],
                     screen,
                 );
@@ -676,8 +576,7 @@ impl ShadowTechnique for Lpv {
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
         // Buffers and maps follow the parameters at the next `prepare`.
-        self.params = LpvParams::from_values(values)?;
-        Ok(ParamUpdate::Applied)
+        Ok(self.params.update(values)?)
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
@@ -701,8 +600,7 @@ fn copy_whole(encoder: &mut wgpu::CommandEncoder, from: &wgpu::Buffer, to: &wgpu
 }
 
 /// Bind groups over the current data, buffers and maps.
-fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
-    let device = &ctx.gpu.device;
+fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> TechniqueResult<Groups> {
     let v = gpu.volumes.as_ref().expect("made in prepare");
     let t = gpu.rsm.targets.as_ref().expect("made in prepare");
     let d = gpu.debug.as_ref().expect("made in prepare");
@@ -711,95 +609,92 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> Groups {
         b.as_entire_binding()
     }
     let view = wgpu::BindingResource::TextureView;
-    let data = buffer(&gpu.data);
+    let data = || ("lpv", buffer(&gpu.data));
     let propagate = |from: usize| {
-        zoo_host::kit::bind_group(
-            device,
-            "lpv propagate group",
-            &s.propagate.layout,
+        s.propagate.bind(
+            ctx,
+            ["lpv propagate group a to b", "lpv propagate group b to a"][from],
             &[
-                data.clone(),
-                buffer(&v.steps[from]),
-                buffer(&v.steps[1 - from]),
-                buffer(&v.accumulated),
-                buffer(&v.occluder_sums),
+                data(),
+                ("source", buffer(&v.steps[from])),
+                ("destination", buffer(&v.steps[1 - from])),
+                ("accumulated", buffer(&v.accumulated)),
+                ("occluder_sums", buffer(&v.occluder_sums)),
             ],
         )
     };
     let spread = |from: usize| {
-        zoo_host::kit::bind_group(
-            device,
+        s.spread[0].bind(
+            ctx,
             ["lpv spread group a to b", "lpv spread group b to a"][from],
-            &s.spread[0].layout,
             &[
-                data.clone(),
-                buffer(&v.moments[from]),
-                buffer(&v.moments[1 - from]),
+                data(),
+                ("source", buffer(&v.moments[from])),
+                ("destination", buffer(&v.moments[1 - from])),
             ],
         )
     };
-    Groups {
-        inject: zoo_host::kit::bind_group(
-            device,
+    Ok(Groups {
+        inject: s.inject.bind(
+            ctx,
             "lpv inject group",
-            &s.inject.layout,
             &[
-                data.clone(),
-                view(&t.flux.1),
-                view(&t.normal.1),
-                view(&t.position.1),
-                buffer(&v.light_sums),
-                buffer(&v.occluder_sums),
-                buffer(&v.moment_sums),
+                data(),
+                ("rsm_flux", view(&t.flux.1)),
+                ("rsm_normal", view(&t.normal.1)),
+                ("rsm_position", view(&t.position.1)),
+                ("light_sums", buffer(&v.light_sums)),
+                ("occluder_sums", buffer(&v.occluder_sums)),
+                ("moment_sums", buffer(&v.moment_sums)),
             ],
-        ),
-        camera_occluders: zoo_host::kit::bind_group(
-            device,
+        )?,
+        camera_occluders: s.camera_occluders.bind(
+            ctx,
             "lpv camera occluders group",
-            &s.camera_occluders.layout,
-            &[data.clone(), buffer(&v.occluder_sums)],
-        ),
-        resolve: zoo_host::kit::bind_group(
-            device,
+            &[data(), ("occluder_sums", buffer(&v.occluder_sums))],
+        )?,
+        resolve: s.resolve.bind(
+            ctx,
             "lpv resolve group",
-            &s.resolve.layout,
             &[
-                data.clone(),
-                buffer(&v.light_sums),
-                buffer(&v.steps[0]),
-                buffer(&v.accumulated),
-                buffer(&v.moment_sums),
-                buffer(&v.moments[0]),
+                data(),
+                ("light_sums", buffer(&v.light_sums)),
+                ("light", buffer(&v.steps[0])),
+                ("accumulated", buffer(&v.accumulated)),
+                ("moment_sums", buffer(&v.moment_sums)),
+                ("moments", buffer(&v.moments[0])),
             ],
-        ),
-        propagate: [propagate(0), propagate(1)],
-        spread: [spread(0), spread(1)],
-        lookup: zoo_host::kit::bind_group(
-            device,
+        )?,
+        propagate: [propagate(0)?, propagate(1)?],
+        spread: [spread(0)?, spread(1)?],
+        lookup: s.lookup.bind(
+            ctx,
             "lpv lookup group",
-            &s.lookup.layout,
             &[
-                data.clone(),
-                buffer(&v.accumulated),
-                view(&ctx.indirect.view),
-                buffer(&v.near),
-                buffer(&v.moments[0]),
+                data(),
+                ("accumulated", buffer(&v.accumulated)),
+                ("indirect_out", view(&ctx.indirect.view)),
+                ("near", buffer(&v.near)),
+                ("moments", buffer(&v.moments[0])),
             ],
-        ),
-        debug: zoo_host::kit::bind_group(
-            device,
-            "lpv debug group",
-            &s.debug_volume.layout,
+        )?,
+        debug_volume: s.debug_volume.bind(
+            ctx,
+            "lpv debug volume group",
             &[
-                data,
-                buffer(&v.accumulated),
-                buffer(&v.occluder_sums),
-                view(&d.volume.1),
-                view(&d.bounds.1),
-                buffer(&v.moments[0]),
+                data(),
+                ("accumulated", buffer(&v.accumulated)),
+                ("occluder_sums", buffer(&v.occluder_sums)),
+                ("volume_out", view(&d.volume.1)),
+                ("moments", buffer(&v.moments[0])),
             ],
-        ),
-    }
+        )?,
+        debug_bounds: s.debug_bounds.bind(
+            ctx,
+            "lpv debug bounds group",
+            &[data(), ("bounds_out", view(&d.bounds.1))],
+        )?,
+    })
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {

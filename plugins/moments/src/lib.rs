@@ -22,9 +22,9 @@ zoo_host::technique_params! {
         blur_radius: u32 = 2, range(0, 16), step(1);
         /// Exponent of the positive warp exp(c (z - 1)) (32-bit maps; at most 5.5 with 16-bit
         /// ones).
-        positive_exponent: f32 = 40.0, range(1.0, 42.0), step(1.0);
+        positive_exponent: f32 = 40.0, range(1.0, 42.0), step(1.0), flags(rebuild);
         /// Exponent of the negative warp exp(c (1 - z)) (EVSM4).
-        negative_exponent: f32 = 5.0, range(1.0, 42.0), step(1.0);
+        negative_exponent: f32 = 5.0, range(1.0, 42.0), step(1.0), flags(rebuild);
         /// Smallest variance in squared light-depth units, scaled by each warp's slope (EVSM).
         min_variance: f32 = 0.00001, range(0.0, 0.001), step(0.00001);
         /// Moment bias: the filtered moments move this far towards (0.5, 0.5, 0.5, 0.5)
@@ -193,9 +193,9 @@ impl ShadowTechnique for MomentShadows {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+        // The exponents are WGSL constants of the passes (`flags(rebuild)`).
         let next = self.method.params(values)?;
-        let exponents = |p: &MomentParams| (p.positive_exponent, p.negative_exponent);
-        if exponents(&next) != exponents(&self.params) {
+        if next.rebuilds_from(&self.params) {
             return Ok(ParamUpdate::Rebuild);
         }
         self.params = next;

@@ -34,7 +34,7 @@ zoo_host::technique_params! {
         opacity: f32 = 1.0, range(0.0, 1.0), step(0.05);
         /// Depth bias (depth-buffer units, toward the camera) of the plane-marking draw, so the
         /// plane wins the depth test against its own G-buffer depth.
-        depth_offset: u32 = 16, range(0, 4096), step(1);
+        depth_offset: u32 = 16, range(0, 4096), step(1), flags(rebuild);
     }
 }
 
@@ -369,14 +369,9 @@ impl ShadowTechnique for Planar {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
-        let next = PlanarParams::from_values(values)?;
-        // The depth offset is part of the marking pipeline; receivers and opacity are in the
-        // projection uniforms `plan` rewrites.
-        if next.depth_offset != self.params.depth_offset {
-            return Ok(ParamUpdate::Rebuild);
-        }
-        self.params = next;
-        Ok(ParamUpdate::Applied)
+        // The depth offset is part of the marking pipeline (`flags(rebuild)`); receivers and
+        // opacity are in the projection uniforms `plan` rewrites.
+        Ok(self.params.update(values)?)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

@@ -16,13 +16,15 @@ use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::light_space::Projection;
 use zoo_shadow_maps::{
-    Cascades, DepthState, Filter, LightMaps, LookupPass, LookupShader, MapFilter, MapFilters,
-    ShadowMapSet, light_size,
+    Cascades, DepthState, FilterParams, LightMaps, LookupPass, LookupShader, MapFilter, MapFilters,
+    MapParams, ShadowMapSet, light_size,
 };
 
 zoo_host::technique_params! {
     /// Parameters of parallel-split shadow maps.
     pub struct PssmParams {
+        use map: MapParams;
+        use filtering: FilterParams;
         /// Number of splits of the view's depth range.
         splits: u32 = 4, range(1, 8), step(1);
         /// Split scheme: 0 uniform, 1 logarithmic, between them a blend.
@@ -31,20 +33,8 @@ zoo_host::technique_params! {
         blend: f32 = 0.1, range(0.0, 0.5), step(0.01);
         /// Stable crops (bounding sphere, centre snapped to whole texels): no shimmering edges.
         stabilise: bool = true;
-        /// Resolution of each split's map, in texels per side.
-        map_size: u32 = 2048, range(256, 8192), step(256);
-        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
-        filter: Filter = Filter::Pcf3x3;
         /// Constant depth bias of the depth pass, in units of the depth format's resolution.
-        constant_bias: u32 = 0, range(0, 100000), step(100);
-        /// Slope-scaled depth bias of the depth pass.
-        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
-        /// Normal offset: lookups move off the surface by this many texels of their split.
-        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
-        /// Poisson disc radius in texels.
-        kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
-        /// Largest PCSS blocker search and penumbra radius, in texels.
-        pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
+        constant_bias: u32 = 0, range(0, 100000), step(100), flags(rebuild);
         /// Light whose splits the debug views show (the first shadowed light if it has none).
         debug_light: u32 = 0, range(0, 1023), step(1);
     }
@@ -117,7 +107,7 @@ impl Gpu {
     fn new(ctx: &RenderContext<'_>, params: &PssmParams) -> TechniqueResult<Gpu> {
         let state = DepthState {
             constant_bias: params.constant_bias as i32,
-            slope_bias: params.slope_bias,
+            slope_bias: params.map.slope_bias,
             ..DepthState::default()
         };
         let maps = ShadowMapSet::new(ctx, "pssm maps", state, None)?;
@@ -170,7 +160,7 @@ fn light_uniform(
         diagnostics: u32::from(debug),
         map_filter,
         blend: p.blend,
-        normal_offset: p.normal_offset,
+        normal_offset: p.map.normal_offset,
         _pad: [0; 2],
         distances: [0.0; 12],
         texel: [0.0; 8],
@@ -219,7 +209,7 @@ impl ShadowTechnique for Pssm {
             gpu.diagnostics = Diagnostics::new(&ctx.gpu.device, ctx.size);
         }
         let p = &self.params;
-        (gpu.maps).prepare_with(ctx, changes, p.map_size, p.stabilise, &cascades);
+        (gpu.maps).prepare_with(ctx, changes, p.map.map_size, p.stabilise, &cascades);
         Ok(())
     }
 
@@ -243,7 +233,7 @@ impl ShadowTechnique for Pssm {
         // Lights without splits (spot, point) are not shadowed.
         let uniform = |l: &LightMaps, debug| {
             let size = light_size(&ctx.lights[l.light]);
-            let map_filter = filters.filter(p.filter, p.kernel_radius, p.pcss_max_texels, size);
+            let map_filter = filters.filter(&p.filtering, size);
             let shadowed = !l.frustums.is_empty();
             shadowed.then(|| light_uniform(p, map_filter, l, &distances, resolution, debug))
         };
@@ -263,14 +253,9 @@ impl ShadowTechnique for Pssm {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
-        let next = PssmParams::from_values(values)?;
-        // The depth biases live in the depth pipeline; everything else applies at `prepare`.
-        let built = |p: &PssmParams| (p.constant_bias, p.slope_bias.to_bits());
-        if built(&next) != built(&self.params) {
-            return Ok(ParamUpdate::Rebuild);
-        }
-        self.params = next;
-        Ok(ParamUpdate::Applied)
+        // The depth biases live in the depth pipeline (`flags(rebuild)`); everything else
+        // applies at `prepare`.
+        Ok(self.params.update(values)?)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

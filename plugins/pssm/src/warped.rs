@@ -8,6 +8,7 @@
 use std::cell::Cell;
 
 use zoo_host::glam::UVec2;
+use zoo_host::params::ParamError;
 use zoo_host::prelude::*;
 use zoo_host::scene::Light;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
@@ -15,53 +16,37 @@ use zoo_shadow_maps::cascades::visible_depth_range;
 use zoo_shadow_maps::light_space::LightFrustum;
 use zoo_shadow_maps::warped::{lispsm_frustum, psm_frustum};
 use zoo_shadow_maps::{
-    DepthState, Filter, LayerPlan, LightMaps, LookupPass, LookupShader, MapFilter, MapFilters,
-    PlanInputs, ShadowMapSet, StandardLayers, light_size,
+    DepthState, FilterParams, LayerPlan, LightMaps, LookupPass, LookupShader, MapFilter,
+    MapFilters, MapParams, PlanInputs, ShadowMapSet, StandardLayers, light_size,
 };
 
 zoo_host::technique_params! {
-    /// Parameters of light-space perspective shadow maps.
-    pub struct LispsmParams {
-        /// Map resolution in texels per side.
-        map_size: u32 = 2048, range(256, 8192), step(256);
-        /// Warp strength: 1 puts the warp's centre at the optimal n, larger values nearer
-        /// (stronger warp), 0 gives a uniform map.
-        strength: f32 = 1.0, range(0.0, 4.0), step(0.05);
-        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
-        filter: Filter = Filter::Pcf3x3;
-        /// Slope-scaled depth bias of the depth pass.
-        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
-        /// Normal offset: lookups move off the surface by this many texels (measured there).
-        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
-        /// Poisson disc radius in texels.
-        kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
-        /// Largest PCSS blocker search and penumbra radius, in texels.
-        pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
+    /// What both warped techniques read beside their warp.
+    pub struct WarpedParams {
+        use map: MapParams;
+        use filtering: FilterParams;
         /// Light whose diagnostics the debug views show (the first shadowed light if it has none).
         debug_light: u32 = 0, range(0, 1023), step(1);
     }
 }
 
 zoo_host::technique_params! {
+    /// Parameters of light-space perspective shadow maps.
+    pub struct LispsmParams {
+        use shared: WarpedParams;
+        /// Warp strength: 1 puts the warp's centre at the optimal n, larger values nearer
+        /// (stronger warp), 0 gives a uniform map.
+        strength: f32 = 1.0, range(0.0, 4.0), step(0.05);
+    }
+}
+
+zoo_host::technique_params! {
     /// Parameters of perspective shadow maps.
     pub struct PsmParams {
-        /// Map resolution in texels per side.
-        map_size: u32 = 2048, range(256, 8192), step(256);
+        use shared: WarpedParams;
         /// Smallest near plane of the virtual camera, as a fraction of the view's far depth
         /// (a nearer plane warps harder and loses depth precision).
         near_fraction: f32 = 0.002, range(0.0001, 0.1), step(0.0001);
-        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
-        filter: Filter = Filter::Pcf3x3;
-        /// Slope-scaled depth bias of the depth pass.
-        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
-        /// Normal offset: lookups move off the surface by this many texels (measured there).
-        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
-        /// Poisson disc radius in texels.
-        kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
-        /// Largest PCSS blocker search and penumbra radius, in texels.
-        pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
-        /// Light whose diagnostics the debug views show (the first shadowed light if it has none).
-        debug_light: u32 = 0, range(0, 1023), step(1);
     }
 }
 
@@ -74,45 +59,40 @@ enum Warp {
     Psm(f32),
 }
 
-/// What both techniques need of their parameters.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Settings {
-    warp: Warp,
-    map_size: u32,
-    filter: Filter,
-    slope_bias: f32,
-    normal_offset: f32,
-    kernel_radius: f32,
-    pcss_max_texels: f32,
-    debug_light: u32,
+/// The parameters of one of the two techniques.
+#[derive(Debug, Clone)]
+enum Params {
+    Lispsm(LispsmParams),
+    Psm(PsmParams),
 }
 
-impl From<&LispsmParams> for Settings {
-    fn from(p: &LispsmParams) -> Settings {
-        Settings {
-            warp: Warp::Lispsm(p.strength),
-            map_size: p.map_size,
-            filter: p.filter,
-            slope_bias: p.slope_bias,
-            normal_offset: p.normal_offset,
-            kernel_radius: p.kernel_radius,
-            pcss_max_texels: p.pcss_max_texels,
-            debug_light: p.debug_light,
+impl Params {
+    /// The technique's id, which names its passes and resources.
+    fn id(&self) -> &'static str {
+        match self {
+            Params::Lispsm(_) => "lispsm",
+            Params::Psm(_) => "psm",
         }
     }
-}
 
-impl From<&PsmParams> for Settings {
-    fn from(p: &PsmParams) -> Settings {
-        Settings {
-            warp: Warp::Psm(p.near_fraction),
-            map_size: p.map_size,
-            filter: p.filter,
-            slope_bias: p.slope_bias,
-            normal_offset: p.normal_offset,
-            kernel_radius: p.kernel_radius,
-            pcss_max_texels: p.pcss_max_texels,
-            debug_light: p.debug_light,
+    fn warp(&self) -> Warp {
+        match self {
+            Params::Lispsm(p) => Warp::Lispsm(p.strength),
+            Params::Psm(p) => Warp::Psm(p.near_fraction),
+        }
+    }
+
+    fn shared(&self) -> &WarpedParams {
+        match self {
+            Params::Lispsm(p) => &p.shared,
+            Params::Psm(p) => &p.shared,
+        }
+    }
+
+    fn update(&mut self, values: &ParamValues) -> Result<ParamUpdate, ParamError> {
+        match self {
+            Params::Lispsm(p) => p.update(values),
+            Params::Psm(p) => p.update(values),
         }
     }
 }
@@ -199,9 +179,7 @@ struct Gpu {
 
 /// A warped-map technique (LiSPSM or PSM).
 struct WarpedMaps {
-    /// `lispsm` or `psm`: names its passes and resources.
-    id: &'static str,
-    settings: Settings,
+    params: Params,
     gpu: LazyGpu<Gpu>,
 }
 
@@ -218,16 +196,16 @@ fn density_target(device: &wgpu::Device, size: UVec2) -> (wgpu::Texture, wgpu::T
 
 impl WarpedMaps {
     fn map_pass(&self) -> String {
-        format!("{} map", self.id.to_uppercase())
+        format!("{} map", self.params.id().to_uppercase())
     }
 }
 
 impl Gpu {
     /// The maps and lookup of technique `id` (`lispsm` or `psm`).
-    fn new(ctx: &RenderContext<'_>, id: &str, settings: &Settings) -> TechniqueResult<Gpu> {
+    fn new(ctx: &RenderContext<'_>, id: &str, p: &WarpedParams) -> TechniqueResult<Gpu> {
         let state = DepthState {
             constant_bias: 0,
-            slope_bias: settings.slope_bias,
+            slope_bias: p.map.slope_bias,
             ..DepthState::default()
         };
         let label = format!("{id} maps");
@@ -278,10 +256,10 @@ impl ShadowTechnique for WarpedMaps {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        let (id, settings) = (self.id, self.settings);
-        self.gpu.prepare(false, || Gpu::new(ctx, id, &settings))?;
+        let (id, shared) = (self.params.id(), self.params.shared());
+        self.gpu.prepare(false, || Gpu::new(ctx, id, shared))?;
         let layout = WarpedLayers {
-            warp: self.settings.warp,
+            warp: self.params.warp(),
             fitted: Cell::new(0),
             fallbacks: Cell::new(0),
         };
@@ -290,7 +268,7 @@ impl ShadowTechnique for WarpedMaps {
             gpu.density = density_target(&ctx.gpu.device, ctx.size);
         }
         // Warped maps follow the camera: the set refits them on every change.
-        (gpu.maps).prepare_with(ctx, changes, self.settings.map_size, false, &layout);
+        (gpu.maps).prepare_with(ctx, changes, shared.map.map_size, false, &layout);
         if layout.fitted.get() > 0 {
             gpu.fallbacks = layout.fallbacks.get();
         }
@@ -303,7 +281,7 @@ impl ShadowTechnique for WarpedMaps {
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
         let map_pass = self.map_pass();
-        let s = self.settings;
+        let s = self.params.shared();
         let Gpu {
             maps,
             lookup,
@@ -321,8 +299,8 @@ impl ShadowTechnique for WarpedMaps {
                 layer: l.first_layer,
                 diagnostics: u32::from(debug),
                 resolution,
-                map_filter: filters.filter(s.filter, s.kernel_radius, s.pcss_max_texels, size),
-                normal_offset: s.normal_offset,
+                map_filter: filters.filter(&s.filtering, size),
+                normal_offset: s.map.normal_offset,
                 _pad: [0.0; 3],
             })
         };
@@ -330,16 +308,9 @@ impl ShadowTechnique for WarpedMaps {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
-        let next = match self.id {
-            "lispsm" => Settings::from(&LispsmParams::from_values(values)?),
-            _ => Settings::from(&PsmParams::from_values(values)?),
-        };
-        // The slope bias lives in the depth pipeline; everything else applies at `prepare`.
-        if next.slope_bias != self.settings.slope_bias {
-            return Ok(ParamUpdate::Rebuild);
-        }
-        self.settings = next;
-        Ok(ParamUpdate::Applied)
+        // The slope bias lives in the depth pipeline (`flags(rebuild)`); everything else
+        // applies at `prepare`.
+        Ok(self.params.update(values)?)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
@@ -349,7 +320,7 @@ impl ShadowTechnique for WarpedMaps {
                 view: &gpu.density.1,
                 mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
             }),
-            "shadow maps" => gpu.maps.debug_image(self.settings.debug_light),
+            "shadow maps" => gpu.maps.debug_image(self.params.shared().debug_light),
             _ => None,
         }
     }
@@ -369,19 +340,15 @@ fn create_lispsm(
     _: &GpuContext,
     values: &ParamValues,
 ) -> TechniqueResult<Box<dyn ShadowTechnique>> {
-    let settings = Settings::from(&LispsmParams::from_values(values)?);
     Ok(Box::new(WarpedMaps {
-        id: "lispsm",
-        settings,
+        params: Params::Lispsm(LispsmParams::from_values(values)?),
         gpu: LazyGpu::default(),
     }))
 }
 
 fn create_psm(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
-    let settings = Settings::from(&PsmParams::from_values(values)?);
     Ok(Box::new(WarpedMaps {
-        id: "psm",
-        settings,
+        params: Params::Psm(PsmParams::from_values(values)?),
         gpu: LazyGpu::default(),
     }))
 }

@@ -14,32 +14,22 @@ use zoo_host::glam::UVec2;
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::{
-    DepthState, Filter, LightMaps, LookupPass, LookupShader, MapFilter, MapFilters, MapHeader,
-    ShadowMapSet, light_size,
+    DepthState, FilterParams, LightMaps, LookupPass, LookupShader, MapFilter, MapFilters,
+    MapHeader, MapParams, ShadowMapSet, light_size,
 };
 
 zoo_host::technique_params! {
     /// Parameters of shadow maps with PCF.
     pub struct SmParams {
-        /// Shadow-map resolution in texels per side (clamped to the device and memory budget).
-        map_size: u32 = 2048, range(256, 8192), step(256);
-        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
-        filter: Filter = Filter::Pcf3x3;
+        use map: MapParams;
+        use filtering: FilterParams;
         /// Constant depth bias of the depth pass, in units of the depth format's resolution.
-        constant_bias: u32 = 0, range(0, 100000), step(100);
-        /// Slope-scaled depth bias of the depth pass (times the polygon's depth slope).
-        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
-        /// Normal offset: lookups move off the surface by this many shadow-map texels.
-        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
+        constant_bias: u32 = 0, range(0, 100000), step(100), flags(rebuild);
         /// Cull front faces in the depth pass (stores back faces).
-        cull_front: bool = false;
+        cull_front: bool = false, flags(rebuild);
         /// Keep directional maps stable as the camera moves (extent on a geometric ladder, centre
         /// snapped to whole texels), so shadow edges do not shimmer.
         stable_fit: bool = true;
-        /// Poisson disc radius in texels.
-        kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
-        /// Largest PCSS blocker search and penumbra radius, in texels.
-        pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
         /// Light whose maps and diagnostics the debug views show.
         debug_light: u32 = 0, range(0, 1023), step(1);
     }
@@ -86,7 +76,7 @@ impl Gpu {
     fn new(ctx: &RenderContext<'_>, params: &SmParams) -> TechniqueResult<Gpu> {
         let state = DepthState {
             constant_bias: params.constant_bias as i32,
-            slope_bias: params.slope_bias,
+            slope_bias: params.map.slope_bias,
             cull_front: params.cull_front,
             ..DepthState::default()
         };
@@ -118,8 +108,8 @@ fn shadow_light(
 ) -> ShadowLight {
     let size = light_size(light);
     ShadowLight {
-        map: MapHeader::new(maps, resolution, p.normal_offset),
-        map_filter: filters.filter(p.filter, p.kernel_radius, p.pcss_max_texels, size),
+        map: MapHeader::new(maps, resolution, p.map.normal_offset),
+        map_filter: filters.filter(&p.filtering, size),
         debug: u32::from(debug),
         _pad: [0.0; 3],
     }
@@ -179,7 +169,7 @@ impl ShadowTechnique for ShadowMaps {
         }
         // Directional maps follow the camera; spot and point maps follow their lights.
         let p = &self.params;
-        gpu.maps.prepare(ctx, changes, p.map_size, p.stable_fit);
+        gpu.maps.prepare(ctx, changes, p.map.map_size, p.stable_fit);
         Ok(())
     }
 
@@ -212,16 +202,10 @@ impl ShadowTechnique for ShadowMaps {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
-        let next = SmParams::from_values(values)?;
-        // Depth biases and culling live in the depth pipeline; the map size is applied by
-        // the map set at the next `prepare`, the rest reaches the shader through the per-light
-        // uniforms written every frame.
-        let built = |p: &SmParams| (p.constant_bias, p.slope_bias.to_bits(), p.cull_front);
-        if built(&next) != built(&self.params) {
-            return Ok(ParamUpdate::Rebuild);
-        }
-        self.params = next;
-        Ok(ParamUpdate::Applied)
+        // Biases and culling live in the depth pipeline (`flags(rebuild)`); the map size is
+        // applied by the map set at the next `prepare`, the rest reaches the shader through the
+        // per-light uniforms written every frame.
+        Ok(self.params.update(values)?)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

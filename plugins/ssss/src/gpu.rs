@@ -3,28 +3,29 @@
 
 use zoo_host::glam::UVec2;
 use zoo_host::gpu::array_layers;
-use zoo_host::kit::{self, ComputeStage, StageGroups, bind_group};
+use zoo_host::kit::{ComputeStage, StageGroups};
+use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
 use zoo_shadow_maps::{ShadowMapSet, TranslucentPass};
 
-/// `Settings` in `ssss/data.wgsl`.
+use crate::SsssParams;
+
+/// Words of the parameters the shaders read (`SsssParams` in the generated
+/// `ssss/params.wgsl`).
+const PARAM_WORDS: usize = padded_words(<SsssParams as TechniqueParams>::SHADER_FIELDS);
+
+/// `Settings` in `ssss/data.wgsl`: the `flags(shader)` parameters, then what each frame
+/// derives.
 #[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
 #[bytemuck(crate = "zoo_host::bytemuck")]
 #[repr(C)]
 pub struct Settings {
+    pub params: [u32; PARAM_WORDS],
     pub layer_count: u32,
     pub half_taps: u32,
     pub translucent: u32,
     pub pixel_scale: f32,
-    pub depth_threshold: f32,
-    pub grazing_clamp: f32,
-    pub max_sigma: f32,
-    pub search_texels: f32,
-    pub penumbra_scale: f32,
-    pub normal_offset: f32,
     pub debug_mode: u32,
-    pub estimate: u32,
-    pub half_resolution: u32,
     pub _pad: [u32; 3],
 }
 
@@ -184,33 +185,6 @@ pub struct Passes {
     groups: Option<[wgpu::BindGroup; 5]>,
 }
 
-/// Entries of the group every pass starts with: the data buffer.
-fn data_entry() -> wgpu::BindGroupLayoutEntry {
-    kit::storage(0, wgpu::ShaderStages::COMPUTE, true)
-}
-
-fn sampled(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
-    kit::texture(
-        binding,
-        wgpu::ShaderStages::COMPUTE,
-        sample_type,
-        wgpu::TextureViewDimension::D2Array,
-    )
-}
-
-/// A write-only storage texture at `binding`, for compute.
-fn storage_texture(
-    binding: u32,
-    format: wgpu::TextureFormat,
-    dimension: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    kit::storage_texture(binding, wgpu::ShaderStages::COMPUTE, format, dimension)
-}
-
-const FLOAT: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: false };
-const UINT: wgpu::TextureSampleType = wgpu::TextureSampleType::Uint;
-const ARRAY: wgpu::TextureViewDimension = wgpu::TextureViewDimension::D2Array;
-
 /// The penumbra pass: hard shadows, penumbra sizes and tints of every light.
 pub const PENUMBRA_PASS: &str = "SSSS penumbra";
 /// The first separable blur pass.
@@ -223,93 +197,18 @@ pub const RESOLVE_PASS: &str = "SSSS resolve";
 pub const DEBUG_PASS: &str = "SSSS debug view";
 
 impl Passes {
-    /// Builds every pass's pipeline; the penumbra pass reads `maps` through their lookup
-    /// group.
+    /// Builds every pass's pipeline (their groups as the shaders declare them); the penumbra
+    /// pass reads `maps` through their lookup group.
     pub fn new(ctx: &RenderContext<'_>, maps: &ShadowMapSet) -> TechniqueResult<Passes> {
-        use wgpu::TextureFormat as F;
-        let rgba16 = F::Rgba16Float;
-        let penumbra = ComputeStage::new(
-            ctx,
-            "ssss/penumbra.wgsl",
-            "cs_penumbra",
-            &[
-                data_entry(),
-                storage_texture(1, rgba16, ARRAY),
-                storage_texture(2, F::R32Uint, ARRAY),
-                storage_texture(3, rgba16, ARRAY),
-                sampled(4, FLOAT),
-                sampled(5, FLOAT),
-            ],
-            StageGroups::AfterHost,
-            &[maps.lookup_layout()],
-        )?;
-        let blur = |shader, entry, inputs: [wgpu::TextureSampleType; 2], output| {
-            ComputeStage::new(
-                ctx,
-                shader,
-                entry,
-                &[
-                    data_entry(),
-                    sampled(1, FLOAT),
-                    sampled(2, inputs[0]),
-                    sampled(3, inputs[1]),
-                    storage_texture(4, output, ARRAY),
-                    storage_texture(5, output, ARRAY),
-                ],
-                StageGroups::AfterHost,
-                &[],
-            )
+        let stage = |shader, entry, more: &[&wgpu::BindGroupLayout]| {
+            ComputeStage::new(ctx, shader, entry, StageGroups::AfterHost, more)
         };
-        let blur_first = blur(
-            "ssss/blur_first.wgsl",
-            "cs_blur_first",
-            [UINT, FLOAT],
-            rgba16,
-        )?;
-        let blur_second = blur(
-            "ssss/blur_second.wgsl",
-            "cs_blur_second",
-            [FLOAT, FLOAT],
-            rgba16,
-        )?;
-        let resolve = ComputeStage::new(
-            ctx,
-            "ssss/resolve.wgsl",
-            "cs_resolve",
-            &[
-                data_entry(),
-                sampled(1, FLOAT),
-                sampled(2, UINT),
-                sampled(3, FLOAT),
-                sampled(4, FLOAT),
-                sampled(5, FLOAT),
-                storage_texture(6, F::Rgba8Unorm, ARRAY),
-                storage_texture(7, F::Rgba8Unorm, ARRAY),
-            ],
-            StageGroups::AfterHost,
-            &[],
-        )?;
-        let debug = ComputeStage::new(
-            ctx,
-            "ssss/debug.wgsl",
-            "cs_debug",
-            &[
-                data_entry(),
-                sampled(1, FLOAT),
-                sampled(2, UINT),
-                sampled(3, FLOAT),
-                sampled(4, FLOAT),
-                storage_texture(5, F::Rgba8Unorm, wgpu::TextureViewDimension::D2),
-            ],
-            StageGroups::AfterHost,
-            &[],
-        )?;
         Ok(Passes {
-            penumbra,
-            blur_first,
-            blur_second,
-            resolve,
-            debug,
+            penumbra: stage("ssss/penumbra.wgsl", "cs_penumbra", &[maps.lookup_layout()])?,
+            blur_first: stage("ssss/blur_first.wgsl", "cs_blur_first", &[])?,
+            blur_second: stage("ssss/blur_second.wgsl", "cs_blur_second", &[])?,
+            resolve: stage("ssss/resolve.wgsl", "cs_resolve", &[])?,
+            debug: stage("ssss/debug.wgsl", "cs_debug", &[])?,
             groups: None,
         })
     }
@@ -322,80 +221,75 @@ impl Passes {
         targets: &Targets,
         translucency: &wgpu::TextureView,
         min_maps: &wgpu::TextureView,
-    ) {
-        let device = &ctx.gpu.device;
+    ) -> TechniqueResult {
         let view = wgpu::BindingResource::TextureView;
-        let data = data.as_entire_binding();
+        let data = || ("data", data.as_entire_binding());
         let t = targets;
-        let penumbra = bind_group(
-            device,
-            "ssss penumbra group",
-            &self.penumbra.layout,
-            &[
-                data.clone(),
-                view(&t.penumbra.view),
-                view(&t.bits.view),
-                view(&t.tints.view),
-                view(translucency),
-                view(min_maps),
-            ],
-        );
         let [(occlusion_1, light_1), (occlusion_2, light_2)] = &t.blurred;
-        let blur_first = bind_group(
-            device,
+        let penumbra = self.penumbra.bind(
+            ctx,
+            "ssss penumbra group",
+            &[
+                data(),
+                ("penumbra_out", view(&t.penumbra.view)),
+                ("bits_out", view(&t.bits.view)),
+                ("tint_out", view(&t.tints.view)),
+                ("translucency", view(translucency)),
+                ("min_maps", view(min_maps)),
+            ],
+        )?;
+        let blur_first = self.blur_first.bind(
+            ctx,
             "ssss blur 1 group",
-            &self.blur_first.layout,
             &[
-                data.clone(),
-                view(&t.penumbra.view),
-                view(&t.bits.view),
-                view(&t.tints.view),
-                view(&occlusion_1.view),
-                view(&light_1.view),
+                data(),
+                ("penumbra", view(&t.penumbra.view)),
+                ("bits", view(&t.bits.view)),
+                ("tints", view(&t.tints.view)),
+                ("occlusion_out", view(&occlusion_1.view)),
+                ("light_out", view(&light_1.view)),
             ],
-        );
-        let blur_second = bind_group(
-            device,
+        )?;
+        let blur_second = self.blur_second.bind(
+            ctx,
             "ssss blur 2 group",
-            &self.blur_second.layout,
             &[
-                data.clone(),
-                view(&t.penumbra.view),
-                view(&occlusion_1.view),
-                view(&light_1.view),
-                view(&occlusion_2.view),
-                view(&light_2.view),
+                data(),
+                ("penumbra", view(&t.penumbra.view)),
+                ("occlusion_in", view(&occlusion_1.view)),
+                ("light_in", view(&light_1.view)),
+                ("occlusion_out", view(&occlusion_2.view)),
+                ("light_out", view(&light_2.view)),
             ],
-        );
-        let resolve = bind_group(
-            device,
+        )?;
+        let resolve = self.resolve.bind(
+            ctx,
             "ssss resolve group",
-            &self.resolve.layout,
             &[
-                data.clone(),
-                view(&t.penumbra.view),
-                view(&t.bits.view),
-                view(&t.tints.view),
-                view(&occlusion_2.view),
-                view(&light_2.view),
-                view(&ctx.visibility.array_view),
-                view(&ctx.transmittance.array_view),
+                data(),
+                ("penumbra", view(&t.penumbra.view)),
+                ("bits", view(&t.bits.view)),
+                ("tints", view(&t.tints.view)),
+                ("occlusion_in", view(&occlusion_2.view)),
+                ("light_in", view(&light_2.view)),
+                ("visibility_out", view(&ctx.visibility.array_view)),
+                ("transmittance_out", view(&ctx.transmittance.array_view)),
             ],
-        );
-        let debug = bind_group(
-            device,
+        )?;
+        let debug = self.debug.bind(
+            ctx,
             "ssss debug group",
-            &self.debug.layout,
             &[
-                data,
-                view(&t.penumbra.view),
-                view(&t.bits.view),
-                view(&ctx.visibility.array_view),
-                view(&ctx.transmittance.array_view),
-                view(&t.debug.1),
+                data(),
+                ("penumbra", view(&t.penumbra.view)),
+                ("bits", view(&t.bits.view)),
+                ("visibility", view(&ctx.visibility.array_view)),
+                ("transmittance", view(&ctx.transmittance.array_view)),
+                ("image", view(&t.debug.1)),
             ],
-        );
+        )?;
         self.groups = Some([penumbra, blur_first, blur_second, resolve, debug]);
+        Ok(())
     }
 
     /// Records the penumbra pass, both blur passes (on the half-resolution grid when
@@ -411,9 +305,9 @@ impl Passes {
         let (Some(groups), Some(lookup)) = (&self.groups, maps.lookup_group()) else {
             return Err(TechniqueError::not_prepared());
         };
-        let full = ctx.size.map(|side| side.div_ceil(8));
+        let full = ctx.size;
         let grid = if half_resolution {
-            ctx.size.map(|side| side.div_ceil(2).div_ceil(8))
+            ctx.size.map(|side| side.div_ceil(2))
         } else {
             full
         };
@@ -424,7 +318,7 @@ impl Passes {
             (RESOLVE_PASS, &self.resolve, None, full),
             (DEBUG_PASS, &self.debug, None, full),
         ];
-        for (k, (name, stage, lookup, workgroups)) in stages.into_iter().enumerate() {
+        for (k, (name, stage, lookup, extent)) in stages.into_iter().enumerate() {
             if name == DEBUG_PASS && !debug {
                 break;
             }
@@ -435,7 +329,7 @@ impl Passes {
                 name,
                 &groups[k],
                 &more,
-                [workgroups.x, workgroups.y, 1],
+                [extent.x, extent.y, 1],
             );
         }
         Ok(())
@@ -465,11 +359,6 @@ impl MinFilter {
             ctx,
             "ssss/min_depth.wgsl",
             "cs_min_depth",
-            &[
-                sampled(0, FLOAT),
-                storage_texture(1, wgpu::TextureFormat::R32Float, ARRAY),
-                kit::storage(2, wgpu::ShaderStages::COMPUTE, true),
-            ],
             StageGroups::Alone,
             &[],
         )?;
@@ -483,9 +372,9 @@ impl MinFilter {
     }
 
     /// Sizes the min maps to `set`'s depth maps and lists the layers it renders.
-    pub fn prepare(&mut self, ctx: &RenderContext<'_>, set: &ShadowMapSet) {
+    pub fn prepare(&mut self, ctx: &RenderContext<'_>, set: &ShadowMapSet) -> TechniqueResult {
         let Some(depth) = set.depth_maps() else {
-            return;
+            return Ok(());
         };
         let gpu = ctx.gpu;
         let resolution = depth.resolution.div_ceil(MIN_BLOCK).max(1);
@@ -518,20 +407,25 @@ impl MinFilter {
         gpu.queue.write_buffer(buffer, 0, bytes);
         self.kept_count = kept.len() as u32;
         let maps = self.maps.as_ref().expect("created above");
-        self.group = Some(bind_group(
-            &gpu.device,
+        let kept = wgpu::BufferBinding {
+            buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(u64::from(self.kept_count.max(1)) * 4),
+        };
+        let group = self.stage.bind(
+            ctx,
             "ssss min filter group",
-            &self.stage.layout,
             &[
-                wgpu::BindingResource::TextureView(&depth.array_view),
-                wgpu::BindingResource::TextureView(&maps.1),
-                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(u64::from(self.kept_count.max(1)) * 4),
-                }),
+                (
+                    "depth_maps",
+                    wgpu::BindingResource::TextureView(&depth.array_view),
+                ),
+                ("min_maps", wgpu::BindingResource::TextureView(&maps.1)),
+                ("kept_layers", wgpu::BindingResource::Buffer(kept)),
             ],
-        ));
+        )?;
+        self.group = Some(group);
+        Ok(())
     }
 
     /// Whether [`Self::record`] records its pass (some layer is rendered).
@@ -556,10 +450,9 @@ impl MinFilter {
         if self.kept_count == 0 {
             return Ok(());
         }
-        let side = maps.2.div_ceil(8);
-        let workgroups = [side, side, self.kept_count];
+        let extent = [maps.2, maps.2, self.kept_count];
         self.stage
-            .dispatch(ctx, recorder, MIN_FILTER_PASS, group, &[], workgroups);
+            .dispatch(ctx, recorder, MIN_FILTER_PASS, group, &[], extent);
         Ok(())
     }
 }

@@ -50,28 +50,28 @@ zoo_host::technique_params! {
         /// Taps of each blur pass.
         kernel: Kernel = Kernel::Taps11;
         /// How blockers are found for the penumbra estimate.
-        estimate: Estimate = Estimate::MinFilter;
+        estimate: Estimate = Estimate::MinFilter, flags(shader);
         /// Blur on a half-resolution grid (each grid pixel the mean of a 2 x 2 block of the
         /// full-resolution hard shadows), upsampled with depth-aware weights; pixels without
         /// penumbra keep their full-resolution hard result.
-        half_resolution: bool = true;
+        half_resolution: bool = true, flags(shader);
         /// Most screen-space layers; an assignment needing more is refused, naming the lights.
         max_layers: u32 = 64, range(1, 64), step(1);
         /// Scales the estimated penumbra (1: the width the light's size gives).
-        penumbra_scale: f32 = 1.0, range(0.0, 4.0), step(0.05);
+        penumbra_scale: f32 = 1.0, range(0.0, 4.0), step(0.05), flags(shader);
         /// Blur taps whose view depth differs from the centre's by more than this fraction of
         /// it are skipped.
-        depth_threshold: f32 = 0.05, range(0.005, 0.5), step(0.005);
+        depth_threshold: f32 = 0.05, range(0.005, 0.5), step(0.005), flags(shader);
         /// Smallest value of the kernel's grazing-angle factor n_view.z.
-        grazing_clamp: f32 = 0.25, range(0.01, 1.0), step(0.01);
+        grazing_clamp: f32 = 0.25, range(0.01, 1.0), step(0.01), flags(shader);
         /// Largest blur sigma, in pixels.
-        max_blur: f32 = 32.0, range(1.0, 128.0), step(1.0);
+        max_blur: f32 = 32.0, range(1.0, 128.0), step(1.0), flags(shader);
         /// Largest blocker-search radius, in map texels.
-        search_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
+        search_texels: f32 = 24.0, range(2.0, 64.0), step(1.0), flags(shader);
         /// Slope-scaled depth bias of the depth pass.
-        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1);
+        slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1), flags(rebuild);
         /// Lookups move off the surface by this many map texels along the normal.
-        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
+        normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1), flags(shader);
         /// Render only the maps of lights and cube faces that can shadow the view.
         cull_maps: bool = true;
         /// Keep directional maps stable as the camera moves.
@@ -104,8 +104,6 @@ struct Gpu {
     placeholder: (wgpu::Texture, wgpu::TextureView),
     min_filter: MinFilter,
     debug_codes: ChoiceCodes,
-    /// The penumbra shader's value of each `Estimate` (its `ESTIMATE_*` constants).
-    estimate_codes: ChoiceCodes,
 }
 
 impl Gpu {
@@ -125,9 +123,6 @@ impl Gpu {
         let source = ctx.shaders.compose("ssss/debug.wgsl")?.source;
         let debug_codes = ChoiceCodes::read(&source, "DEBUG", &DEBUG_NAMES)
             .map_err(|e| TechniqueError::Other(format!("ssss/debug.wgsl: {e}")))?;
-        let source = ctx.shaders.compose("ssss/penumbra.wgsl")?.source;
-        let estimate_codes = ChoiceCodes::read(&source, "ESTIMATE", Estimate::NAMES)
-            .map_err(|e| TechniqueError::Other(format!("ssss/penumbra.wgsl: {e}")))?;
         Ok(Gpu {
             maps,
             translucent,
@@ -137,7 +132,6 @@ impl Gpu {
             placeholder: placeholder(ctx.gpu),
             min_filter: MinFilter::new(ctx)?,
             debug_codes,
-            estimate_codes,
         })
     }
 }
@@ -226,11 +220,11 @@ impl Ssss {
     }
 }
 
-/// The data buffer's settings for `layer_count` layers; `estimate` is the shader's code for
-/// the blocker estimate.
-fn settings(p: &SsssParams, layer_count: u32, ctx: &RenderContext<'_>, estimate: u32) -> Settings {
+/// The data buffer's settings for `layer_count` layers.
+fn settings(p: &SsssParams, layer_count: u32, ctx: &RenderContext<'_>) -> Settings {
     let proj = ctx.frame.matrices.proj;
     Settings {
+        params: p.shader_block(),
         layer_count: layer_count.max(1),
         half_taps: match p.kernel {
             Kernel::Taps5 => 2,
@@ -239,15 +233,7 @@ fn settings(p: &SsssParams, layer_count: u32, ctx: &RenderContext<'_>, estimate:
         },
         translucent: u32::from(ctx.scene.has_translucent_casters()),
         pixel_scale: proj.y_axis.y * ctx.size.y as f32 * 0.5,
-        depth_threshold: p.depth_threshold,
-        grazing_clamp: p.grazing_clamp,
-        max_sigma: p.max_blur,
-        search_texels: p.search_texels,
-        penumbra_scale: p.penumbra_scale,
-        normal_offset: p.normal_offset,
         debug_mode: 0,
-        estimate,
-        half_resolution: u32::from(p.half_resolution),
         _pad: [0; 3],
     }
 }
@@ -344,8 +330,7 @@ impl ShadowTechnique for Ssss {
         }
         let gpu = self.gpu.get_mut()?;
         let min_filter = self.params.estimate == Estimate::MinFilter;
-        let code = gpu.estimate_codes.code(self.params.estimate.index());
-        let settings = settings(&self.params, self.layers.count, ctx, code);
+        let settings = settings(&self.params, self.layers.count, ctx);
         let p = &self.params;
         let replaced = gpu.maps.prepare(ctx, changes, p.map_size, p.stable_fit);
         let view_proj = ctx.frame.matrices.view_proj;
@@ -361,7 +346,7 @@ impl ShadowTechnique for Ssss {
             translucent.prepare(ctx, &gpu.maps, replaced);
         }
         if min_filter {
-            gpu.min_filter.prepare(ctx, &gpu.maps);
+            gpu.min_filter.prepare(ctx, &gpu.maps)?;
         }
         let translucent = gpu.translucent.is_some();
         let half = p.half_resolution;
@@ -422,7 +407,8 @@ impl ShadowTechnique for Ssss {
             _ => &gpu.placeholder.1,
         };
         let targets = gpu.targets.as_ref().expect("created above");
-        gpu.passes.bind(ctx, data, targets, translucency, min_maps);
+        gpu.passes
+            .bind(ctx, data, targets, translucency, min_maps)?;
         Ok(())
     }
 
@@ -466,14 +452,9 @@ impl ShadowTechnique for Ssss {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
-        let next = SsssParams::from_values(values)?;
-        // The depth bias lives in the depth pipeline; everything else reaches the shaders
-        // through the data buffer at the next `prepare`.
-        if next.slope_bias != self.params.slope_bias {
-            return Ok(ParamUpdate::Rebuild);
-        }
-        self.params = next;
-        Ok(ParamUpdate::Applied)
+        // The depth bias lives in the depth pipeline (`flags(rebuild)`); everything else
+        // reaches the shaders through the data buffer at the next `prepare`.
+        Ok(self.params.update(values)?)
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
@@ -505,6 +486,8 @@ fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn Shado
     }))
 }
 
+zoo_host::shader_params_module!("ssss/params.wgsl", SsssParams);
+
 zoo_host::register_technique! {
     id: "ssss",
     name: "Layered screen-space soft shadows",
@@ -533,19 +516,12 @@ mod tests {
     fn data_mirrors_the_shader() {
         let source = shader("ssss/penumbra.wgsl");
         let (size, fields) = zoo_host::mirror_fields!(Settings {
+            params,
             layer_count,
             half_taps,
             translucent,
             pixel_scale,
-            depth_threshold,
-            grazing_clamp,
-            max_sigma,
-            search_texels,
-            penumbra_scale,
-            normal_offset,
-            debug_mode,
-            estimate,
-            half_resolution
+            debug_mode
         });
         assert_eq!(
             size % 16,
@@ -566,13 +542,6 @@ mod tests {
             kept_faces
         });
         check_mirror(&source, "SsssLight", size, &fields, SizeRule::Equal).unwrap();
-    }
-
-    #[test]
-    fn every_estimate_has_a_distinct_shader_constant() {
-        let source = shader("ssss/penumbra.wgsl");
-        let codes = ChoiceCodes::read(&source, "ESTIMATE", Estimate::NAMES).unwrap();
-        assert_ne!(codes.code(0), codes.code(1));
     }
 
     #[test]

@@ -28,17 +28,17 @@ zoo_host::technique_params! {
     /// Parameters of stencil shadow volumes.
     pub struct SvParams {
         /// Counting: z-fail (robust, the default) or z-pass (wrong with the camera in a shadow).
-        counting: Counting = Counting::ZFail;
+        counting: Counting = Counting::ZFail, flags(rebuild);
         /// Volumes from silhouette edges (default) or one volume per triangle (seed 004's baseline).
-        volumes: Volumes = Volumes::Silhouette;
+        volumes: Volumes = Volumes::Silhouette, flags(rebuild);
         /// Constant depth bias pushing volume faces back, so a lit surface is never shadowed by
         /// its own near cap (depth-buffer units).
-        depth_bias: u32 = 16, range(0, 65536), step(1);
+        depth_bias: u32 = 16, range(0, 65536), step(1), flags(rebuild);
         /// Slope-scaled depth bias of volume faces. It also pushes back the volume's sides,
         /// which a camera sees at grazing angles when the light is low: a slope bias of 1 then
         /// moves shadow edges by about a pixel (judge: core errors 0.012 under a horizontal sun
         /// on planar-room, 0 without), so it is off by default.
-        slope_bias: f32 = 0.0, range(0.0, 8.0), step(0.1);
+        slope_bias: f32 = 0.0, range(0.0, 8.0), step(0.1), flags(rebuild);
         /// Light whose volumes and stencil counts the debug views show.
         debug_light: u32 = 0, range(0, 1023), step(1);
     }
@@ -210,17 +210,9 @@ impl ShadowTechnique for ShadowVolumes {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
-        let next = SvParams::from_values(values)?;
-        // Only the debug light is read at record time; the rest shapes pipelines and buffers.
-        let same_build = SvParams {
-            debug_light: self.params.debug_light,
-            ..next.clone()
-        } == self.params;
-        if !same_build {
-            return Ok(ParamUpdate::Rebuild);
-        }
-        self.params = next;
-        Ok(ParamUpdate::Applied)
+        // Only the debug light is read at record time; the rest shapes pipelines and buffers
+        // (`flags(rebuild)`).
+        Ok(self.params.update(values)?)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

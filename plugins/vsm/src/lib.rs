@@ -81,8 +81,7 @@ impl ShadowTechnique for Vsm {
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
         // Everything, map size included, applies at the next `prepare`.
-        self.params = VsmParams::from_values(values)?;
-        Ok(ParamUpdate::Applied)
+        Ok(self.params.update(values)?)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

@@ -42,15 +42,29 @@ impl GpuContext {
         pollster::block_on(Self::create(descriptor))
     }
 
+    /// Creates a headless context as [`Self::new_headless`] does, without the `removed`
+    /// features (to run techniques as on a device that lacks them).
+    pub fn new_headless_without(removed: wgpu::Features) -> Result<GpuContext, GpuError> {
+        let descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        pollster::block_on(Self::create_without(descriptor, removed))
+    }
+
     async fn new_headless_async() -> Result<GpuContext, GpuError> {
         Self::create(wgpu::InstanceDescriptor::new_without_display_handle_from_env()).await
     }
 
     async fn create(descriptor: wgpu::InstanceDescriptor) -> Result<GpuContext, GpuError> {
+        Self::create_without(descriptor, wgpu::Features::empty()).await
+    }
+
+    async fn create_without(
+        descriptor: wgpu::InstanceDescriptor,
+        removed: wgpu::Features,
+    ) -> Result<GpuContext, GpuError> {
         let backends = descriptor.backends;
         let instance = wgpu::Instance::new(descriptor);
         let adapter = select_adapter(&instance, backends).await?;
-        let features = Self::wanted_features(&adapter);
+        let features = Self::wanted_features(&adapter) - removed;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("shadow-zoo device"),

@@ -104,7 +104,7 @@ impl ShaderLibrary {
         names
     }
 
-    /// The text of one file.
+    /// The text of one file (or of a generated module, see [`crate::params::shader`]).
     pub fn source(&self, name: &str) -> Result<String, ShaderError> {
         if let Some(root) = &self.disk_root
             && let Ok(text) = std::fs::read_to_string(root.join(name))
@@ -115,6 +115,7 @@ impl ShaderLibrary {
             .iter()
             .find(|(n, _)| *n == name)
             .map(|(_, s)| s.to_string())
+            .or_else(|| crate::params::shader::generated_shader(name))
             .ok_or_else(|| ShaderError::NotFound(name.to_string()))
     }
 
@@ -202,10 +203,23 @@ impl ShaderLibrary {
 
     /// Composes and validates `name` with naga, reporting errors at their original location.
     pub fn validate(&self, name: &str) -> Result<(ComposedShader, naga::Module), ShaderError> {
-        Self::validated(self.compose(name)?)
+        let (composed, module, _) = Self::validated(self.compose(name)?)?;
+        Ok((composed, module))
     }
 
-    fn validated(composed: ComposedShader) -> Result<(ComposedShader, naga::Module), ShaderError> {
+    /// Composes and validates `name`, with naga's analysis of it (which globals each entry
+    /// point uses), for reflection.
+    pub fn reflect(
+        &self,
+        name: &str,
+    ) -> Result<(naga::Module, naga::valid::ModuleInfo), ShaderError> {
+        let (_, module, info) = Self::validated(self.compose(name)?)?;
+        Ok((module, info))
+    }
+
+    fn validated(
+        composed: ComposedShader,
+    ) -> Result<(ComposedShader, naga::Module, naga::valid::ModuleInfo), ShaderError> {
         let module = naga::front::wgsl::parse_str(&composed.source).map_err(|e| {
             let location = e.location(&composed.source);
             compile_error(&composed, location, e.message().to_string())
@@ -214,7 +228,7 @@ impl ShaderLibrary {
             naga::valid::ValidationFlags::all(),
             naga::valid::Capabilities::all(),
         );
-        validator.validate(&module).map_err(|e| {
+        let info = validator.validate(&module).map_err(|e| {
             let location = e.location(&composed.source);
             let mut message = e.as_inner().to_string();
             let mut source: Option<&dyn std::error::Error> =
@@ -226,7 +240,7 @@ impl ShaderLibrary {
             }
             compile_error(&composed, location, message)
         })?;
-        Ok((composed, module))
+        Ok((composed, module, info))
     }
 
     /// Creates a labelled shader module from `name`, validated first so errors carry locations.
@@ -254,7 +268,7 @@ impl ShaderLibrary {
         name: &str,
         composed: ComposedShader,
     ) -> Result<wgpu::ShaderModule, ShaderError> {
-        let (composed, _) = Self::validated(composed)?;
+        let (composed, _, _) = Self::validated(composed)?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),
@@ -306,25 +320,6 @@ fn compile_error(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn every_embedded_shader_validates() {
-        let library = ShaderLibrary::embedded();
-        let names: Vec<_> = ShaderLibrary::names().collect();
-        assert!(names.contains(&"host/lighting.wgsl"), "{names:?}");
-        assert!(library.is_shared_module("common/gbuffer.wgsl"));
-        assert!(library.is_shared_module("shadow-maps/filters.wgsl"));
-        assert!(!library.is_shared_module("sm-pcf/lookup.wgsl"));
-        for name in names {
-            // Shared modules are checked through the shaders that import them.
-            if library.is_shared_module(name) {
-                continue;
-            }
-            if let Err(e) = library.validate(name) {
-                panic!("{e}");
-            }
-        }
-    }
 
     #[test]
     fn errors_point_into_the_imported_file() {

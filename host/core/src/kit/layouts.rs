@@ -56,25 +56,6 @@ pub fn texture(
     }
 }
 
-/// A write-only storage texture at `binding`.
-pub fn storage_texture(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    format: wgpu::TextureFormat,
-    view_dimension: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension,
-        },
-        count: None,
-    }
-}
-
 /// A sampler at `binding`.
 pub fn sampler(
     binding: u32,

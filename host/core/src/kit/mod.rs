@@ -10,7 +10,8 @@
 //! - [`light_pass`]: a full-screen fragment shader run once per light into its slot, with
 //!   per-light uniforms.
 //! - [`compute`]: a compute pass with the technique's own group, after the host's groups or
-//!   alone.
+//!   alone, its layout and workgroup size read from the WGSL ([`reflect`]) and its resources
+//!   bound by name.
 //!
 //! Shader modules from inline WGSL with `#import`s come from
 //! [`ShaderLibrary::create_module_from_source`](crate::ShaderLibrary::create_module_from_source).
@@ -19,13 +20,14 @@ pub mod compute;
 pub mod layouts;
 pub mod lazy;
 pub mod light_pass;
+pub mod reflect;
 pub mod slot;
 pub mod uniforms;
 
 pub use compute::{ComputeStage, StageGroups};
 pub use layouts::{
     SlotPipeline, bind_group, bind_group_layout, diagnostics_pipelines, pipeline_layout, sampler,
-    slot_fullscreen_pipeline, storage, storage_texture, texture, uniform,
+    slot_fullscreen_pipeline, storage, texture, uniform,
 };
 pub use lazy::LazyGpu;
 pub use light_pass::{FullscreenLightPass, light_pass_name};
