@@ -13,25 +13,31 @@
 @group(2) @binding(4) var bounds_out: texture_storage_2d<rgba8unorm, write>;
 @group(2) @binding(5) var<storage, read> moments: array<vec4<f32>>;
 
+// What the volume view shows (`lpv.settings.debug_source`): the plugin's volume views in
+// order (its test reads these).
+const DEBUG_SOURCE_LIGHT: u32 = 0u;
+const DEBUG_SOURCE_OCCLUDERS: u32 = 1u;
+const DEBUG_SOURCE_EMITTERS: u32 = 2u;
+
 // The mean of an SH4 over the sphere is its band-0 coefficient times y00.
 @compute @workgroup_size(4, 4, 4)
 fn cs_volume(@builtin(global_invocation_id) id: vec3<u32>) {
-    let n = lpv.settings.grid_size;
+    let n = lpv.settings.params.grid_size;
     if any(id >= vec3<u32>(n)) {
         return;
     }
     let k = min(lpv.settings.debug_cascade, lpv.settings.cascade_count - 1u);
     let cell = cell_index(k, vec3<i32>(id));
     var value = vec3<f32>(0.0);
-    if lpv.settings.debug_source == 0u {
+    if lpv.settings.debug_source == DEBUG_SOURCE_LIGHT {
         let i = cell * 3u;
         value = SH_Y0 * vec3<f32>(accumulated[i].x, accumulated[i + 1u].x, accumulated[i + 2u].x);
-    } else if lpv.settings.debug_source == 2u {
+    } else if lpv.settings.debug_source == DEBUG_SOURCE_EMITTERS {
         // The emitters' mean normal (flux-weighted over the channels) as 0.5 + 0.5 n, scaled
         // by its length: grey where normals cancel, black without emitters.
         let i = cell * 3u;
         let m = moments[i] + moments[i + 1u] + moments[i + 2u];
-        if m.w > 0.0 && lpv.settings.emitter_orientation != 0u {
+        if m.w > 0.0 && lpv.settings.params.emitter_orientation != 0u {
             let mean = m.xyz / m.w;
             value = length(mean) * (0.5 + 0.5 * normalize(mean));
         }
@@ -66,7 +72,7 @@ fn cs_bounds(@builtin(global_invocation_id) id: vec3<u32>) {
             let k = lpv.settings.cascade_count - 1u - j;
             let g = lpv.cascades[k];
             let u = (s.position - g.min) / g.cell;
-            let n = f32(lpv.settings.grid_size);
+            let n = f32(lpv.settings.params.grid_size);
             if all(u >= vec3<f32>(0.0)) && all(u <= vec3<f32>(n)) {
                 color = palette[k];
             }

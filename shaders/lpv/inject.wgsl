@@ -84,7 +84,7 @@ fn cs_inject(@builtin(global_invocation_id) id: vec3<u32>) {
         add_sums(false, cell, 0u, flux.r * lobe);
         add_sums(false, cell, 1u, flux.g * lobe);
         add_sums(false, cell, 2u, flux.b * lobe);
-        if lpv.settings.emitter_orientation != 0u {
+        if lpv.settings.params.emitter_orientation != 0u {
             let moment = vec4<f32>(n, 1.0);
             add_sums(true, cell, 0u, flux.r * moment);
             add_sums(true, cell, 1u, flux.g * moment);

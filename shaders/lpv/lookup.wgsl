@@ -47,7 +47,7 @@ fn sample_grid(k: u32, p: vec3<f32>, with_near: bool) -> Sample {
     let u = (p - g.min) / g.cell - vec3<f32>(0.5);
     let base = vec3<i32>(floor(u));
     let f = u - floor(u);
-    let oriented = lpv.settings.emitter_orientation != 0u;
+    let oriented = lpv.settings.params.emitter_orientation != 0u;
     var out: Sample;
     for (var corner = 0u; corner < 8u; corner++) {
         let o = vec3<i32>(i32(corner & 1u), i32((corner >> 1u) & 1u), i32((corner >> 2u) & 1u));
@@ -74,16 +74,16 @@ fn sample_grid(k: u32, p: vec3<f32>, with_near: bool) -> Sample {
 // How much of grid k to use at p: 1 inside, fading to 0 over its last `blend_cells` cells.
 fn grid_weight(k: u32, p: vec3<f32>) -> f32 {
     let g = lpv.cascades[k];
-    let n = f32(lpv.settings.grid_size);
+    let n = f32(lpv.settings.params.grid_size);
     let u = (p - g.min) / g.cell;
     let border = min(u, vec3<f32>(n) - u);
     let nearest = min(border.x, min(border.y, border.z));
-    return clamp((nearest - 0.5) / max(lpv.settings.blend_cells, 1e-3), 0.0, 1.0);
+    return clamp((nearest - 0.5) / max(lpv.settings.params.blend_cells, 1e-3), 0.0, 1.0);
 }
 
 // Where grid k is read for a surface at p with normal n: `damping` cells along the normal.
 fn lookup_point(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    return p + n * (lpv.settings.damping * lpv.cascades[k].cell);
+    return p + n * (lpv.settings.params.damping * lpv.cascades[k].cell);
 }
 
 // The clamped-cosine lookup of one channel's SH `s` on a surface with normal n: the SH
@@ -95,7 +95,7 @@ fn lookup_point(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // plane would otherwise light itself (see `sh.rs`).
 fn receive(s: vec4<f32>, moment: vec4<f32>, n: vec3<f32>) -> f32 {
     var g = vec3<f32>(-s.w, -s.y, s.z);
-    if lpv.settings.emitter_orientation != 0u && moment.w > 0.0 {
+    if lpv.settings.params.emitter_orientation != 0u && moment.w > 0.0 {
         let mean = moment.xyz / moment.w;
         let m = min(length(mean), 1.0);
         if m > 1e-4 {
@@ -139,7 +139,7 @@ fn cs_lookup(@builtin(global_invocation_id) id: vec3<u32>) {
     var light = vec3<f32>(0.0);
     if s.valid {
         let count = lpv.settings.cascade_count;
-        let far = lpv.settings.coarse_far_light != 0u;
+        let far = lpv.settings.params.coarse_far_light != 0u;
         // From the coarsest grid in; `coarser` is the grid read last and `coarser_weight` the
         // weight its light has in `light` (its light within half the steps, at that weight,
         // is what the next finer grid replaces).
@@ -161,5 +161,5 @@ fn cs_lookup(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     light = max(light, vec3<f32>(0.0));
-    textureStore(indirect_out, pixel, vec4<f32>(light * lpv.settings.intensity, 1.0));
+    textureStore(indirect_out, pixel, vec4<f32>(light * lpv.settings.params.intensity, 1.0));
 }

@@ -32,7 +32,7 @@ const AXES: array<vec3<i32>, 6> = array<vec3<i32>, 6>(
 // The occluder SH of `source` (0 light's view, 1 camera's) at occluder cell `c` of cascade k.
 // Corners on the grid's far planes (index n) are stored with the nearest inner ones.
 fn occluders(k: u32, source: u32, corner: vec3<i32>) -> vec4<f32> {
-    let n = i32(lpv.settings.grid_size);
+    let n = i32(lpv.settings.params.grid_size);
     if any(corner < vec3<i32>(0)) || any(corner > vec3<i32>(n)) {
         return vec4<f32>(0.0);
     }
@@ -50,7 +50,7 @@ fn occluders(k: u32, source: u32, corner: vec3<i32>) -> vec4<f32> {
 // How much light flowing along `d` gets through the face cell `c` shares with `c - d`: the
 // occluder cells sit on cell corners, so the face's centre is the mean of its four corners.
 fn transmittance(k: u32, c: vec3<i32>, d: vec3<i32>) -> f32 {
-    if lpv.settings.occlusion == 0u {
+    if lpv.settings.params.occlusion == 0u {
         return 1.0;
     }
     // The face lies on the corner plane of c on the side facing the neighbour.
@@ -67,7 +67,7 @@ fn transmittance(k: u32, c: vec3<i32>, d: vec3<i32>) -> f32 {
     let towards_source = sh_basis(-vec3<f32>(d));
     var blocked = 0.0;
     for (var s = 0u; s < 2u; s++) {
-        if s == 1u && lpv.settings.camera_occluders == 0u {
+        if s == 1u && lpv.settings.params.camera_occluders == 0u {
             break;
         }
         let b = 0.25 * (occluders(k, s, plane) + occluders(k, s, plane + u)
@@ -79,7 +79,7 @@ fn transmittance(k: u32, c: vec3<i32>, d: vec3<i32>) -> f32 {
 
 @compute @workgroup_size(4, 4, 4)
 fn cs_propagate(@builtin(global_invocation_id) id: vec3<u32>) {
-    let n = lpv.settings.grid_size;
+    let n = lpv.settings.params.grid_size;
     let k = id.z / n;
     if id.x >= n || id.y >= n || k >= lpv.settings.cascade_count {
         return;
@@ -95,7 +95,7 @@ fn cs_propagate(@builtin(global_invocation_id) id: vec3<u32>) {
         // Cells light has not reached (band 0 of every channel zero) send nothing.
         let src = cell_index(k, neighbour) * 3u;
         let dark = source[src].x <= 0.0 && source[src + 1u].x <= 0.0 && source[src + 2u].x <= 0.0;
-        if dark && lpv.settings.skip_dark_cells != 0u {
+        if dark && lpv.settings.params.skip_dark_cells != 0u {
             continue;
         }
         let t = transmittance(k, c, d);

@@ -13,13 +13,13 @@
 
 // Sums the moments of the cells within `orientation_cells` of `id` along `axis`.
 fn spread(id: vec3<u32>, axis: vec3<i32>) {
-    let n = lpv.settings.grid_size;
+    let n = lpv.settings.params.grid_size;
     let k = id.z / n;
     if id.x >= n || id.y >= n || k >= lpv.settings.cascade_count {
         return;
     }
     let c = vec3<i32>(vec3<u32>(id.x, id.y, id.z % n));
-    let r = i32(lpv.settings.orientation_cells);
+    let r = i32(lpv.settings.params.orientation_cells);
     var sum: array<vec4<f32>, 3>;
     for (var t = -r; t <= r; t++) {
         let other = c + axis * t;

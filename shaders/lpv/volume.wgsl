@@ -5,38 +5,26 @@
 
 const MAX_CASCADES: u32 = 4u;
 
+#import "lpv/params.wgsl"
+
 struct LpvSettings {
-    // Cells along each side of a grid.
-    grid_size: u32,
+    // The plugin's parameters the shaders read (generated from their declaration: grid size,
+    // occlusion and camera occluders, damping, intensity, blend cells, coarse far light,
+    // emitter orientation and its cells, skipping dark cells).
+    params: LpvParams,
     cascade_count: u32,
     // Fixed-point scales of the injection sums (integer units per unit).
     light_scale: f32,
     occluder_scale: f32,
-    // 1 when propagation is blocked by the geometry volume.
-    occlusion: u32,
-    // Lookups move this many cells along the normal (against self-bleeding).
-    damping: f32,
-    // Multiplies the indirect light written.
-    intensity: f32,
-    // 1 when the camera's G-buffer adds occluders.
-    camera_occluders: u32,
-    // Cells over which a finer grid fades into the next at its border.
-    blend_cells: f32,
     // The grid and volume the debug volume view shows (0 light, 1 occluders, 2 emitter normals).
     debug_cascade: u32,
     debug_source: u32,
     // Reflective shadow maps injected (each sees the same surfaces: their surfels count
     // once between them).
     map_count: u32,
-    // 1 when a coarser grid adds only the light that travelled beyond the next finer grid's
-    // reach (its steps past half the iterations); 0 when a finer grid replaces it.
-    coarse_far_light: u32,
-    // 1 when lookups restore the flux direction from the emitters' mean normal.
-    emitter_orientation: u32,
-    // Cells each way over which emitters' normals are averaged.
-    orientation_cells: u32,
-    // 1 when propagation skips neighbours light has not reached.
-    skip_dark_cells: u32,
+    // To a multiple of 16 bytes (the origin after it is a vec4).
+    _pad0: u32,
+    _pad1: u32,
 }
 
 struct Cascade {
@@ -69,19 +57,19 @@ fn sh_cosine_lobe(d: vec3<f32>) -> vec4<f32> {
 }
 
 fn cells_per_grid() -> u32 {
-    let n = lpv.settings.grid_size;
+    let n = lpv.settings.params.grid_size;
     return n * n * n;
 }
 
 // Whether integer cell `c` lies inside a grid.
 fn inside_grid(c: vec3<i32>) -> bool {
-    let n = i32(lpv.settings.grid_size);
+    let n = i32(lpv.settings.params.grid_size);
     return all(c >= vec3<i32>(0)) && all(c < vec3<i32>(n));
 }
 
 // Index of cell `c` of cascade `k` over all grids.
 fn cell_index(k: u32, c: vec3<i32>) -> u32 {
-    let n = i32(lpv.settings.grid_size);
+    let n = i32(lpv.settings.params.grid_size);
     return k * cells_per_grid() + u32(c.x + n * (c.y + n * c.z));
 }
 

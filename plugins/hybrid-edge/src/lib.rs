@@ -601,6 +601,16 @@ mod tests {
     use zoo_host::gpu::layout::{SizeRule, check_mirror};
 
     #[test]
+    fn the_empty_id_matches_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose(SHADER)
+            .unwrap()
+            .source;
+        let value = zoo_host::gpu::layout::wgsl_integer_constant(&source, "NO_TRIANGLE");
+        assert_eq!(value, Ok(i64::from(NO_TRIANGLE)));
+    }
+
+    #[test]
     fn edge_light_mirrors_the_shader() {
         let source = zoo_host::ShaderLibrary::embedded()
             .compose(SHADER)

@@ -3,10 +3,12 @@
 
 use zoo_host::glam::{UVec2, Vec3};
 use zoo_host::kit::{self, UniformSlots};
+use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
 use zoo_host::render::Vertex;
 use zoo_shadow_maps::light_space::LightFrustum;
 
+use crate::LpvParams;
 use crate::cascades::Grid;
 
 /// Most grids (`MAX_CASCADES` in `lpv/volume.wgsl`).
@@ -17,23 +19,19 @@ pub const MAX_CASCADES: usize = 4;
 #[bytemuck(crate = "zoo_host::bytemuck")]
 #[repr(C)]
 pub struct LpvSettings {
-    pub grid_size: u32,
+    /// The `flags(shader)` parameters (`LpvParams` in the generated `lpv/params.wgsl`).
+    pub params: [u32; PARAM_WORDS],
     pub cascade_count: u32,
     pub light_scale: f32,
     pub occluder_scale: f32,
-    pub occlusion: u32,
-    pub damping: f32,
-    pub intensity: f32,
-    pub camera_occluders: u32,
-    pub blend_cells: f32,
     pub debug_cascade: u32,
     pub debug_source: u32,
     pub map_count: u32,
-    pub coarse_far_light: u32,
-    pub emitter_orientation: u32,
-    pub orientation_cells: u32,
-    pub skip_dark_cells: u32,
+    pub _pad: [u32; 2],
 }
+
+/// Words of the parameters the shaders read.
+const PARAM_WORDS: usize = padded_words(<LpvParams as TechniqueParams>::SHADER_FIELDS);
 
 /// `Cascade` in `lpv/volume.wgsl`.
 #[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]

@@ -43,43 +43,43 @@ zoo_host::technique_params! {
         /// Cascaded grids, cell sizes doubling from the finest.
         cascades: u32 = 3, range(1, 4), step(1);
         /// Cells along each side of a grid.
-        grid_size: u32 = 32, range(8, 64), step(8);
+        grid_size: u32 = 32, range(8, 64), step(8), flags(shader);
         /// Propagation steps (light travels one cell a step).
         iterations: u32 = 8, range(0, 64), step(1);
         /// Reflective-shadow-map resolution: its texels are the virtual point lights.
         rsm_size: u32 = 256, range(64, 1024), step(64);
         /// Block propagation with the geometry volume.
-        occlusion: bool = true;
+        occlusion: bool = true, flags(shader);
         /// Add the camera's G-buffer surfels to the geometry volume.
-        camera_occluders: bool = true;
+        camera_occluders: bool = true, flags(shader);
         /// Lookups move this fraction of a cell along the normal (against self-bleeding).
-        damping: f32 = 0.4, range(0.0, 1.0), step(0.05);
+        damping: f32 = 0.4, range(0.0, 1.0), step(0.05), flags(shader);
         /// Multiplies the indirect light.
-        intensity: f32 = 1.0, range(0.0, 10.0), step(0.1);
+        intensity: f32 = 1.0, range(0.0, 10.0), step(0.1), flags(shader);
         /// How far light travels in the coarsest grid over `iterations` steps, as a share of
         /// the scene's diagonal: sets the cells' size (coarser cells reach further).
         reach: f32 = 0.4, range(0.05, 2.0), step(0.05);
         /// Finest cell size in world units (0: from `reach`).
         finest_cell: f32 = 0.0, range(0.0, 100.0), step(0.05);
         /// Cells over which a finer grid fades into the next at its border.
-        blend_cells: f32 = 2.0, range(0.0, 16.0), step(0.5);
+        blend_cells: f32 = 2.0, range(0.0, 16.0), step(0.5), flags(shader);
         /// A coarser grid adds the light that travelled beyond the next finer grid's reach
         /// (iterations x its cell: the coarser grid's steps past half the iterations); off, a
         /// finer grid replaces the coarser ones where it lies and light reaches only
         /// iterations x the finest cell there.
-        coarse_far_light: bool = true;
+        coarse_far_light: bool = true, flags(shader);
         /// Lookups restore the flux direction that propagation diffuses away, from the mean
         /// normal of the virtual point lights within `orientation_cells`: above a lit plane a
         /// receiver facing the plane's way then gets nothing, as in the exact field.
-        emitter_orientation: bool = true;
+        emitter_orientation: bool = true, flags(shader);
         /// Cells each way of the box the virtual point lights' normals are averaged over,
         /// twice: weights fall linearly to zero at twice this (4: the default 8 iterations'
         /// reach).
-        orientation_cells: u32 = 4, range(0, 16), step(1);
+        orientation_cells: u32 = 4, range(0, 16), step(1), flags(shader);
         /// Propagation skips neighbours light has not reached (the same result, less work
         /// where the grids are dark); off, every cell costs the same, as in the published
         /// timings.
-        skip_dark_cells: bool = true;
+        skip_dark_cells: bool = true, flags(shader);
         /// Spot lights also render reflective shadow maps (directional lights always do).
         spot_lights: bool = false;
         /// Direct shadow-map resolution.
@@ -357,22 +357,14 @@ impl ShadowTechnique for Lpv {
             gpu.debug = Some(DebugTargets::new(ctx.gpu, p.grid_size, ctx.size));
         }
         let settings = LpvSettings {
-            grid_size: p.grid_size,
+            params: p.shader_block(),
             cascade_count: p.cascades,
             light_scale: light_scale(ctx.lights, &rsm_lights, &cameras, p.rsm_size),
             occluder_scale: 1.0e6,
-            occlusion: u32::from(p.occlusion),
-            damping: p.damping,
-            intensity: p.intensity,
-            camera_occluders: u32::from(p.camera_occluders),
-            blend_cells: p.blend_cells,
             debug_cascade: p.debug_cascade.min(p.cascades - 1),
             debug_source: 0,
             map_count: rsm_lights.len() as u32,
-            coarse_far_light: u32::from(p.coarse_far_light),
-            emitter_orientation: u32::from(p.emitter_orientation),
-            orientation_cells: p.orientation_cells,
-            skip_dark_cells: u32::from(p.skip_dark_cells),
+            _pad: [0; 2],
         };
         let data = LpvData::new(settings, origin, &grids);
         ctx.gpu
@@ -705,6 +697,8 @@ fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn Shado
     }))
 }
 
+zoo_host::shader_params_module!("lpv/params.wgsl", LpvParams);
+
 zoo_host::register_technique! {
     id: "lpv",
     name: "Light propagation volumes",
@@ -735,25 +729,28 @@ mod tests {
     }
 
     #[test]
+    fn volume_views_are_the_debug_sources_in_order() {
+        let source = shader("lpv/debug.wgsl");
+        let names = ["LIGHT", "OCCLUDERS", "EMITTERS"];
+        let codes = zoo_host::gpu::layout::ChoiceCodes::read(&source, "DEBUG_SOURCE", &names);
+        let codes = codes.unwrap();
+        assert_eq!(names.len(), VOLUME_VIEWS.len());
+        for (k, view) in VOLUME_VIEWS.iter().enumerate() {
+            assert_eq!(codes.code(k), k as u32, "{view} is written as its position");
+        }
+    }
+
+    #[test]
     fn structs_mirror_the_shaders() {
         let source = shader("lpv/propagate.wgsl");
         let (size, fields) = zoo_host::mirror_fields!(LpvSettings {
-            grid_size,
+            params,
             cascade_count,
             light_scale,
             occluder_scale,
-            occlusion,
-            damping,
-            intensity,
-            camera_occluders,
-            blend_cells,
             debug_cascade,
             debug_source,
-            map_count,
-            coarse_far_light,
-            emitter_orientation,
-            orientation_cells,
-            skip_dark_cells
+            map_count
         });
         check_mirror(&source, "LpvSettings", size, &fields, SizeRule::Equal).unwrap();
         let (size, fields) = zoo_host::mirror_fields!(LpvData {
