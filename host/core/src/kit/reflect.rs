@@ -310,7 +310,8 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
-    fn stage() -> ReflectedStage {
+    /// Entry `entry` of [`SOURCE`], group 0, reflected.
+    fn reflect(entry: &str) -> Result<ReflectedStage, String> {
         let module = naga::front::wgsl::parse_str(SOURCE).unwrap();
         let info = naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
@@ -318,7 +319,11 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
         )
         .validate(&module)
         .unwrap();
-        reflect_compute(&module, &info, "cs_main", 0).unwrap()
+        reflect_compute(&module, &info, entry, 0)
+    }
+
+    fn stage() -> ReflectedStage {
+        reflect("cs_main").unwrap()
     }
 
     #[test]
@@ -363,18 +368,11 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
                 view_dimension: wgpu::TextureViewDimension::D3
             }
         );
-        assert!(reflect_compute_err("cs_missing").contains("no compute entry point"));
-    }
-
-    fn reflect_compute_err(entry: &str) -> String {
-        let module = naga::front::wgsl::parse_str(SOURCE).unwrap();
-        let info = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        )
-        .validate(&module)
-        .unwrap();
-        reflect_compute(&module, &info, entry, 0).unwrap_err()
+        assert!(
+            reflect("cs_missing")
+                .unwrap_err()
+                .contains("no compute entry point")
+        );
     }
 
     #[test]
