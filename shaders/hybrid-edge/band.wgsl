@@ -164,8 +164,7 @@ fn occluded(c: Classified) -> bool {
     let light = c.light;
     let layer = header_layer(edge.map, c.lookup);
     let m = map_point(layer, c.lookup);
-    let size = vec2<i32>(textureDimensions(triangle_ids));
-    let centre = vec2<i32>(m.uv * vec2<f32>(size));
+    let centre = tile_texel(m.tile, m.uv);
     // Leave the surface by a hair, relative to the scene's scale at this point.
     let scale = max(distance(c.surface.position, camera.position), 1.0);
     let origin = c.surface.position + c.surface.normal * (1e-4 * scale);
@@ -179,8 +178,8 @@ fn occluded(c: Classified) -> bool {
     let r = i32(edge.radius) + 1;
     for (var j = -r; j <= r; j++) {
         for (var i = -r; i <= r; i++) {
-            let texel = clamp(centre + vec2<i32>(i, j), vec2<i32>(0), size - vec2<i32>(1));
-            let id = textureLoad(triangle_ids, texel, layer, 0).r;
+            let texel = clamp_to_tile(m.tile, centre + vec2<i32>(i, j));
+            let id = textureLoad(triangle_ids, texel, m.tile.page, 0).r;
             if id != NO_TRIANGLE && ray_hits(id, origin, direction, t_max) {
                 return true;
             }

@@ -25,12 +25,13 @@ fn sample_color_map(h: MapHeader, p: vec3<f32>) -> ColorSample {
     let clip = camera.view_proj * vec4<f32>(p, 1.0);
     let ndc = clip.xyz / clip.w;
     var s: ColorSample;
-    s.inside = clip.w > 0.0 && all(abs(ndc.xy) <= vec2<f32>(1.0)) && ndc.z >= 0.0 && ndc.z <= 1.0;
+    s.inside = camera.tile.size > 0u && clip.w > 0.0 && all(abs(ndc.xy) <= vec2<f32>(1.0)) && ndc.z >= 0.0 && ndc.z <= 1.0;
     if !s.inside {
         return s;
     }
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
-    s.value = textureSampleLevel(color_maps, color_sampler, uv, layer, 0.0);
+    let page_uv = tile_page_uv(camera.tile, uv, textureDimensions(color_maps));
+    s.value = textureSampleLevel(color_maps, color_sampler, page_uv, camera.tile.page, 0.0);
     s.depth = light_depth(camera, p);
     return s;
 }

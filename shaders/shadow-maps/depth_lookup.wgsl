@@ -12,23 +12,27 @@
 @group(3) @binding(4) var depth_values: texture_2d_array<f32>;
 @group(3) @binding(5) var depth_maps_nearest: texture_depth_2d_array;
 
-// Where a world point lands in one layer: texture coordinates, depth in [0, 1], and whether it
-// is inside the layer's frustum.
+// Where a world point lands in one layer: the layer's map coordinates in [0, 1], depth in
+// [0, 1], the layer (its index among the cameras), its tile in the atlas, and whether it is
+// inside the layer's frustum.
 struct MapPoint {
     uv: vec2<f32>,
     depth: f32,
     layer: u32,
+    tile: MapTile,
     inside: bool,
 }
 
 fn map_point(layer: u32, p: vec3<f32>) -> MapPoint {
-    let clip = layer_cameras[layer].camera.view_proj * vec4<f32>(p, 1.0);
+    let camera = layer_cameras[layer].camera;
+    let clip = camera.view_proj * vec4<f32>(p, 1.0);
     let ndc = clip.xyz / clip.w;
     var m: MapPoint;
     m.uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     m.depth = ndc.z;
     m.layer = layer;
-    m.inside = clip.w > 0.0 && abs(ndc.x) <= 1.0 && abs(ndc.y) <= 1.0 && ndc.z >= 0.0 && ndc.z <= 1.0;
+    m.tile = camera.tile;
+    m.inside = camera.tile.size > 0u && clip.w > 0.0 && abs(ndc.x) <= 1.0 && abs(ndc.y) <= 1.0 && ndc.z >= 0.0 && ndc.z <= 1.0;
     return m;
 }
 
@@ -37,15 +41,14 @@ fn compare_map(m: MapPoint, linear: bool) -> f32 {
     if !m.inside {
         return 1.0;
     }
+    let uv = tile_page_uv(m.tile, m.uv, textureDimensions(depth_maps));
     if linear {
-        return textureSampleCompareLevel(depth_maps, depth_compare_linear, m.uv, m.layer, m.depth);
+        return textureSampleCompareLevel(depth_maps, depth_compare_linear, uv, m.tile.page, m.depth);
     }
-    return textureSampleCompareLevel(depth_maps_nearest, depth_compare_nearest, m.uv, m.layer, m.depth);
+    return textureSampleCompareLevel(depth_maps_nearest, depth_compare_nearest, uv, m.tile.page, m.depth);
 }
 
 // The depth stored in the texel under `m`, in [0, 1].
 fn stored_map_depth(m: MapPoint) -> f32 {
-    let size = vec2<i32>(textureDimensions(depth_values));
-    let texel = clamp(vec2<i32>(m.uv * vec2<f32>(size)), vec2<i32>(0), size - vec2<i32>(1));
-    return textureLoad(depth_values, texel, m.layer, 0).r;
+    return textureLoad(depth_values, tile_texel(m.tile, m.uv), m.tile.page, 0).r;
 }

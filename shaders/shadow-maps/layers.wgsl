@@ -1,6 +1,16 @@
-// Shadow-map layers as lookups see them: each layer's camera, the depth that moment maps
-// store, the cube face a direction falls in, and a tangent frame across a light ray. No
-// bindings: the importer binds the cameras.
+// Shadow-map layers as lookups see them: each layer's camera and tile in the atlas, the
+// depth that moment maps store, the cube face a direction falls in, and a tangent frame across
+// a light ray. No bindings: the importer binds the cameras.
+
+// Where one layer's map lies in the atlas (the library's `MapTile`).
+struct MapTile {
+    // Texel of the page the tile starts at.
+    origin: vec2<u32>,
+    // Texels per side.
+    size: u32,
+    // Array layer of the atlas.
+    page: u32,
+}
 
 // One layer's camera (the depth pass's uniform; an array element of 256-byte slots for
 // lookups).
@@ -10,6 +20,28 @@ struct LayerCamera {
     eye: vec4<f32>,
     // Clip space back to world space (to unproject stored depths).
     inv_view_proj: mat4x4<f32>,
+    tile: MapTile,
+}
+
+// Page coordinates in [0, 1] of tile coordinates `uv`, kept half a texel inside the tile so
+// bilinear taps never read a neighbouring tile (edges repeat, like a clamping sampler).
+fn tile_page_uv(tile: MapTile, uv: vec2<f32>, page_size: vec2<u32>) -> vec2<f32> {
+    let size = f32(tile.size);
+    let texel = clamp(uv * size, vec2<f32>(0.5), vec2<f32>(size - 0.5));
+    return (vec2<f32>(tile.origin) + texel) / vec2<f32>(page_size);
+}
+
+// The page texel under tile coordinates `uv` (clamped to the tile).
+fn tile_texel(tile: MapTile, uv: vec2<f32>) -> vec2<i32> {
+    let size = i32(tile.size);
+    let texel = clamp(vec2<i32>(floor(uv * f32(size))), vec2<i32>(0), vec2<i32>(size - 1));
+    return vec2<i32>(tile.origin) + texel;
+}
+
+// `texel` clamped to the tile's texels (neighbourhoods stay inside the tile).
+fn clamp_to_tile(tile: MapTile, texel: vec2<i32>) -> vec2<i32> {
+    let origin = vec2<i32>(tile.origin);
+    return clamp(texel, origin, origin + vec2<i32>(i32(tile.size) - 1));
 }
 
 // The light-space depth of `world` that moment maps store: distance to the light over far
@@ -48,7 +80,7 @@ fn light_layer(first_layer: u32, layer_count: u32, light_position: vec3<f32>, p:
 // the cameras (`CAMERA_STRIDE` in the library).
 struct CameraSlot {
     camera: LayerCamera,
-    _pad: array<vec4<f32>, 7>,
+    _pad: array<vec4<f32>, 6>,
 }
 
 // World size of one map texel at p, across the light's rays: `texel_scale` itself for

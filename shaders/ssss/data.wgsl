@@ -3,8 +3,8 @@
 // of array layer `l / 4` in the float targets, and bit `l % 32` of array layer `l / 32` in
 // the bit targets (occluded bits; the tinted bits follow in as many layers again).
 
-// Largest layer count the passes handle (64, the plugin's `max_layers` cap): the private
-// arrays of the penumbra pass hold this many groups of four and words of 32.
+// Largest layer count of one batch (64, the plugin's `max_layers` cap): the private arrays
+// of the penumbra pass hold this many groups of four and words of 32.
 const MAX_GROUPS: u32 = 16u;
 const MAX_WORDS: u32 = 2u;
 
@@ -24,18 +24,20 @@ struct Settings {
     pixel_scale: f32,
     // What the debug pass shows (`DEBUG_*` in `ssss/debug.wgsl`).
     debug_mode: u32,
+    // The batch's first layer among all (a multiple of four): the passes run once per batch
+    // of at most 64 layers, each over its own layers 0..layer_count.
+    layer_base: u32,
     // To 64 bytes, where the light array starts (its 16-byte alignment).
-    _pad0: u32,
     _pad1: u32,
     _pad2: u32,
 }
 
-// One scene light's maps and layer (indexed like the scene's lights).
+// One scene light's maps and layer in the batch (indexed like the scene's lights).
 struct SsssLight {
     first_layer: u32,
-    // 0 when the light is culled or not shadowed; 1 or 6 (cube faces).
+    // 0 when the light is culled, not shadowed or in another batch; 1 or 6 (cube faces).
     layer_count: u32,
-    // Its screen-space layer (visibility slot).
+    // Its screen-space layer in the batch (visibility slot layer_base + layer).
     layer: u32,
     perspective: u32,
     near: f32,

@@ -67,11 +67,12 @@ fn cs_debug(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
                 case DEBUG_HARD: { sum += select(vec3<f32>(1.0), vec3<f32>(0.0), occluded); }
                 case DEBUG_BLURRED: {
-                    sum += vec3<f32>(textureLoad(visibility, pixel, group_of(layer), 0)[layer % 4u]);
+                    let slot = settings.layer_base + layer;
+                    sum += vec3<f32>(textureLoad(visibility, pixel, group_of(slot), 0)[slot % 4u]);
                 }
                 default: {
                     if settings.translucent == 1u {
-                        sum += textureLoad(transmittance, pixel, layer, 0).rgb;
+                        sum += textureLoad(transmittance, pixel, settings.layer_base + layer, 0).rgb;
                     } else {
                         sum += vec3<f32>(1.0);
                     }

@@ -7,7 +7,8 @@ const MIN_BLOCK: i32 = 8;
 
 @group(0) @binding(0) var depth_maps: texture_2d_array<f32>;
 @group(0) @binding(1) var min_maps: texture_storage_2d_array<r32float, write>;
-// The map layers that are rendered this frame (culled ones are skipped).
+// The atlas pages rendered into this frame (others are skipped). Atlas tiles are whole
+// blocks, so no block straddles two lights' maps.
 @group(0) @binding(2) var<storage, read> kept_layers: array<u32>;
 
 @compute @workgroup_size(8, 8, 1)

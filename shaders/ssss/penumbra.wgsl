@@ -42,9 +42,7 @@ fn linear_depth(d: f32) -> f32 {
 
 // The translucency map's texel under `m`: min transmittance (rgb), nearest `light_depth` (a).
 fn translucency_at(m: MapPoint) -> vec4<f32> {
-    let size = vec2<i32>(textureDimensions(translucency));
-    let texel = clamp(vec2<i32>(m.uv * vec2<f32>(size)), vec2<i32>(0), size - vec2<i32>(1));
-    return textureLoad(translucency, texel, m.layer, 0);
+    return textureLoad(translucency, tile_texel(m.tile, m.uv), m.tile.page, 0);
 }
 
 // The nearest translucent caster on the light ray through `p` (which projects to `m`), as a
@@ -130,15 +128,18 @@ fn width_by_search(p: vec3<f32>, receiver: f32, frame: mat2x3<f32>, texel: f32, 
 // Penumbra width from the min-filtered maps (0: no blocker near): the nearest depth over the
 // min texels covering the search radius around `m` (at most 5 x 5 of them).
 fn width_by_min_filter(m: MapPoint, receiver: f32, texel: f32) -> f32 {
-    let size = vec2<i32>(textureDimensions(min_maps));
-    let block = f32(textureDimensions(depth_values).x) / f32(size.x);
-    let reach = clamp(i32(ceil(search_radius(receiver, texel) / (texel * block))), 1, 2);
-    let center = vec2<i32>(m.uv * vec2<f32>(size));
+    let block = textureDimensions(depth_values).x / textureDimensions(min_maps).x;
+    let reach = clamp(i32(ceil(search_radius(receiver, texel) / (texel * f32(block)))), 1, 2);
+    // The tile in min texels (tiles are whole blocks).
+    var blocks = m.tile;
+    blocks.origin /= block;
+    blocks.size /= block;
+    let center = tile_texel(blocks, m.uv);
     var nearest = 1.0;
     for (var y = -reach; y <= reach; y++) {
         for (var x = -reach; x <= reach; x++) {
-            let t = clamp(center + vec2<i32>(x, y), vec2<i32>(0), size - vec2<i32>(1));
-            nearest = min(nearest, textureLoad(min_maps, t, m.layer, 0).r);
+            let t = clamp_to_tile(blocks, center + vec2<i32>(x, y));
+            nearest = min(nearest, textureLoad(min_maps, t, m.tile.page, 0).r);
         }
     }
     let blocker = linear_depth(nearest);

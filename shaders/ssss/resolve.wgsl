@@ -117,10 +117,10 @@ fn cs_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
                     }
                     // What arrives is visibility times transmittance: keep the colour part.
                     let t = saturate(light / max(visibility[c], 1e-3));
-                    textureStore(transmittance_out, p, layer, vec4<f32>(t, 1.0));
+                    textureStore(transmittance_out, p, settings.layer_base + layer, vec4<f32>(t, 1.0));
                 }
             }
         }
-        textureStore(visibility_out, p, g, visibility);
+        textureStore(visibility_out, p, settings.layer_base / 4u + g, visibility);
     }
 }

@@ -62,3 +62,56 @@ fn every_light_of_two_hundred_and_fifty_six_keeps_its_own_shadows() {
         );
     }
 }
+
+/// The scene format's limit: 1024 lights of every kind (767 cube maps, 256 spot maps, a sun),
+/// far more map layers than a device has array layers. Every technique renders it on a device
+/// with WebGPU's default limits (256 array layers, 8192² textures, 32 bytes of colour
+/// attachments a sample, 4 bind groups) on the test adapter, or, where a technique declares it
+/// needs more than those defaults, on the adapter's own limits (which give the same atlas: 64
+/// pages at most). Small pages keep the test short on a software rasterizer: the tiles are
+/// what is tested, not their size.
+#[test]
+fn a_thousand_and_twenty_four_lights_render_with_every_technique() {
+    let scene = zoo_host::Scene::load(&scene_path("lights-1024.ron")).unwrap();
+    assert_eq!(scene.lights.len(), 1024);
+    let size = UVec2::new(160, 120);
+    let webgpu = zoo_host::test_support::gpu_with_webgpu_limits();
+    let mut on_webgpu = Renderer::new(webgpu.clone(), scene.clone(), size).unwrap();
+    let mut on_adapter = Renderer::new(gpu(), scene.clone(), size).unwrap();
+    let mut on_defaults = 0;
+    for registration in zoo_host::registry() {
+        if registration.id.starts_with("test-") {
+            continue;
+        }
+        let (renderer, limits) = match registration.unavailable_reason(&webgpu) {
+            None => (&mut on_webgpu, "WebGPU default limits".to_string()),
+            Some(why) => (&mut on_adapter, format!("adapter limits: {why}")),
+        };
+        on_defaults += usize::from(limits.starts_with("WebGPU"));
+        let start = std::time::Instant::now();
+        let values = zoo_host::test_support::small_map_params(&(registration.params)());
+        renderer
+            .set_technique(registration.id, &values)
+            .unwrap_or_else(|e| panic!("{} ({limits}): {e}", registration.id));
+        renderer.render(&View::Final).unwrap();
+        assert_eq!(
+            renderer.technique().id,
+            registration.id,
+            "{} ({limits}) was disabled",
+            registration.id
+        );
+        let counters = renderer.wait_for_counters();
+        let atlas: Vec<_> = (counters.iter())
+            .filter(|(name, _)| name.starts_with("atlas") || name.starts_with("lights with"))
+            .collect();
+        eprintln!(
+            "{} ({limits}): {:.1} s, {atlas:?}",
+            registration.id,
+            start.elapsed().as_secs_f64()
+        );
+    }
+    assert!(
+        on_defaults >= 10,
+        "most techniques run within WebGPU's defaults"
+    );
+}

@@ -84,14 +84,13 @@ fn warped_and_split_maps_put_more_texels_near_the_viewer() {
     let camera = scene.camera;
     let size = UVec2::new(256, 256);
     let view_proj = camera.projection(1.0) * camera.view();
-    let inputs = |resolution| PlanInputs {
+    let inputs = PlanInputs {
         lights: &scene.lights,
         camera: &camera,
         view_proj,
         size,
         objects: &objects,
         casters: &casters,
-        resolution,
         stable: true,
     };
     let light = &scene.lights[0];
@@ -102,7 +101,7 @@ fn warped_and_split_maps_put_more_texels_near_the_viewer() {
         let p = ground(d);
         match name {
             "uniform (sm-pcf, 2048)" => {
-                StandardLayers.frustums(light, &inputs(2048))[0].texel_world_size(p, 2048)
+                StandardLayers.frustums(light, 2048, &inputs)[0].texel_world_size(p, 2048)
             }
             "pssm (4 x 1024)" => {
                 let cascades = Cascades {
@@ -114,7 +113,7 @@ fn warped_and_split_maps_put_more_texels_near_the_viewer() {
                 let depth =
                     (p - camera.position).dot((camera.target - camera.position).normalize());
                 let split = (0..4).find(|&i| depth <= c[i + 1]).unwrap_or(3);
-                cascades.frustums(light, &inputs(1024))[split].texel_world_size(p, 1024)
+                cascades.frustums(light, 1024, &inputs)[split].texel_world_size(p, 1024)
             }
             "lispsm (2048)" => lispsm_frustum(light.direction, &camera, 1.0, range, &casters, 1.0)
                 .frustum

@@ -133,6 +133,14 @@ pub fn gpu_without(removed: wgpu::Features) -> Arc<GpuContext> {
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// A new context on the test adapter with WebGPU's default limits (256 array layers, 8192²
+/// textures...) instead of the adapter's.
+pub fn gpu_with_webgpu_limits() -> Arc<GpuContext> {
+    GpuContext::new_headless_limited(wgpu::Limits::default())
+        .map(Arc::new)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// As [`judge`], for a scene built in the test.
 pub fn judge_scene(
     loaded: crate::scene::Scene,

@@ -1,23 +1,24 @@
-//! A separable Gaussian blur of colour map layers (moment maps, for example) through a
-//! one-layer scratch texture (`shaders/shadow-maps/blur.wgsl`).
+//! A separable Gaussian blur of colour map layers (moment maps, for example), tile by tile
+//! through a one-page scratch texture (`shaders/shadow-maps/blur.wgsl`).
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::gpu::PassRecorder;
 use zoo_host::kit::{UniformSlots, bind_group, bind_group_layout, texture};
 use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
 
+use crate::atlas::MapTile;
 use crate::maps::MapArray;
-use crate::planning::LightMaps;
-use crate::set::layer_pass_name;
+use crate::set::TilePass;
 
 /// `BlurParams` in `shadow-maps/blur.wgsl`.
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 #[repr(C)]
 struct BlurParams {
-    layer: u32,
+    tile: MapTile,
     radius: u32,
     sigma: f32,
     vertical: u32,
+    _pad: u32,
 }
 
 /// The scratch layer and the source bind groups for one map array.
@@ -85,14 +86,15 @@ impl LayerBlur {
         })
     }
 
-    /// Blurs every layer of `lights` in `maps` with a Gaussian of `radius` texels on each side
-    /// (standard deviation radius / 2); nothing for radius 0. Once per frame.
+    /// Blurs the tile of each of `passes` in `maps` with a Gaussian of `radius` texels on each
+    /// side (standard deviation radius / 2; taps past the tile's edge repeat it); nothing for
+    /// radius 0. Once per frame.
     pub fn record(
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         maps: &MapArray,
-        lights: &[LightMaps],
+        passes: &[TilePass<'_>],
         radius: u32,
         base: &str,
     ) {
@@ -105,53 +107,49 @@ impl LayerBlur {
             self.bound = Some(self.bind(ctx.gpu, maps));
         }
         let bound = self.bound.as_ref().expect("bound above");
-        // Each layer's horizontal pass reads it from the maps; every vertical pass reads the
-        // scratch's layer 0.
-        let layers: Vec<(String, u32)> = lights
-            .iter()
-            .flat_map(|l| {
-                (0..l.frustums.len()).map(move |face| {
-                    let name = layer_pass_name(base, l, face);
-                    (name, l.first_layer + face as u32)
-                })
-            })
-            .collect();
-        let step = |layer, vertical| BlurParams {
-            layer,
+        // Each tile's horizontal pass reads it from its page into the same texels of the
+        // scratch page; its vertical pass reads those back into the page.
+        let step = |tile, vertical| BlurParams {
+            tile,
             radius,
             sigma: radius as f32 * 0.5,
             vertical: u32::from(vertical),
+            _pad: 0,
         };
-        let params: Vec<BlurParams> = (layers.iter())
-            .flat_map(|(_, layer)| [step(*layer, false), step(0, true)])
+        let params: Vec<BlurParams> = (passes.iter())
+            .flat_map(|p| {
+                [
+                    step(p.tile, false),
+                    step(MapTile { page: 0, ..p.tile }, true),
+                ]
+            })
             .collect();
         self.params.write(ctx.gpu, &params);
-        for (i, (base, layer)) in layers.iter().enumerate() {
+        for (i, tile_pass) in passes.iter().enumerate() {
+            let name = tile_pass.name(base);
+            let page = tile_pass.tile.page as usize;
             let steps = [
                 (
                     "horizontal",
                     &bound.maps_group,
                     &bound.scratch.layer_views[0],
                 ),
-                (
-                    "vertical",
-                    &bound.scratch_group,
-                    &maps.layer_views[*layer as usize],
-                ),
+                ("vertical", &bound.scratch_group, &maps.layer_views[page]),
             ];
             for (k, (direction, source, target)) in steps.into_iter().enumerate() {
-                let label = format!("{base} ({direction})");
+                let label = format!("{name} ({direction})");
                 let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&label),
                     color_attachments: &[zoo_host::gpu::color_attachment(
                         target,
-                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        wgpu::LoadOp::Load,
                     )],
                     depth_stencil_attachment: None,
                     timestamp_writes: None,
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
+                tile_pass.tile.restrict(&mut pass);
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, source, &[]);
                 let offset = self.params.offset(2 * i + k);
@@ -199,10 +197,11 @@ mod tests {
             .unwrap()
             .source;
         let (size, fields) = zoo_host::mirror_fields!(BlurParams {
-            layer,
+            tile,
             radius,
             sigma,
-            vertical
+            vertical,
+            _pad
         });
         check_mirror(&source, "BlurParams", size, &fields, SizeRule::Equal).unwrap();
     }

@@ -58,13 +58,18 @@ impl LayerPlan for Cascades {
         }
     }
 
-    fn frustums(&self, light: &Light, inputs: &PlanInputs<'_>) -> Vec<LightFrustum> {
+    fn frustums(
+        &self,
+        light: &Light,
+        resolution: u32,
+        inputs: &PlanInputs<'_>,
+    ) -> Vec<LightFrustum> {
         if light.kind != LightKind::Directional {
             return Vec::new();
         }
         let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
         let c = self.distances(inputs.camera, aspect, inputs.objects, inputs.stable);
-        let stable = inputs.stable.then_some(inputs.resolution);
+        let stable = inputs.stable.then_some(resolution);
         (0..c.len() - 1)
             .map(|i| {
                 let start = match i {

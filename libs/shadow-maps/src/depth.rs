@@ -8,9 +8,11 @@ use zoo_host::gpu::PassRecorder;
 use zoo_host::render::Vertex;
 use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
 
+use crate::atlas::MapTile;
 use crate::light_space::{LightFrustum, Projection};
 use crate::maps::{MAP_FORMAT, MapArray};
 use crate::planning::LightMaps;
+use crate::set::TilePass;
 
 /// Bytes between layer cameras: a uniform dynamic-offset slot, and `LayerCamera` as an array
 /// element for lookups that project into any layer.
@@ -25,11 +27,13 @@ pub struct LayerCamera {
     pub eye: [f32; 4],
     /// Clip space back to world space (to unproject stored depths).
     pub inv_view_proj: [f32; 16],
+    /// Where the layer's map lies in the atlas.
+    pub tile: MapTile,
 }
 
 impl LayerCamera {
-    /// The camera of `frustum`.
-    pub fn new(frustum: &LightFrustum) -> LayerCamera {
+    /// The camera of `frustum`, rendering into `tile`.
+    pub fn new(frustum: &LightFrustum, tile: MapTile) -> LayerCamera {
         let eye = match frustum.projection {
             Projection::Perspective { far, .. } => {
                 frustum.view.inverse().w_axis.truncate().extend(1.0 / far)
@@ -40,6 +44,7 @@ impl LayerCamera {
             view_proj: frustum.view_proj.to_cols_array(),
             eye: eye.to_array(),
             inv_view_proj: frustum.view_proj.inverse().to_cols_array(),
+            tile,
         }
     }
 }
@@ -189,9 +194,10 @@ impl DepthPass {
     /// the buffer was replaced, so bind groups that read [`Self::cameras`] must be rebuilt.
     pub fn write_cameras(&mut self, gpu: &GpuContext, lights: &[LightMaps]) -> bool {
         let mut bytes = Vec::new();
-        for frustum in lights.iter().flat_map(|l| &l.frustums) {
+        let layers = lights.iter().flat_map(|l| l.frustums.iter().zip(&l.tiles));
+        for (frustum, &tile) in layers {
             let mut slot = [0u8; CAMERA_STRIDE as usize];
-            let camera = LayerCamera::new(frustum);
+            let camera = LayerCamera::new(frustum, tile);
             slot[..size_of::<LayerCamera>()].copy_from_slice(bytemuck::bytes_of(&camera));
             bytes.extend_from_slice(&slot);
         }
@@ -236,11 +242,10 @@ impl DepthPass {
         self.cameras.as_ref().map(|(buffer, _)| buffer)
     }
 
-    /// Records one pass per layer of `lights` that `keep` accepts (by layer index), into the
-    /// depth layers of `depth` and, for a pass with a [`ColorOutput`], the colour layers of
-    /// `color` (`depth` is then one scratch layer of the same resolution, cleared for every
-    /// layer). Passes are named by `name(light_maps, layer)` (`layer` counts within the
-    /// light's layers).
+    /// Records one pass per tile of `passes` (named by [`TilePass::name`] with `base`), into
+    /// the depth pages of `depth` and, for a pass with a [`ColorOutput`], the colour pages of
+    /// `color` (`depth` is then one scratch page, cleared with each page's first tile). Each
+    /// draws the casters `reaches(light, object)` accepts.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -248,9 +253,9 @@ impl DepthPass {
         recorder: &mut PassRecorder<'_>,
         color: Option<&MapArray>,
         depth: &MapArray,
-        lights: &[LightMaps],
-        name: impl Fn(&LightMaps, usize) -> String,
-        keep: &dyn Fn(u32) -> bool,
+        passes: &[TilePass<'_>],
+        base: &str,
+        reaches: &dyn Fn(usize, usize) -> bool,
     ) -> Result<(), TechniqueError> {
         let (_, bind_group) = self
             .cameras
@@ -261,42 +266,40 @@ impl DepthPass {
                 "depth pass: colour maps go with a ColorOutput".into(),
             ));
         }
-        for light_maps in lights {
-            for face in 0..light_maps.frustums.len() {
-                let layer = light_maps.first_layer + face as u32;
-                if !keep(layer) {
-                    continue;
-                }
-                let label = name(light_maps, face);
-                let clear = wgpu::LoadOp::Clear(self.clear.unwrap_or_default());
-                let colors: Vec<_> = color
-                    .map(|c| zoo_host::gpu::color_attachment(&c.layer_views[layer as usize], clear))
-                    .into_iter()
-                    .collect();
-                let depth_layer = if color.is_some() { 0 } else { layer as usize };
-                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(&label),
-                    color_attachments: &colors,
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &depth.layer_views[depth_layer],
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
+        for tile_pass in passes {
+            let page = tile_pass.tile.page as usize;
+            let clear = tile_pass.load_op(self.clear.unwrap_or_default());
+            let colors: Vec<_> = color
+                .map(|c| zoo_host::gpu::color_attachment(&c.layer_views[page], clear))
+                .into_iter()
+                .collect();
+            let depth_page = if color.is_some() { 0 } else { page };
+            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(&tile_pass.name(base)),
+                color_attachments: &colors,
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth.layer_views[depth_page],
+                    depth_ops: Some(wgpu::Operations {
+                        load: tile_pass.load_op(1.0),
+                        store: wgpu::StoreOp::Store,
                     }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            tile_pass.tile.restrict(&mut pass);
+            pass.set_pipeline(&self.pipeline);
+            let offset = tile_pass.layer as u64 * CAMERA_STRIDE;
+            pass.set_bind_group(0, bind_group, &[offset as u32]);
+            let (opaque_only, light) = (self.opaque_only, tile_pass.maps.light);
+            ctx.scene_buffers
+                .draw_objects_where(&mut pass, ctx.scene, |i, o| {
+                    o.casts_shadows
+                        && !(opaque_only && o.transmittance().is_some())
+                        && reaches(light, i)
                 });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, bind_group, &[(layer as u64 * CAMERA_STRIDE) as u32]);
-                let opaque_only = self.opaque_only;
-                ctx.scene_buffers
-                    .draw_objects_where(&mut pass, ctx.scene, |o| {
-                        o.casts_shadows && !(opaque_only && o.transmittance().is_some())
-                    });
-            }
         }
         Ok(())
     }
@@ -316,7 +319,8 @@ mod tests {
         let (size, fields) = zoo_host::mirror_fields!(LayerCamera {
             view_proj,
             eye,
-            inv_view_proj
+            inv_view_proj,
+            tile
         });
         check_mirror(&source, "LayerCamera", size, &fields, SizeRule::Equal).unwrap();
         assert_eq!(CAMERA_STRIDE % 256, 0, "a dynamic-offset slot");

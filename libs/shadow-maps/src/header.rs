@@ -26,10 +26,9 @@ pub struct MapHeader {
 }
 
 impl MapHeader {
-    /// The header of `maps` at `resolution` texels, with lookups `normal_offset` texels off
-    /// the surface.
-    pub fn new(maps: &LightMaps, resolution: u32, normal_offset: f32) -> MapHeader {
-        let scale = maps.scale(resolution);
+    /// The header of `maps`, with lookups `normal_offset` texels off the surface.
+    pub fn new(maps: &LightMaps, normal_offset: f32) -> MapHeader {
+        let scale = maps.scale();
         MapHeader {
             light: maps.light as u32,
             first_layer: maps.first_layer,

@@ -1,7 +1,8 @@
 //! Shadow-map building blocks shared by the shadow-map techniques (sm-pcf, the moment family,
 //! PSSM and the warped maps, the hybrid, SSSS, LPV): light frusta fitted to spot cones, cube
 //! faces and what the camera sees ([`light_space`]), the per-light layer plan with screen
-//! scissors ([`planning`]), the depth array under a memory budget ([`maps`]), the depth pass
+//! scissors ([`planning`]), the shadow atlas that gives every layer a tile at its light's
+//! tier within the device's limits and a memory budget ([`atlas`], [`maps`]), the depth pass
 //! that fills it, optionally with a colour map such as moments ([`depth`]), and a separable
 //! blur of colour map layers ([`blur`]). [`ShadowMapSet`] keeps them up to date for a
 //! technique in one call per frame.
@@ -10,6 +11,7 @@
 //! [`Filter`] choice says; the header, receivers, texel sizes, the map groups and the filters
 //! live in WGSL: `shaders/shadow-maps/`.
 
+pub mod atlas;
 pub mod blur;
 pub mod cascades;
 pub mod culling;
@@ -27,21 +29,19 @@ pub mod set;
 pub mod translucent;
 pub mod warped;
 
+pub use atlas::{AtlasLimits, MEMORY_BUDGET, MapTile};
 pub use blur::LayerBlur;
 pub use cascades::Cascades;
 pub use depth::{CAMERA_STRIDE, ColorOutput, DepthPass, DepthState, LayerCamera};
 pub use filter::{Filter, MapFilter, MapFilters};
 pub use header::MapHeader;
 pub use lookup_pass::{Lookup, LookupPass, LookupShader};
-pub use maps::{
-    CUBE_GUARD, MAP_FORMAT, MEMORY_BUDGET, MapArray, effective_resolution, filterable_rg_format,
-    filterable_rgba_format,
-};
+pub use maps::{CUBE_GUARD, MAP_FORMAT, MapArray, filterable_rg_format, filterable_rgba_format};
 pub use moments::{MomentMaps, MomentMethod, MomentSettings};
 pub use params::{FilterParams, MapParams};
 pub use planning::{
-    LayerPlan, LightMaps, MapScale, PlanInputs, StandardLayers, layers_needed_with, light_scissor,
-    light_size, object_bounds, plan_with,
+    LayerPlan, LightMaps, MapScale, PlanInputs, StandardLayers, light_scissor, light_size,
+    object_bounds, plan_with,
 };
-pub use set::{ShadowMapSet, layer_pass_name};
+pub use set::{ShadowMapSet, TilePass, layer_pass_name};
 pub use translucent::{TRANSLUCENT_FORMAT, TranslucentPass};

@@ -1,5 +1,5 @@
-//! The arrays that hold every light's shadow-map layers: depth maps, or colour maps (moments,
-//! fluxes) rendered beside a depth scratch.
+//! The array textures that hold the atlas pages of every light's shadow maps: depth maps, or
+//! colour maps (moments, fluxes) rendered beside a depth scratch.
 
 use zoo_host::GpuContext;
 use zoo_host::wgpu;
@@ -8,32 +8,6 @@ use zoo_host::wgpu;
 pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Texels of guard band around each cube face (covers bilinear taps across face edges).
 pub const CUBE_GUARD: u32 = 2;
-/// Shadow maps are kept under this many bytes; the resolution drops to fit.
-pub const MEMORY_BUDGET: u64 = 1 << 30;
-
-/// The resolution to use: `requested` clamped to the device and to [`MEMORY_BUDGET`] for
-/// `layers` layers of `bytes_per_texel`, with a note saying why when it was lowered.
-pub fn effective_resolution(
-    requested: u32,
-    device_max: u32,
-    layers: u32,
-    bytes_per_texel: u64,
-) -> (u32, Option<String>) {
-    let mut resolution = requested.min(device_max);
-    let mut note = (resolution < requested)
-        .then(|| format!("map_size {requested} exceeds the device limit; using {resolution}"));
-    while resolution > 256
-        && layers as u64 * (resolution as u64).pow(2) * bytes_per_texel > MEMORY_BUDGET
-    {
-        resolution /= 2;
-        note = Some(format!(
-            "{layers} map layers at {requested} texels exceed {} MiB; using {resolution}",
-            MEMORY_BUDGET >> 20
-        ));
-    }
-    (resolution, note)
-}
-
 /// The two-channel float format for filtered colour maps (moments): `Rg32Float` where the
 /// device filters 32-bit floats (`FLOAT32_FILTERABLE`), `Rg16Float` elsewhere.
 pub fn filterable_rg_format(device: &wgpu::Device) -> wgpu::TextureFormat {
@@ -60,7 +34,8 @@ pub fn filterable_rgba_format(device: &wgpu::Device) -> wgpu::TextureFormat {
     }
 }
 
-/// `layers` square maps of `resolution` texels in one array texture (depth or colour).
+/// `layers` square maps (atlas pages) of `resolution` texels in one array texture (depth or
+/// colour).
 pub struct MapArray {
     pub resolution: u32,
     /// Layers in use (the texture may hold a spare one on GL, see
@@ -127,26 +102,5 @@ impl MapArray {
             layer_views,
             array_view,
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn resolution_is_clamped_to_device_and_memory() {
-        assert_eq!(effective_resolution(2048, 16384, 3, 4), (2048, None));
-        let (r, note) = effective_resolution(8192, 4096, 1, 4);
-        assert_eq!(r, 4096);
-        assert!(note.unwrap().contains("device limit"));
-        // 224 layers at 2048 would need 3.5 GiB.
-        let (r, note) = effective_resolution(2048, 16384, 224, 4);
-        assert!(224 * (r as u64).pow(2) * 4 <= MEMORY_BUDGET);
-        assert!(note.unwrap().contains("exceed"));
-        // Twice the bytes per texel: the next step down.
-        let (wide, _) = effective_resolution(2048, 16384, 224, 8);
-        assert!(224 * (wide as u64).pow(2) * 8 <= MEMORY_BUDGET);
-        assert_eq!(wide, r / 2);
     }
 }

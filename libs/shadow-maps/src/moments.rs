@@ -128,9 +128,10 @@ impl MomentMaps {
             .record(ctx, recorder, &format!("{label} moments"))?;
         let lights = self.maps.lights();
         let blur = format!("{label} blur");
-        (self.blur).record(ctx, recorder, maps, lights, s.blur_radius, &blur);
+        let passes = self.maps.tile_passes();
+        (self.blur).record(ctx, recorder, maps, &passes, s.blur_radius, &blur);
         let uniform = |light: usize| MomentLight {
-            map: MapHeader::new(&lights[light], maps.resolution, s.normal_offset),
+            map: MapHeader::new(&lights[light], s.normal_offset),
             bias: s.bias,
             bleeding_reduction: s.bleeding_reduction,
             _pad: [0.0; 2],
@@ -150,10 +151,11 @@ impl MomentMaps {
         moments.into_iter().chain(cameras).collect()
     }
 
-    /// The first channel of the first light's first layer, for resource `"moments"`.
+    /// The first channel of the atlas page holding the first light's first layer, for
+    /// resource `"moments"`.
     pub fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        let layer = self.maps.lights().first()?.first_layer as usize;
-        let view = &self.maps.maps()?.layer_views[layer];
+        let page = self.maps.lights().first()?.tiles.first()?.page as usize;
+        let view = &self.maps.maps()?.layer_views[page];
         let mapping = ViewMapping::Channel {
             channel: 0,
             min: 0.0,

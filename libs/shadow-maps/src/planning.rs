@@ -3,17 +3,23 @@
 use zoo_host::glam::{Mat4, UVec2, Vec2, Vec3};
 use zoo_host::scene::{Camera, Light, LightKind, Scene};
 
+use crate::atlas::{Allocation, AtlasLimits, MapTile, allocate, wanted_tier};
 use crate::light_space::{
     Aabb, LightFrustum, Projection, cube_frustums, directional_frustum, spot_frustum,
 };
 use crate::maps::CUBE_GUARD;
 
-/// One light's layers of the map array.
+/// One light's layers: their cameras and their tiles in the atlas.
 #[derive(Debug, Clone)]
 pub struct LightMaps {
     /// Index of the scene light.
     pub light: usize,
+    /// Index of its first layer among all lights' layers (and layer cameras).
     pub first_layer: u32,
+    /// Texels per side of each of its maps (its tier's tile size).
+    pub resolution: u32,
+    /// Where each layer's map lies in the atlas, one per frustum.
+    pub tiles: Vec<MapTile>,
     /// One frustum per layer: 1 (spot, directional) or 6 (point: cube faces) under the
     /// standard plan; a technique's own plan may use others (cascade splits), or none for a
     /// light it does not shadow.
@@ -36,8 +42,9 @@ pub struct MapScale {
 }
 
 impl LightMaps {
-    /// The projection of this light's layers (all alike) for `resolution`-texel maps.
-    pub fn scale(&self, resolution: u32) -> MapScale {
+    /// The projection of this light's layers (all alike) at its resolution.
+    pub fn scale(&self) -> MapScale {
+        let resolution = self.resolution;
         match self.frustums[0].projection {
             Projection::Perspective {
                 tan_half_fov,
@@ -71,8 +78,14 @@ impl LightMaps {
 pub trait LayerPlan {
     /// Layers `light` needs (the same until the lights or the plan's settings change).
     fn layers(&self, light: &Light) -> u32;
-    /// The frusta of `light`, exactly [`Self::layers`] of them, fitted to `inputs`.
-    fn frustums(&self, light: &Light, inputs: &PlanInputs<'_>) -> Vec<LightFrustum>;
+    /// The frusta of `light`, exactly [`Self::layers`] of them, fitted to `inputs` for maps
+    /// of `resolution` texels.
+    fn frustums(
+        &self,
+        light: &Light,
+        resolution: u32,
+        inputs: &PlanInputs<'_>,
+    ) -> Vec<LightFrustum>;
     /// What one layer of a light with several is called in pass names.
     fn layer_word(&self, _light: &Light) -> &'static str {
         "face"
@@ -90,26 +103,26 @@ impl LayerPlan for StandardLayers {
         if light.kind == LightKind::Point { 6 } else { 1 }
     }
 
-    fn frustums(&self, light: &Light, inputs: &PlanInputs<'_>) -> Vec<LightFrustum> {
+    fn frustums(
+        &self,
+        light: &Light,
+        resolution: u32,
+        inputs: &PlanInputs<'_>,
+    ) -> Vec<LightFrustum> {
         let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
         match light.kind {
             LightKind::Spot => vec![spot_frustum(light)],
-            LightKind::Point => cube_frustums(light, inputs.resolution, CUBE_GUARD).to_vec(),
+            LightKind::Point => cube_frustums(light, resolution, CUBE_GUARD).to_vec(),
             LightKind::Directional => vec![directional_frustum(
                 light.direction,
                 inputs.camera,
                 aspect,
                 inputs.objects,
                 inputs.casters,
-                inputs.stable.then_some(inputs.resolution),
+                inputs.stable.then_some(resolution),
             )],
         }
     }
-}
-
-/// Layers the lights need under `layout` (at least one in all).
-pub fn layers_needed_with(lights: &[Light], layout: &dyn LayerPlan) -> u32 {
-    lights.iter().map(|l| layout.layers(l)).sum::<u32>().max(1)
 }
 
 /// What [`plan_with`] fits the maps to.
@@ -122,33 +135,46 @@ pub struct PlanInputs<'a> {
     /// World bounds of every object and of each caster ([`object_bounds`]).
     pub objects: &'a [Aabb],
     pub casters: &'a [Aabb],
-    /// Map resolution; with `stable`, directional maps keep a stable fit (extent on a ladder,
-    /// centre snapped to whole texels) so edges do not shimmer as the camera moves.
-    pub resolution: u32,
+    /// With `stable`, directional maps keep a stable fit (extent on a ladder, centre snapped
+    /// to whole texels) so edges do not shimmer as the camera moves.
     pub stable: bool,
 }
 
-/// Consecutive layers for every light with the frusta `layout` fits.
-pub fn plan_with(inputs: &PlanInputs<'_>, layout: &dyn LayerPlan) -> Vec<LightMaps> {
+/// Consecutive layers for every light with the frusta `layout` fits, each light's maps at
+/// the tier the atlas gives it within `limits` (from its span on screen, [`wanted_tier`]).
+pub fn plan_with(
+    inputs: &PlanInputs<'_>,
+    layout: &dyn LayerPlan,
+    limits: &AtlasLimits,
+) -> (Vec<LightMaps>, Allocation) {
+    let layers: Vec<u32> = inputs.lights.iter().map(|l| layout.layers(l)).collect();
+    let scissors: Vec<[u32; 4]> = (inputs.lights.iter())
+        .map(|light| light_scissor(light, inputs.view_proj, inputs.size))
+        .collect();
+    let wanted: Vec<u32> = (scissors.iter())
+        .map(|&scissor| wanted_tier(scissor, inputs.size))
+        .collect();
+    let allocation = allocate(&layers, &wanted, limits);
     let mut next_layer = 0;
-    inputs
-        .lights
-        .iter()
-        .enumerate()
+    let lights = (inputs.lights.iter().enumerate())
         .map(|(i, light)| {
-            let frustums = layout.frustums(light, inputs);
-            debug_assert_eq!(frustums.len() as u32, layout.layers(light));
-            let maps = LightMaps {
+            let resolution = limits.tile_size(allocation.tiers[i]);
+            let frustums = layout.frustums(light, resolution, inputs);
+            debug_assert_eq!(frustums.len() as u32, layers[i]);
+            let first = next_layer as usize;
+            next_layer += layers[i];
+            LightMaps {
                 light: i,
-                first_layer: next_layer,
+                first_layer: first as u32,
+                resolution,
+                tiles: allocation.tiles[first..next_layer as usize].to_vec(),
                 frustums,
                 layer_word: layout.layer_word(light),
-                scissor: light_scissor(light, inputs.view_proj, inputs.size),
-            };
-            next_layer += maps.frustums.len() as u32;
-            maps
+                scissor: scissors[i],
+            }
         })
-        .collect()
+        .collect();
+    (lights, allocation)
 }
 
 /// The screen rectangle covering `light`'s range sphere (the whole screen for directional
@@ -188,11 +214,19 @@ pub fn light_scissor(light: &Light, view_proj: Mat4, size: UVec2) -> [u32; 4] {
 
 /// World-space bounds of the objects (only shadow casters when `casters_only`).
 pub fn object_bounds(scene: &Scene, casters_only: bool) -> Vec<Aabb> {
-    scene
+    let casters = scene
         .objects
         .iter()
-        .filter(|o| o.casts_shadows || !casters_only)
-        .filter_map(|o| {
+        .map(|o| o.casts_shadows || !casters_only);
+    (each_object_bounds(scene).into_iter().zip(casters))
+        .filter_map(|(bounds, kept)| bounds.filter(|_| kept))
+        .collect()
+}
+
+/// World-space bounds of each scene object, in scene order (none for an empty one).
+pub fn each_object_bounds(scene: &Scene) -> Vec<Option<Aabb>> {
+    (scene.objects.iter())
+        .map(|o| {
             let points: Vec<Vec3> = scene.mesh.indices[o.indices.clone()]
                 .iter()
                 .map(|&i| scene.mesh.positions[i as usize])

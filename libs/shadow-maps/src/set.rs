@@ -5,13 +5,12 @@ use zoo_host::gpu::PassRecorder;
 use zoo_host::technique::{DebugImage, ViewMapping};
 use zoo_host::{Changes, RenderContext, TechniqueResult, wgpu};
 
+use crate::atlas::{Allocation, AtlasLimits, MapTile};
 use crate::depth::{ColorOutput, DepthPass, DepthState};
 use crate::light_space::Aabb;
 use crate::lookup::LookupGroup;
-use crate::maps::{MAP_FORMAT, MapArray, effective_resolution};
-use crate::planning::{
-    LayerPlan, LightMaps, PlanInputs, StandardLayers, layers_needed_with, object_bounds, plan_with,
-};
+use crate::maps::{MAP_FORMAT, MapArray};
+use crate::planning::{LayerPlan, LightMaps, PlanInputs, StandardLayers, object_bounds, plan_with};
 
 /// The name of the pass that renders `layer` of a light's layers: `"{base}: light {l}"` for
 /// a light with one layer, else `"{base}: light {l} {word} {layer}"` with the plan's word for
@@ -24,8 +23,35 @@ pub fn layer_pass_name(base: &str, maps: &LightMaps, layer: usize) -> String {
     }
 }
 
-/// Shadow maps of every light: depth maps, or colour maps (moments, fluxes) with a one-layer
-/// depth scratch when built with a [`ColorOutput`].
+/// One layer's map to render: its light, the layer within the light, its index among all
+/// layers (and layer cameras) and its tile.
+#[derive(Debug, Clone, Copy)]
+pub struct TilePass<'a> {
+    pub maps: &'a LightMaps,
+    pub face: usize,
+    pub layer: u32,
+    pub tile: MapTile,
+    /// The first tile rendered on its page this frame: its pass clears the page.
+    pub first_on_page: bool,
+}
+
+impl TilePass<'_> {
+    /// The pass's name: [`layer_pass_name`] with `base`.
+    pub fn name(&self, base: &str) -> String {
+        layer_pass_name(base, self.maps, self.face)
+    }
+
+    /// Clear on the page's first pass, else keep what the page's other tiles hold.
+    pub fn load_op<V>(&self, clear: V) -> wgpu::LoadOp<V> {
+        match self.first_on_page {
+            true => wgpu::LoadOp::Clear(clear),
+            false => wgpu::LoadOp::Load,
+        }
+    }
+}
+
+/// Shadow maps of every light in an atlas ([`crate::atlas`]): depth maps, or colour maps
+/// (moments, fluxes) with a one-page depth scratch when built with a [`ColorOutput`].
 pub struct ShadowMapSet {
     label: String,
     depth_pass: DepthPass,
@@ -33,9 +59,13 @@ pub struct ShadowMapSet {
     lookup: LookupGroup,
     objects: Vec<Aabb>,
     casters: Vec<Aabb>,
+    /// Per scene object: its world bounds (none for an empty object).
+    object_boxes: Vec<Option<Aabb>>,
     lights: Vec<LightMaps>,
     depth: Option<MapArray>,
     color: Option<MapArray>,
+    limits: Option<AtlasLimits>,
+    allocation: Option<Allocation>,
     fitted: bool,
     /// Per layer: whether [`Self::record`] renders it (all, unless [`Self::cull`] says not).
     kept: Vec<bool>,
@@ -69,18 +99,21 @@ impl ShadowMapSet {
             lookup,
             objects: Vec::new(),
             casters: Vec::new(),
+            object_boxes: Vec::new(),
             lights: Vec::new(),
             depth: None,
             color: None,
+            limits: None,
+            allocation: None,
             fitted: false,
             kept: Vec::new(),
         })
     }
 
-    /// Replans the layers when the scene or the lights change (new maps when their number or
-    /// `resolution` changes) and refits the frusta on any change (directional maps follow the
-    /// camera; with `stable` they keep a stable fit). Returns whether the maps or the camera
-    /// buffer were replaced, so bind groups over them must be rebuilt.
+    /// Replans the layers on any change: directional maps follow the camera (with `stable`
+    /// they keep a stable fit) and every light's tier follows its span on screen, within an
+    /// atlas of pages of `resolution` texels. Returns whether the maps or the camera buffer
+    /// were replaced, so bind groups over them must be rebuilt.
     pub fn prepare(
         &mut self,
         ctx: &RenderContext<'_>,
@@ -101,27 +134,36 @@ impl ShadowMapSet {
         layout: &dyn LayerPlan,
     ) -> bool {
         self.update_bounds(ctx, changes);
-        let replanned = self.plan_maps(ctx, resolution, layout);
-        if !replanned && self.fitted && changes == Changes::default() {
+        let limits = self.atlas_limits(ctx, resolution);
+        if self.fitted && changes == Changes::default() && self.limits == Some(limits) {
             return false;
         }
-        let resolution = self.resolution();
-        self.lights = plan_with(
-            &PlanInputs {
-                lights: ctx.lights,
-                camera: ctx.camera,
-                view_proj: ctx.frame.matrices.view_proj,
-                size: ctx.size,
-                objects: &self.objects,
-                casters: &self.casters,
-                resolution,
-                stable,
-            },
-            layout,
-        );
+        self.limits = Some(limits);
+        let inputs = PlanInputs {
+            lights: ctx.lights,
+            camera: ctx.camera,
+            view_proj: ctx.frame.matrices.view_proj,
+            size: ctx.size,
+            objects: &self.objects,
+            casters: &self.casters,
+            stable,
+        };
+        let (lights, allocation) = plan_with(&inputs, layout, &limits);
+        if allocation.unfitted > 0 && self.allocation.as_ref().is_none_or(|a| a.unfitted == 0) {
+            zoo_host::log::warn!(
+                "{}: {} map layers do not fit the atlas even at {}²; their lights are unshadowed there",
+                self.label,
+                allocation.unfitted,
+                limits.tile_size(limits.max_tier())
+            );
+        }
+        self.lights = lights;
+        let shrink = changes.scene || changes.lights;
+        let new_maps = self.make_pages(ctx, limits.page_size, allocation.pages, shrink);
+        self.allocation = Some(allocation);
         self.fitted = true;
         self.kept.clear();
-        let replaced = self.depth_pass.write_cameras(ctx.gpu, &self.lights) || replanned;
+        let replaced = self.depth_pass.write_cameras(ctx.gpu, &self.lights) || new_maps;
         let lookup = &mut self.lookup;
         let maps = self.color.as_ref().or(self.depth.as_ref());
         if let (Some(maps), Some(cameras)) = (maps, self.depth_pass.cameras())
@@ -130,6 +172,25 @@ impl ShadowMapSet {
             lookup.bind(&ctx.gpu.device, maps, cameras);
         }
         replaced
+    }
+
+    /// The atlas's pages for maps of `requested` texels on this device.
+    fn atlas_limits(&self, ctx: &RenderContext<'_>, requested: u32) -> AtlasLimits {
+        let bytes =
+            |format: wgpu::TextureFormat| u64::from(format.block_copy_size(None).unwrap_or(4));
+        let (maps, scratch) = match self.color_format {
+            Some(color) => (bytes(color), bytes(MAP_FORMAT)),
+            None => (bytes(MAP_FORMAT), 0),
+        };
+        let spare = ctx.gpu.info.backend == wgpu::Backend::Gl;
+        let limits = ctx.gpu.device.limits();
+        let (limits, note) = AtlasLimits::new(requested, &limits, spare, maps, scratch);
+        if let Some(note) = note
+            && self.limits != Some(limits)
+        {
+            zoo_host::log::warn!("{}: {note}", self.label);
+        }
+        limits
     }
 
     /// The layout of [`Self::lookup_group`] (see [`crate::lookup`]), for the lookup's
@@ -147,6 +208,7 @@ impl ShadowMapSet {
         if changes.scene || !self.fitted {
             self.objects = object_bounds(ctx.scene, false);
             self.casters = object_bounds(ctx.scene, true);
+            self.object_boxes = crate::planning::each_object_bounds(ctx.scene);
         }
     }
 
@@ -156,33 +218,48 @@ impl ShadowMapSet {
         (&self.objects, &self.casters)
     }
 
-    /// (Re)creates the maps when the layer count or the resolution changes.
-    fn plan_maps(
-        &mut self,
-        ctx: &RenderContext<'_>,
-        requested: u32,
-        layout: &dyn LayerPlan,
-    ) -> bool {
-        let layers = layers_needed_with(ctx.lights, layout);
-        let device_max = ctx.gpu.device.limits().max_texture_dimension_2d;
-        let format = self.color_format.unwrap_or(MAP_FORMAT);
-        let bytes = u64::from(format.block_copy_size(None).unwrap_or(4));
-        let (resolution, note) = effective_resolution(requested, device_max, layers, bytes);
-        let current = self.maps().map(|m| (m.resolution, m.layers));
-        if current == Some((resolution, layers)) {
+    /// (Re)creates the pages when their size changes or more are needed (and, with
+    /// `shrink`, when fewer are); returns whether it did.
+    fn make_pages(&mut self, ctx: &RenderContext<'_>, size: u32, pages: u32, shrink: bool) -> bool {
+        let pages = pages.max(1);
+        let fits = self.maps().is_some_and(|m| {
+            m.resolution == size && m.layers >= pages && (!shrink || m.layers == pages)
+        });
+        if fits {
             return false;
-        }
-        if let Some(note) = note {
-            zoo_host::log::warn!("{}: {note}", self.label);
         }
         let (gpu, label) = (ctx.gpu, &self.label);
         self.color = self
             .color_format
-            .map(|format| MapArray::with_format(gpu, label, resolution, layers, format));
-        let depth_layers = if self.color.is_some() { 1 } else { layers };
+            .map(|format| MapArray::with_format(gpu, label, size, pages, format));
+        let depth_pages = if self.color.is_some() { 1 } else { pages };
         let depth_label = format!("{label} depth");
-        self.depth = Some(MapArray::new(gpu, &depth_label, resolution, depth_layers));
+        self.depth = Some(MapArray::new(gpu, &depth_label, size, depth_pages));
         true
+    }
+
+    /// The layers to render this frame (kept ones), page by page: tiles of one page are
+    /// disjoint, so a depth scratch cleared at each page's first tile serves them all.
+    pub fn tile_passes(&self) -> Vec<TilePass<'_>> {
+        let mut passes: Vec<TilePass<'_>> = (self.lights.iter())
+            .flat_map(|maps| {
+                (maps.tiles.iter().enumerate()).map(move |(face, &tile)| TilePass {
+                    maps,
+                    face,
+                    layer: maps.first_layer + face as u32,
+                    tile,
+                    first_on_page: false,
+                })
+            })
+            .filter(|pass| pass.tile.size > 0 && self.is_kept(pass.layer))
+            .collect();
+        passes.sort_by_key(|pass| (pass.tile.page, pass.layer));
+        let mut page = None;
+        for pass in &mut passes {
+            pass.first_on_page = page != Some(pass.tile.page);
+            page = Some(pass.tile.page);
+        }
+        passes
     }
 
     /// Every light's layers, in light order.
@@ -199,8 +276,8 @@ impl ShadowMapSet {
             .or_else(|| shadowed().next())
     }
 
-    /// The `shadow maps` debug image: the first layer of [`Self::debug_light`]`(wanted)`
-    /// (depth maps shown as depth, colour maps as colour).
+    /// The `shadow maps` debug image: the atlas page that holds the first layer of
+    /// [`Self::debug_light`]`(wanted)` (depth maps shown as depth, colour maps as colour).
     pub fn debug_image(&self, wanted: u32) -> Option<DebugImage<'_>> {
         let light = self.debug_light(wanted)?;
         let mapping = match self.color {
@@ -208,18 +285,39 @@ impl ShadowMapSet {
             None => ViewMapping::Depth { min: 0.0, max: 1.0 },
         };
         Some(DebugImage {
-            view: &self.maps()?.layer_views[light.first_layer as usize],
+            view: &self.maps()?.layer_views[light.tiles[0].page as usize],
             mapping,
         })
     }
 
-    /// Workload counters: map layers in use and their resolution.
+    /// Workload counters: map layers in use, the atlas (pages, page size, texels used and the
+    /// budget) and how many lights have maps of each size.
     pub fn counters(&self) -> Vec<(String, f64)> {
         let layers: usize = self.lights.iter().map(|l| l.frustums.len()).sum();
-        vec![
-            ("map layers".into(), layers as f64),
-            ("map resolution".into(), self.resolution() as f64),
-        ]
+        let mut counters = vec![("map layers".into(), layers as f64)];
+        if let (Some(limits), Some(allocation)) = (self.limits, &self.allocation) {
+            let budget = u64::from(limits.max_pages) * u64::from(limits.page_size).pow(2);
+            counters.extend([
+                ("atlas pages".into(), f64::from(allocation.pages)),
+                ("atlas page size".into(), f64::from(limits.page_size)),
+                ("atlas texels used".into(), allocation.texels as f64),
+                ("atlas texel budget".into(), budget as f64),
+                (
+                    "map layers without a tile".into(),
+                    f64::from(allocation.unfitted),
+                ),
+            ]);
+            for tier in 0..=limits.max_tier() {
+                let size = limits.tile_size(tier);
+                let lights = (self.lights.iter())
+                    .filter(|l| !l.tiles.is_empty() && l.resolution == size)
+                    .count();
+                if lights > 0 {
+                    counters.push((format!("lights with {size}² maps"), lights as f64));
+                }
+            }
+        }
+        counters
     }
 
     /// The maps lookups read (the colour maps when there are any, else the depth maps).
@@ -227,8 +325,9 @@ impl ShadowMapSet {
         self.color.as_ref().or(self.depth.as_ref())
     }
 
-    /// Texels per side of the maps (0 before the first [`Self::prepare`]).
-    pub fn resolution(&self) -> u32 {
+    /// Texels per side of the atlas pages (0 before the first [`Self::prepare`]); each
+    /// light's maps are [`LightMaps::resolution`].
+    pub fn page_size(&self) -> u32 {
         self.maps().map_or(0, |m| m.resolution)
     }
 
@@ -270,9 +369,23 @@ impl ShadowMapSet {
             .depth
             .as_ref()
             .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
-        let name = |l: &LightMaps, k| layer_pass_name(base, l, k);
-        let keep = |layer| self.is_kept(layer);
         let color = self.color.as_ref();
-        (self.depth_pass).record(ctx, recorder, color, depth, &self.lights, name, &keep)
+        let passes = self.tile_passes();
+        let reaches = |light, object| self.reaches(&ctx.lights[light], object);
+        (self.depth_pass).record(ctx, recorder, color, depth, &passes, base, &reaches)
+    }
+
+    /// Whether scene object `object` can cast into `light`'s maps: it meets the light's range
+    /// (directional lights reach everything).
+    pub fn reaches(&self, light: &zoo_host::Light, object: usize) -> bool {
+        if light.kind == zoo_host::scene::LightKind::Directional {
+            return true;
+        }
+        self.object_boxes.get(object).is_none_or(|bounds| {
+            bounds.is_some_and(|(lo, hi)| {
+                let nearest = light.position.clamp(lo, hi);
+                nearest.distance_squared(light.position) <= light.range * light.range
+            })
+        })
     }
 }

@@ -14,7 +14,7 @@ use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
 use crate::depth::{CAMERA_STRIDE, LayerCamera};
 use crate::maps::{MAP_FORMAT, MapArray};
-use crate::set::{ShadowMapSet, layer_pass_name};
+use crate::set::ShadowMapSet;
 
 /// Format of the translucency maps: rgb transmittance, a depth (as the depth map stores it).
 pub const TRANSLUCENT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -160,39 +160,34 @@ impl TranslucentPass {
         else {
             return Err(TechniqueError::not_prepared());
         };
-        for light_maps in set.lights() {
-            for face in 0..light_maps.frustums.len() {
-                let layer = light_maps.first_layer + face as u32;
-                if !set.is_kept(layer) {
-                    continue;
-                }
-                let label = layer_pass_name(base, light_maps, face);
-                let clear = wgpu::LoadOp::Clear(wgpu::Color::WHITE);
-                let colors = [zoo_host::gpu::color_attachment(
-                    &maps.layer_views[layer as usize],
-                    clear,
-                )];
-                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(&label),
-                    color_attachments: &colors,
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &depth.layer_views[layer as usize],
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
+        for tile_pass in set.tile_passes() {
+            let page = tile_pass.tile.page as usize;
+            let colors = [zoo_host::gpu::color_attachment(
+                &maps.layer_views[page],
+                tile_pass.load_op(wgpu::Color::WHITE),
+            )];
+            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(&tile_pass.name(base)),
+                color_attachments: &colors,
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth.layer_views[page],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
                     }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-                pass.set_bind_group(1, group, &[(layer as u64 * CAMERA_STRIDE) as u32]);
-                ctx.scene_buffers
-                    .draw_objects_where(&mut pass, ctx.scene, |o| o.transmittance().is_some());
-            }
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            tile_pass.tile.restrict(&mut pass);
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+            let offset = tile_pass.layer as u64 * CAMERA_STRIDE;
+            pass.set_bind_group(1, group, &[offset as u32]);
+            ctx.scene_buffers
+                .draw_objects_where(&mut pass, ctx.scene, |_, o| o.transmittance().is_some());
         }
         Ok(())
     }

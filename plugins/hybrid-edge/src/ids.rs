@@ -6,7 +6,7 @@
 use zoo_host::gpu::PassRecorder;
 use zoo_host::kit::{bind_group, bind_group_layout, storage, texture};
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
-use zoo_shadow_maps::{CAMERA_STRIDE, DepthState, LayerCamera, LightMaps, MAP_FORMAT, MapArray};
+use zoo_shadow_maps::{CAMERA_STRIDE, DepthState, LayerCamera, MAP_FORMAT, MapArray, TilePass};
 
 use crate::NO_TRIANGLE;
 
@@ -187,15 +187,15 @@ impl IdMaps {
         self.bound.as_ref().map(|b| &b.ids)
     }
 
-    /// Renders every layer of `lights` into `depth` and the id maps, one pass each named by
-    /// `name(light, layer)`.
+    /// Renders the tile of each of `passes` into `depth` and the id maps, one pass each named
+    /// by [`TilePass::name`] with `base`.
     pub(crate) fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         depth: &MapArray,
-        lights: &[LightMaps],
-        name: impl Fn(&LightMaps, usize) -> String,
+        passes: &[TilePass<'_>],
+        base: &str,
     ) -> TechniqueResult {
         let bound = self
             .bound
@@ -208,34 +208,32 @@ impl IdMaps {
             b: none,
             a: none,
         };
-        for light_maps in lights {
-            for k in 0..light_maps.frustums.len() {
-                let layer = light_maps.first_layer as usize + k;
-                let label = name(light_maps, k);
-                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(&label),
-                    color_attachments: &[zoo_host::gpu::color_attachment(
-                        &bound.ids.layer_views[layer],
-                        wgpu::LoadOp::Clear(clear),
-                    )],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &depth.layer_views[layer],
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
+        for tile_pass in passes {
+            let page = tile_pass.tile.page as usize;
+            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(&tile_pass.name(base)),
+                color_attachments: &[zoo_host::gpu::color_attachment(
+                    &bound.ids.layer_views[page],
+                    tile_pass.load_op(clear),
+                )],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth.layer_views[page],
+                    depth_ops: Some(wgpu::Operations {
+                        load: tile_pass.load_op(1.0),
+                        store: wgpu::StoreOp::Store,
                     }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-                let offset = (layer as u64 * CAMERA_STRIDE) as u32;
-                pass.set_bind_group(1, &bound.camera_group, &[offset]);
-                pass.draw(0..ctx.scene_buffers.index_count, 0..1);
-            }
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            tile_pass.tile.restrict(&mut pass);
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
+            let offset = (tile_pass.layer as u64 * CAMERA_STRIDE) as u32;
+            pass.set_bind_group(1, &bound.camera_group, &[offset]);
+            pass.draw(0..ctx.scene_buffers.index_count, 0..1);
         }
         Ok(())
     }

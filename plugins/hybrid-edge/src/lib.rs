@@ -30,9 +30,7 @@ use zoo_host::kit::{SlotPipeline, light_pass_name, pipeline_layout};
 use zoo_host::prelude::*;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
-use zoo_shadow_maps::{
-    DepthState, LightMaps, LookupPass, LookupShader, MapHeader, ShadowMapSet, layer_pass_name,
-};
+use zoo_shadow_maps::{DepthState, LightMaps, LookupPass, LookupShader, MapHeader, ShadowMapSet};
 
 use ids::IdMaps;
 use tiles::Tiles;
@@ -345,9 +343,9 @@ fn record_counts(
 }
 
 /// The band pass's uniform for one light's maps.
-fn edge_light(p: &HybridParams, maps: &LightMaps, resolution: u32, restriction: u32) -> EdgeLight {
+fn edge_light(p: &HybridParams, maps: &LightMaps, restriction: u32) -> EdgeLight {
     EdgeLight {
-        map: MapHeader::new(maps, resolution, p.normal_offset),
+        map: MapHeader::new(maps, p.normal_offset),
         radius: p.radius,
         restriction,
         _pad: [0; 2],
@@ -430,15 +428,13 @@ impl ShadowTechnique for Hybrid {
         let exact = p.restriction == Restriction::TriangleIds;
         if exact {
             let depth = gpu.maps.maps().ok_or_else(TechniqueError::not_prepared)?;
-            let name = |l: &LightMaps, k| layer_pass_name(IDS_PASS, l, k);
-            gpu.ids
-                .record(ctx, recorder, depth, gpu.maps.lights(), name)?;
+            let passes = gpu.maps.tile_passes();
+            gpu.ids.record(ctx, recorder, depth, &passes, IDS_PASS)?;
         } else {
             gpu.maps.record(ctx, recorder, MAP_PASS)?;
         }
-        let resolution = gpu.maps.resolution();
         let restriction = gpu.restriction_codes.code(p.restriction.index());
-        let uniform = |l: &LightMaps, _| Some(edge_light(p, l, resolution, restriction));
+        let uniform = |l: &LightMaps, _| Some(edge_light(p, l, restriction));
         let lookups = match exact {
             true => gpu.band_ids.write(ctx, &gpu.maps, p.debug_light, uniform),
             false => gpu.band.write(ctx, &gpu.maps, p.debug_light, uniform),
@@ -582,7 +578,9 @@ zoo_host::register_technique! {
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     required_features: || wgpu::Features::DEPTH_CLIP_CONTROL,
     required_limits: || wgpu::Limits {
-        max_storage_buffers_per_shader_stage: 8,
+        // Volume generation: the frame group's lights and objects and the generation group's
+        // eight buffers in one compute stage.
+        max_storage_buffers_per_shader_stage: 10,
         max_bind_groups: 5,
         ..wgpu::Limits::downlevel_defaults()
     },

@@ -460,10 +460,9 @@ impl ShadowTechnique for Lpv {
             return Err(TechniqueError::not_prepared());
         };
         let lights = gpu.maps.lights().to_vec();
-        let resolution = gpu.maps.resolution();
         let shadow = |light: usize| {
             let maps = &lights[light];
-            let scale = maps.scale(resolution);
+            let scale = maps.scale();
             LpvShadow {
                 first_layer: maps.first_layer,
                 layer_count: maps.frustums.len() as u32,

@@ -150,7 +150,6 @@ fn light_uniform(
     map_filter: MapFilter,
     maps: &LightMaps,
     distances: &[f32],
-    resolution: u32,
     debug: bool,
 ) -> PssmLight {
     let mut light = PssmLight {
@@ -170,7 +169,7 @@ fn light_uniform(
     light.distances[..distances.len()].copy_from_slice(distances);
     for (i, frustum) in maps.frustums.iter().enumerate() {
         if let Projection::Orthographic { extent, near, far } = frustum.projection {
-            light.texel[i] = extent / resolution as f32;
+            light.texel[i] = extent / maps.resolution as f32;
             light.depth_near[i] = near;
             light.depth_far[i] = far;
         }
@@ -229,13 +228,12 @@ impl ShadowTechnique for Pssm {
         maps.record(ctx, recorder, MAP_PASS)?;
         let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
         let distances = cascades.distances(ctx.camera, aspect, maps.bounds().0, p.stabilise);
-        let resolution = maps.resolution();
         // Lights without splits (spot, point) are not shadowed.
         let uniform = |l: &LightMaps, debug| {
             let size = light_size(&ctx.lights[l.light]);
             let map_filter = filters.filter(&p.filtering, size);
             let shadowed = !l.frustums.is_empty();
-            shadowed.then(|| light_uniform(p, map_filter, l, &distances, resolution, debug))
+            shadowed.then(|| light_uniform(p, map_filter, l, &distances, debug))
         };
         let targets = [&d.splits.1, &d.density.1];
         lookup.record(ctx, recorder, maps, p.debug_light, &targets, uniform)?;
@@ -360,11 +358,13 @@ mod tests {
         let maps = LightMaps {
             light: 0,
             first_layer: 3,
+            resolution: 1024,
+            tiles: Vec::new(),
             frustums: Vec::new(),
             layer_word: "split",
             scissor: [0; 4],
         };
-        let light = light_uniform(&p, MapFilter::zeroed(), &maps, &distances, 1024, true);
+        let light = light_uniform(&p, MapFilter::zeroed(), &maps, &distances, true);
         assert_eq!(light.distances[8], 8.0);
         assert_eq!(light.first_layer, 3);
     }

@@ -113,7 +113,12 @@ impl LayerPlan for WarpedLayers {
         }
     }
 
-    fn frustums(&self, light: &Light, inputs: &PlanInputs<'_>) -> Vec<LightFrustum> {
+    fn frustums(
+        &self,
+        light: &Light,
+        resolution: u32,
+        inputs: &PlanInputs<'_>,
+    ) -> Vec<LightFrustum> {
         if self.layers(light) == 0 {
             return Vec::new();
         }
@@ -145,7 +150,7 @@ impl LayerPlan for WarpedLayers {
         };
         fit.map(|f| vec![f]).unwrap_or_else(|| {
             self.fallbacks.set(self.fallbacks.get() + 1);
-            StandardLayers.frustums(light, inputs)
+            StandardLayers.frustums(light, resolution, inputs)
         })
     }
 }
@@ -290,7 +295,6 @@ impl ShadowTechnique for WarpedMaps {
             ..
         } = self.gpu.get_mut()?;
         maps.record(ctx, recorder, &map_pass)?;
-        let resolution = maps.resolution() as f32;
         // Lights without a layer (point lights, spot lights under LiSPSM) are not shadowed.
         let uniform = |l: &LightMaps, debug| {
             let size = light_size(&ctx.lights[l.light]);
@@ -298,7 +302,7 @@ impl ShadowTechnique for WarpedMaps {
                 light: l.light as u32,
                 layer: l.first_layer,
                 diagnostics: u32::from(debug),
-                resolution,
+                resolution: l.resolution as f32,
                 map_filter: filters.filter(&s.filtering, size),
                 normal_offset: s.map.normal_offset,
                 _pad: [0.0; 3],
@@ -329,10 +333,9 @@ impl ShadowTechnique for WarpedMaps {
         let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
-        vec![
-            ("map resolution".into(), gpu.maps.resolution() as f64),
-            ("standard-fit fallbacks".into(), gpu.fallbacks as f64),
-        ]
+        let mut counters = gpu.maps.counters();
+        counters.push(("standard-fit fallbacks".into(), gpu.fallbacks as f64));
+        counters
     }
 }
 

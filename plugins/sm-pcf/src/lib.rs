@@ -103,12 +103,11 @@ fn shadow_light(
     filters: &MapFilters,
     maps: &LightMaps,
     light: &zoo_host::Light,
-    resolution: u32,
     debug: bool,
 ) -> ShadowLight {
     let size = light_size(light);
     ShadowLight {
-        map: MapHeader::new(maps, resolution, p.map.normal_offset),
+        map: MapHeader::new(maps, p.map.normal_offset),
         map_filter: filters.filter(&p.filtering, size),
         debug: u32::from(debug),
         _pad: [0.0; 3],
@@ -186,10 +185,9 @@ impl ShadowTechnique for ShadowMaps {
             diagnostics,
         } = self.gpu.get_mut()?;
         maps.record(ctx, recorder, DEPTH_PASS)?;
-        let resolution = maps.resolution();
         let uniform = |l: &LightMaps, debug| {
             let light = &ctx.lights[l.light];
-            Some(shadow_light(p, filters, l, light, resolution, debug))
+            Some(shadow_light(p, filters, l, light, debug))
         };
         lookup.record(
             ctx,

@@ -26,7 +26,9 @@ pub struct Settings {
     pub translucent: u32,
     pub pixel_scale: f32,
     pub debug_mode: u32,
-    pub _pad: [u32; 3],
+    /// The batch's first layer among all (a multiple of four).
+    pub layer_base: u32,
+    pub _pad: [u32; 2],
 }
 
 /// `SsssLight` in `ssss/data.wgsl`.
@@ -182,7 +184,8 @@ pub struct Passes {
     blur_second: ComputeStage,
     resolve: ComputeStage,
     debug: ComputeStage,
-    groups: Option<[wgpu::BindGroup; 5]>,
+    /// Per batch of layers: the groups of the penumbra, blur, resolve and debug passes.
+    groups: Vec<[wgpu::BindGroup; 5]>,
 }
 
 /// The penumbra pass: hard shadows, penumbra sizes and tints of every light.
@@ -209,19 +212,33 @@ impl Passes {
             blur_second: stage("ssss/blur_second.wgsl", "cs_blur_second", &[])?,
             resolve: stage("ssss/resolve.wgsl", "cs_resolve", &[])?,
             debug: stage("ssss/debug.wgsl", "cs_debug", &[])?,
-            groups: None,
+            groups: Vec::new(),
         })
     }
 
-    /// Rebuilds the bind groups over the current data, targets, maps and host slots.
+    /// Rebuilds the bind groups over each batch's data, the targets, maps and host slots.
     pub fn bind(
         &mut self,
+        ctx: &RenderContext<'_>,
+        data: &[wgpu::Buffer],
+        targets: &Targets,
+        translucency: &wgpu::TextureView,
+        min_maps: &wgpu::TextureView,
+    ) -> TechniqueResult {
+        self.groups = (data.iter())
+            .map(|data| self.batch_groups(ctx, data, targets, translucency, min_maps))
+            .collect::<TechniqueResult<_>>()?;
+        Ok(())
+    }
+
+    fn batch_groups(
+        &self,
         ctx: &RenderContext<'_>,
         data: &wgpu::Buffer,
         targets: &Targets,
         translucency: &wgpu::TextureView,
         min_maps: &wgpu::TextureView,
-    ) -> TechniqueResult {
+    ) -> TechniqueResult<[wgpu::BindGroup; 5]> {
         let view = wgpu::BindingResource::TextureView;
         let data = || ("data", data.as_entire_binding());
         let t = targets;
@@ -288,12 +305,12 @@ impl Passes {
                 ("image", view(&t.debug.1)),
             ],
         )?;
-        self.groups = Some([penumbra, blur_first, blur_second, resolve, debug]);
-        Ok(())
+        Ok([penumbra, blur_first, blur_second, resolve, debug])
     }
 
-    /// Records the penumbra pass, both blur passes (on the half-resolution grid when
-    /// `half_resolution`) and the resolve pass, and the debug pass when `debug`.
+    /// Records, for each batch of layers, the penumbra pass, both blur passes (on the
+    /// half-resolution grid when `half_resolution`) and the resolve pass; then the debug pass
+    /// when `debug` (over the last batch's layers).
     pub fn record(
         &self,
         ctx: &RenderContext<'_>,
@@ -302,7 +319,7 @@ impl Passes {
         half_resolution: bool,
         debug: bool,
     ) -> TechniqueResult {
-        let (Some(groups), Some(lookup)) = (&self.groups, maps.lookup_group()) else {
+        let (false, Some(lookup)) = (self.groups.is_empty(), maps.lookup_group()) else {
             return Err(TechniqueError::not_prepared());
         };
         let full = ctx.size;
@@ -318,19 +335,20 @@ impl Passes {
             (RESOLVE_PASS, &self.resolve, None, full),
             (DEBUG_PASS, &self.debug, None, full),
         ];
-        for (k, (name, stage, lookup, extent)) in stages.into_iter().enumerate() {
-            if name == DEBUG_PASS && !debug {
-                break;
+        let batches = self.groups.len();
+        for (b, groups) in self.groups.iter().enumerate() {
+            for (k, (name, stage, lookup, extent)) in stages.iter().enumerate() {
+                if *name == DEBUG_PASS && !(debug && b + 1 == batches) {
+                    continue;
+                }
+                let name = match (batches, *name) {
+                    (1, _) | (_, DEBUG_PASS) => name.to_string(),
+                    _ => format!("{name} (batch {b})"),
+                };
+                let more: Vec<&wgpu::BindGroup> = lookup.iter().copied().collect();
+                let extent = [extent.x, extent.y, 1];
+                stage.dispatch(ctx, recorder, &name, &groups[k], &more, extent);
             }
-            let more: Vec<&wgpu::BindGroup> = lookup.into_iter().collect();
-            stage.dispatch(
-                ctx,
-                recorder,
-                name,
-                &groups[k],
-                &more,
-                [extent.x, extent.y, 1],
-            );
         }
         Ok(())
     }
@@ -371,7 +389,7 @@ impl MinFilter {
         })
     }
 
-    /// Sizes the min maps to `set`'s depth maps and lists the layers it renders.
+    /// Sizes the min maps to `set`'s depth pages and lists the pages it renders into.
     pub fn prepare(&mut self, ctx: &RenderContext<'_>, set: &ShadowMapSet) -> TechniqueResult {
         let Some(depth) = set.depth_maps() else {
             return Ok(());
@@ -392,7 +410,9 @@ impl MinFilter {
             );
             self.maps = Some((layered.texture, layered.view, resolution, depth.layers));
         }
-        let kept: Vec<u32> = (0..depth.layers).filter(|&l| set.is_kept(l)).collect();
+        // The atlas pages that hold a rendered tile.
+        let mut kept: Vec<u32> = set.tile_passes().iter().map(|p| p.tile.page).collect();
+        kept.dedup();
         let bytes: &[u8] = bytemuck::cast_slice(&kept);
         let size = (bytes.len() as u64).max(4);
         if self.kept.as_ref().is_none_or(|b| b.size() < size) {

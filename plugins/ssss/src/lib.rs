@@ -55,8 +55,9 @@ zoo_host::technique_params! {
         /// full-resolution hard shadows), upsampled with depth-aware weights; pixels without
         /// penumbra keep their full-resolution hard result.
         half_resolution: bool = true, flags(shader);
-        /// Most screen-space layers; an assignment needing more is refused, naming the lights.
-        max_layers: u32 = 64, range(1, 64), step(1);
+        /// Screen-space layers per batch: lights needing more layers run in several batches of
+        /// the penumbra, blur and resolve passes (rounded down to whole groups of four).
+        max_layers: u32 = 64, range(4, 64), step(4);
         /// Scales the estimated penumbra (1: the width the light's size gives).
         penumbra_scale: f32 = 1.0, range(0.0, 4.0), step(0.05), flags(shader);
         /// Blur taps whose view depth differs from the centre's by more than this fraction of
@@ -99,7 +100,8 @@ struct Gpu {
     translucent: Option<TranslucentPass>,
     passes: Passes,
     targets: Option<Targets>,
-    data: Option<wgpu::Buffer>,
+    /// One data buffer per batch of layers.
+    data: Vec<wgpu::Buffer>,
     /// A white translucency map for scenes without translucent casters.
     placeholder: (wgpu::Texture, wgpu::TextureView),
     min_filter: MinFilter,
@@ -128,7 +130,7 @@ impl Gpu {
             translucent,
             passes,
             targets: None,
-            data: None,
+            data: Vec::new(),
             placeholder: placeholder(ctx.gpu),
             min_filter: MinFilter::new(ctx)?,
             debug_codes,
@@ -198,33 +200,34 @@ pub struct Ssss {
 }
 
 impl Ssss {
-    /// The colouring for the lights and camera of `request`, or an error naming the lights
-    /// beyond the layer cap.
+    /// The colouring for the lights and camera of `request`.
     fn layers_for(&self, request: &SlotRequest<'_>) -> TechniqueResult<Layers> {
-        let layers = assign_layers(request.lights, request.view_proj());
-        let cap = self.params.max_layers;
-        if layers.count > cap {
-            let over: Vec<String> = (0..request.lights.len())
-                .filter(|&i| layers.of_light[i].is_some_and(|l| l >= cap))
-                .map(|i| i.to_string())
-                .collect();
-            return Err(TechniqueError::Other(format!(
-                "ssss: the lights need {} screen-space layers, more than max_layers = {cap}: \
-                 lights {} overlap on screen with lights in every one of the first {cap} \
-                 (shorter ranges, fewer overlapping lights or a larger max_layers)",
-                layers.count,
-                over.join(", ")
-            )));
-        }
-        Ok(layers)
+        Ok(assign_layers(request.lights, request.view_proj()))
+    }
+
+    /// Layers per batch: `max_layers` in whole groups of four.
+    fn batch_layers(&self) -> u32 {
+        (self.params.max_layers / 4 * 4).max(4)
     }
 }
 
-/// The data buffer's settings for `layer_count` layers.
-fn settings(p: &SsssParams, layer_count: u32, ctx: &RenderContext<'_>) -> Settings {
+/// Batches of at most `per_batch` layers covering `count`: (first layer, layers).
+fn batches(count: u32, per_batch: u32) -> Vec<(u32, u32)> {
+    (0..count.max(1).div_ceil(per_batch))
+        .map(|b| (b * per_batch, per_batch.min(count.max(1) - b * per_batch)))
+        .collect()
+}
+
+/// The data buffer's settings for the batch of `layer_count` layers from `layer_base`.
+fn settings(
+    p: &SsssParams,
+    (layer_base, layer_count): (u32, u32),
+    ctx: &RenderContext<'_>,
+) -> Settings {
     let proj = ctx.frame.matrices.proj;
     Settings {
         params: p.shader_block(),
+        layer_base,
         layer_count: layer_count.max(1),
         half_taps: match p.kernel {
             Kernel::Taps5 => 2,
@@ -234,8 +237,24 @@ fn settings(p: &SsssParams, layer_count: u32, ctx: &RenderContext<'_>) -> Settin
         translucent: u32::from(ctx.scene.has_translucent_casters()),
         pixel_scale: proj.y_axis.y * ctx.size.y as f32 * 0.5,
         debug_mode: 0,
-        _pad: [0; 3],
+        _pad: [0; 2],
     }
+}
+
+/// A batch's data: its settings, then the light records with layers counted from the batch's
+/// first (lights of other batches have none).
+fn batch_data(settings: Settings, records: &[SsssLight], (base, count): (u32, u32)) -> Vec<u8> {
+    let mut bytes = bytemuck::bytes_of(&settings).to_vec();
+    for record in records {
+        let mut record = *record;
+        if (base..base + count).contains(&record.layer) {
+            record.layer -= base;
+        } else {
+            record.layer_count = 0;
+        }
+        bytes.extend_from_slice(bytemuck::bytes_of(&record));
+    }
+    bytes
 }
 
 /// Which of a light's map layers can shadow what the camera sees.
@@ -328,9 +347,9 @@ impl ShadowTechnique for Ssss {
                 )));
             }
         }
+        let batches = batches(self.layers.count, self.batch_layers());
         let gpu = self.gpu.get_mut()?;
         let min_filter = self.params.estimate == Estimate::MinFilter;
-        let settings = settings(&self.params, self.layers.count, ctx);
         let p = &self.params;
         let replaced = gpu.maps.prepare(ctx, changes, p.map_size, p.stable_fit);
         let view_proj = ctx.frame.matrices.view_proj;
@@ -350,7 +369,8 @@ impl ShadowTechnique for Ssss {
         }
         let translucent = gpu.translucent.is_some();
         let half = p.half_resolution;
-        let layer_count = settings.layer_count;
+        // Batches run one after another through the same targets.
+        let layer_count = batches[0].1;
         if !gpu
             .targets
             .as_ref()
@@ -359,15 +379,15 @@ impl ShadowTechnique for Ssss {
             let targets = Targets::new(ctx.gpu, ctx.size, layer_count, translucent, half);
             gpu.targets = Some(targets);
         }
-        // The data buffer: settings, then one record per scene light.
-        let resolution = gpu.maps.resolution();
+        // The data buffers: a batch's settings, then one record per scene light (lights of
+        // other batches have no layers there).
         let mut records = vec![SsssLight::default(); ctx.lights.len().max(1)];
         for maps in gpu.maps.lights() {
             let (Some(layer), false) = (self.layers.of_light[maps.light], maps.frustums.is_empty())
             else {
                 continue;
             };
-            let scale = maps.scale(resolution);
+            let scale = maps.scale();
             records[maps.light] = SsssLight {
                 first_layer: maps.first_layer,
                 layer_count: maps.frustums.len() as u32,
@@ -384,23 +404,24 @@ impl ShadowTechnique for Ssss {
                 _pad: [0; 3],
             };
         }
-        let mut bytes = bytemuck::bytes_of(&settings).to_vec();
-        bytes.extend_from_slice(bytemuck::cast_slice(&records));
-        if gpu
-            .data
-            .as_ref()
-            .is_none_or(|b| b.size() != bytes.len() as u64)
-        {
-            // Exactly the size of the data: the shaders take the light count from it.
-            gpu.data = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("ssss data"),
-                size: bytes.len() as u64,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
+        // Exactly the size of the data: the shaders take the light count from it.
+        let size = (size_of::<Settings>() + size_of_val(records.as_slice())) as u64;
+        if gpu.data.len() != batches.len() || gpu.data[0].size() != size {
+            gpu.data = (0..batches.len())
+                .map(|b| {
+                    ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(&format!("ssss data (batch {b})")),
+                        size,
+                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    })
+                })
+                .collect();
         }
-        let data = gpu.data.as_ref().expect("created above");
-        ctx.gpu.queue.write_buffer(data, 0, &bytes);
+        for (&batch, data) in batches.iter().zip(&gpu.data) {
+            let bytes = batch_data(settings(p, batch, ctx), &records, batch);
+            ctx.gpu.queue.write_buffer(data, 0, &bytes);
+        }
         let translucency = gpu::translucency_view(gpu.translucent.as_ref(), &gpu.placeholder.1);
         let min_maps = match gpu.min_filter.view() {
             Some(view) if min_filter => view,
@@ -408,7 +429,7 @@ impl ShadowTechnique for Ssss {
         };
         let targets = gpu.targets.as_ref().expect("created above");
         gpu.passes
-            .bind(ctx, data, targets, translucency, min_maps)?;
+            .bind(ctx, &gpu.data, targets, translucency, min_maps)?;
         Ok(())
     }
 
@@ -428,7 +449,7 @@ impl ShadowTechnique for Ssss {
         let debug = ctx
             .debug_view
             .and_then(|name| DEBUG_VIEWS.iter().position(|v| *v == name));
-        if let (Some(view), Some(data)) = (debug, &gpu.data) {
+        if let (Some(view), Some(data)) = (debug, gpu.data.last()) {
             let code = gpu.debug_codes.code(view);
             ctx.gpu
                 .queue
@@ -521,7 +542,8 @@ mod tests {
             half_taps,
             translucent,
             pixel_scale,
-            debug_mode
+            debug_mode,
+            layer_base
         });
         assert_eq!(
             size % 16,
@@ -549,6 +571,8 @@ mod tests {
         let source = shader("ssss/min_depth.wgsl");
         let block = zoo_host::gpu::layout::wgsl_integer_constant(&source, "MIN_BLOCK");
         assert_eq!(block, Ok(i64::from(gpu::MIN_BLOCK)));
+        // Min texels never straddle two atlas tiles.
+        assert!(zoo_shadow_maps::atlas::TILE_ALIGN.is_multiple_of(gpu::MIN_BLOCK));
     }
 
     #[test]
@@ -561,7 +585,7 @@ mod tests {
     }
 
     #[test]
-    fn the_layer_cap_is_reported_with_the_lights() {
+    fn layers_past_the_cap_run_in_batches() {
         let light = |x: f32| zoo_host::Light {
             kind: LightKind::Point,
             position: zoo_host::glam::Vec3::new(x, 1.0, 0.0),
@@ -572,7 +596,8 @@ mod tests {
             spot_softness: 0.1,
             radius: 0.1,
         };
-        let lights: Vec<_> = (0..4).map(|i| light(i as f32 * 0.5)).collect();
+        // Ten lights that all overlap on screen: ten layers, more than a batch of four.
+        let lights: Vec<_> = (0..10).map(|i| light(i as f32 * 0.2)).collect();
         let camera = zoo_host::Camera {
             position: zoo_host::glam::Vec3::new(0.0, 5.0, 10.0),
             target: zoo_host::glam::Vec3::ZERO,
@@ -586,17 +611,33 @@ mod tests {
             aspect: 1.0,
         };
         let mut values = zoo_host::params::defaults(&SsssParams::schema());
-        values.insert("max_layers".into(), zoo_host::ParamValue::Int(2));
+        values.insert("max_layers".into(), zoo_host::ParamValue::Int(4));
         let technique = create_for_test(&values);
-        let error = technique.assign_slots(&request).unwrap_err().to_string();
-        assert!(error.contains("need 4 screen-space layers"), "{error}");
-        assert!(error.contains("max_layers = 2"), "{error}");
-        // All four overlap with equal degree and are coloured in index order: the last two
-        // are over the cap.
-        assert!(error.contains("lights 2, 3 overlap"), "{error}");
-        let technique = create_for_test(&zoo_host::params::defaults(&SsssParams::schema()));
         let slots = technique.assign_slots(&request).unwrap();
-        assert_eq!(slots.slot_count(), 4);
+        assert_eq!(slots.slot_count(), 10, "every light keeps its own slot");
+        assert_eq!(
+            batches(10, technique.batch_layers()),
+            [(0, 4), (4, 4), (8, 2)]
+        );
+        assert_eq!(batches(64, 64), [(0, 64)]);
+        assert_eq!(batches(0, 64), [(0, 1)], "one batch even without lights");
+        // A batch's records count layers from its first; other batches' lights have none.
+        let record = |layer| SsssLight {
+            layer,
+            layer_count: 6,
+            ..SsssLight::default()
+        };
+        let records: Vec<SsssLight> = (0..10).map(record).collect();
+        let bytes = batch_data(Settings::default(), &records, (4, 4));
+        let batch: &[SsssLight] = bytemuck::cast_slice(&bytes[size_of::<Settings>()..]);
+        let layers: Vec<(u32, u32)> = batch.iter().map(|r| (r.layer, r.layer_count)).collect();
+        let expected: Vec<(u32, u32)> = (0..10)
+            .map(|l| match l {
+                4..8 => (l - 4, 6),
+                _ => (l, 0),
+            })
+            .collect();
+        assert_eq!(layers, expected);
     }
 
     fn create_for_test(values: &ParamValues) -> Ssss {

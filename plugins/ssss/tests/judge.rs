@@ -213,3 +213,42 @@ fn resizing_moving_and_dropping_lights_keep_layers_and_slots_together() {
         );
     }
 }
+
+/// Lights needing more layers than `max_layers` run in batches: with batches of four layers
+/// every light's visibility is what one batch of all layers gives.
+#[test]
+fn batches_of_layers_give_the_visibility_of_one_batch() {
+    let scene = zoo_host::Scene::load(&scene_path("many-lights.ron")).unwrap();
+    let mut renderer = Renderer::new(gpu(), scene.clone(), UVec2::new(128, 96)).unwrap();
+    let mut render = |max_layers: i64| {
+        let mut values = zoo_host::params::ParamValues::new();
+        values.insert("max_layers".into(), zoo_host::ParamValue::Int(max_layers));
+        renderer.set_technique("ssss", &values).unwrap();
+        renderer.render(&View::Final).unwrap();
+        assert_eq!(renderer.technique().id, "ssss");
+        let counters = renderer.wait_for_counters();
+        let layers = counters
+            .iter()
+            .find(|(n, _)| n == "screen-space layers")
+            .map(|(_, v)| *v)
+            .unwrap();
+        let visibility: Vec<Vec<f32>> = (0..scene.lights.len())
+            .map(|i| renderer.read_visibility(i))
+            .collect();
+        (layers, visibility)
+    };
+    let (layers, whole) = render(64);
+    let (_, batched) = render(4);
+    assert!(
+        layers > 8.0,
+        "{layers} layers: at least three batches of four"
+    );
+    for (light, (a, b)) in whole.iter().zip(&batched).enumerate() {
+        let worst = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f32::max);
+        assert!(worst <= 1.0 / 255.0, "light {light} differs by {worst}");
+    }
+}

@@ -46,7 +46,16 @@ impl GpuContext {
     /// features (to run techniques as on a device that lacks them).
     pub fn new_headless_without(removed: wgpu::Features) -> Result<GpuContext, GpuError> {
         let descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        pollster::block_on(Self::create_without(descriptor, removed))
+        pollster::block_on(Self::create_restricted(descriptor, removed, None))
+    }
+
+    /// Creates a headless context as [`Self::new_headless`] does, with `limits` instead of
+    /// the adapter's (WebGPU's defaults, for example, to run techniques as on a browser's
+    /// device).
+    pub fn new_headless_limited(limits: wgpu::Limits) -> Result<GpuContext, GpuError> {
+        let descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        let removed = wgpu::Features::empty();
+        pollster::block_on(Self::create_restricted(descriptor, removed, Some(limits)))
     }
 
     async fn new_headless_async() -> Result<GpuContext, GpuError> {
@@ -54,12 +63,13 @@ impl GpuContext {
     }
 
     async fn create(descriptor: wgpu::InstanceDescriptor) -> Result<GpuContext, GpuError> {
-        Self::create_without(descriptor, wgpu::Features::empty()).await
+        Self::create_restricted(descriptor, wgpu::Features::empty(), None).await
     }
 
-    async fn create_without(
+    async fn create_restricted(
         descriptor: wgpu::InstanceDescriptor,
         removed: wgpu::Features,
+        limits: Option<wgpu::Limits>,
     ) -> Result<GpuContext, GpuError> {
         let backends = descriptor.backends;
         let instance = wgpu::Instance::new(descriptor);
@@ -69,7 +79,7 @@ impl GpuContext {
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("shadow-zoo device"),
                 required_features: features,
-                required_limits: adapter.limits(),
+                required_limits: limits.unwrap_or_else(|| adapter.limits()),
                 ..Default::default()
             })
             .await

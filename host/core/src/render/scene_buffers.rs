@@ -105,20 +105,20 @@ impl SceneBuffers {
     /// Draws every object (or only shadow casters) with `first_instance` = object index, so
     /// shaders find the object's data through `@builtin(instance_index)`.
     pub fn draw_objects(&self, pass: &mut wgpu::RenderPass<'_>, scene: &Scene, casters_only: bool) {
-        self.draw_objects_where(pass, scene, |o| o.casts_shadows || !casters_only);
+        self.draw_objects_where(pass, scene, |_, o| o.casts_shadows || !casters_only);
     }
 
-    /// As [`Self::draw_objects`] for the objects `keep` accepts.
+    /// As [`Self::draw_objects`] for the objects `keep(index, object)` accepts.
     pub fn draw_objects_where(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         scene: &Scene,
-        keep: impl Fn(&SceneObject) -> bool,
+        keep: impl Fn(usize, &SceneObject) -> bool,
     ) {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         for (i, object) in scene.objects.iter().enumerate() {
-            if keep(object) {
+            if keep(i, object) {
                 let range = object.indices.start as u32..object.indices.end as u32;
                 pass.draw_indexed(range, 0, i as u32..i as u32 + 1);
             }

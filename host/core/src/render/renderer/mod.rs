@@ -19,7 +19,8 @@ use super::gbuffer::{GBuffer, GBufferPass};
 use super::lighting::{LightingPass, OUTPUT_FORMAT};
 use super::scene_buffers::SceneBuffers;
 use super::visibility::{
-    IndirectTarget, SlotAssignment, SlotRequest, TransmittanceTargets, VisibilityTargets,
+    INDIRECT_FORMAT, IndirectTarget, SlotAssignment, SlotRequest, TransmittanceTargets,
+    VISIBILITY_FORMAT, VisibilityTargets,
 };
 use crate::gpu::{
     FrameTimings, GpuContext, PassOwner, PassRecorder, ShaderError, ShaderLibrary,
@@ -374,10 +375,21 @@ impl Renderer {
                 self.lights.len()
             )));
         }
+        // Four visibility slots share an array layer; transmittance takes a layer per slot.
         let max_layers = self.gpu.device.limits().max_texture_array_layers;
-        if slots.slot_count() > max_layers {
+        let transmittance = instance.writes_transmittance(&self.scene);
+        let layers = match transmittance {
+            true => slots.slot_count(),
+            false => slots.layer_count(),
+        };
+        if layers > max_layers {
+            let what = if transmittance {
+                " with transmittance"
+            } else {
+                ""
+            };
             return Err(TechniqueError::Other(format!(
-                "{id}: {} visibility slots need more texture array layers than the device's {max_layers}",
+                "{id}: {} visibility slots{what} need {layers} texture array layers, more than the device's {max_layers}",
                 slots.slot_count()
             )));
         }
@@ -504,6 +516,7 @@ impl Renderer {
         );
         clear_visibility(
             &mut recorder,
+            &self.gpu.device.limits(),
             &self.visibility,
             &self.transmittance,
             &self.indirect,
@@ -611,10 +624,42 @@ fn check_size(size: UVec2) -> Result<(), RenderError> {
     Ok(())
 }
 
+/// `targets` in consecutive groups that each fit one render pass: at most
+/// `max_color_attachments` of them within `max_color_attachment_bytes_per_sample` (each
+/// format's render-target byte cost, aligned to its component size, as WebGPU counts them).
+fn attachment_chunks<T: Clone>(
+    targets: &[(T, wgpu::TextureFormat)],
+    limits: &wgpu::Limits,
+) -> Vec<Vec<T>> {
+    let mut chunks: Vec<Vec<_>> = Vec::new();
+    let mut bytes = 0u32;
+    for (target, format) in targets {
+        let cost = format.target_pixel_byte_cost().unwrap_or(16);
+        let align = format.target_component_alignment().unwrap_or(4);
+        let next = bytes.next_multiple_of(align) + cost;
+        let full = chunks.last().is_none_or(|c| {
+            c.len() as u32 >= limits.max_color_attachments
+                || next > limits.max_color_attachment_bytes_per_sample
+        });
+        if full {
+            chunks.push(Vec::new());
+            bytes = cost;
+        } else {
+            bytes = next;
+        }
+        chunks
+            .last_mut()
+            .expect("pushed above")
+            .push(target.clone());
+    }
+    chunks
+}
+
 /// Clears every visibility layer to 1 (lit), the transmittance slots in use to white and the
-/// indirect target to 0.
+/// indirect target to 0, in as few passes as the device's colour-attachment limits allow.
 fn clear_visibility(
     recorder: &mut PassRecorder<'_>,
+    limits: &wgpu::Limits,
     visibility: &VisibilityTargets,
     transmittance: &TransmittanceTargets,
     indirect: &IndirectTarget,
@@ -635,21 +680,60 @@ fn clear_visibility(
             },
         })
     };
-    let mut targets: Vec<_> = visibility
-        .layer_views
-        .iter()
+    let lit = (visibility.layer_views.iter())
         .chain(&transmittance.slot_views)
-        .map(|v| attachment(v, 1.0))
+        .map(|v| (attachment(v, 1.0), VISIBILITY_FORMAT));
+    let targets: Vec<_> = lit
+        .chain([(attachment(&indirect.view, 0.0), INDIRECT_FORMAT)])
         .collect();
-    targets.push(attachment(&indirect.view, 0.0));
-    for chunk in targets.chunks(8) {
+    for chunk in attachment_chunks(&targets, limits) {
         drop(recorder.render_pass(&wgpu::RenderPassDescriptor {
             label: Some("Clear visibility"),
-            color_attachments: chunk,
+            color_attachments: &chunk,
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         }));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clears_fit_the_colour_attachment_limits() {
+        let visibility = (VISIBILITY_FORMAT.target_pixel_byte_cost()).unwrap();
+        let targets: Vec<_> = (0..20)
+            .map(|i| (i, VISIBILITY_FORMAT))
+            .chain([(20, INDIRECT_FORMAT)])
+            .collect();
+        // WebGPU's defaults: 8 attachments, 32 bytes a sample.
+        let webgpu = wgpu::Limits::default();
+        let chunks = attachment_chunks(&targets, &webgpu);
+        let per_pass = (32 / visibility).min(8) as usize;
+        assert_eq!(chunks[0].len(), per_pass);
+        assert_eq!(
+            chunks.concat(),
+            (0..21).collect::<Vec<_>>(),
+            "every target, in order"
+        );
+        for chunk in &chunks {
+            let bytes: u32 = (chunk.iter())
+                .map(|&i| targets[i].1.target_pixel_byte_cost().unwrap())
+                .sum();
+            assert!(chunk.len() <= 8 && bytes <= 32, "{chunk:?}: {bytes} bytes");
+        }
+        // A device with room for eight of them a pass.
+        let roomy = wgpu::Limits {
+            max_color_attachment_bytes_per_sample: 128,
+            ..webgpu
+        };
+        let sizes: Vec<usize> = attachment_chunks(&targets, &roomy)
+            .iter()
+            .map(Vec::len)
+            .collect();
+        assert_eq!(sizes, [8, 8, 5]);
     }
 }

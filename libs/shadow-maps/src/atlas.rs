@@ -1,0 +1,400 @@
+//! The shadow atlas: every light layer's map (a cube face, a spot map, a cascade split) is a
+//! square tile on a page of one array texture. Each light gets a resolution tier from its
+//! importance on screen; when the tiles do not fit the device's pages and the memory budget,
+//! the least important of the largest tiles drop a tier, so any number of lights fits.
+
+use bytemuck::{Pod, Zeroable};
+use zoo_host::glam::UVec2;
+use zoo_host::wgpu;
+
+/// Shadow maps are kept under this many bytes (the atlas pages, with their depth scratch).
+pub const MEMORY_BUDGET: u64 = 1 << 30;
+/// The texel budget: at most this many pages, each the size of one full-tier map (so the
+/// requested map size scales the budget: 64 maps of 2048² are 1 GiB of depth).
+pub const MAX_PAGES: u32 = 64;
+/// The smallest tile side, in texels.
+pub const MIN_TILE: u32 = 16;
+/// Tiles are multiples of this many texels per side (min-filtered maps read blocks of it).
+pub const TILE_ALIGN: u32 = 8;
+/// A light whose screen rectangle spans at least this fraction of the screen (along its
+/// longer side) wants the full tier; each halving of the span halves its tile.
+pub const FULL_TIER_SPAN: f32 = 0.25;
+/// Tiers a light can want from its screen span (the budget may lower it further).
+pub const WANTED_TIERS: u32 = 4;
+
+/// Where one layer's map lies in the atlas (`MapTile` in `shadow-maps/layers.wgsl`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Pod, Zeroable)]
+#[repr(C)]
+pub struct MapTile {
+    /// Texel of the page the tile starts at.
+    pub origin: [u32; 2],
+    /// Texels per side.
+    pub size: u32,
+    /// Array layer of the atlas.
+    pub page: u32,
+}
+
+impl MapTile {
+    /// Restricts a render pass to the tile.
+    pub fn restrict(&self, pass: &mut wgpu::RenderPass<'_>) {
+        let [x, y] = self.origin;
+        let size = self.size as f32;
+        pass.set_viewport(x as f32, y as f32, size, size, 0.0, 1.0);
+        pass.set_scissor_rect(x, y, self.size, self.size);
+    }
+}
+
+/// What the atlas may use: square pages of `page_size` texels, at most `max_pages` of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AtlasLimits {
+    pub page_size: u32,
+    pub max_pages: u32,
+}
+
+impl AtlasLimits {
+    /// Pages of the requested map size, at most [`MAX_PAGES`] of them, within the device's
+    /// texture size and array layers and [`MEMORY_BUDGET`] for maps of `bytes_per_texel` (plus `scratch_pages` single pages
+    /// of `scratch_bytes` per texel that go with them, such as a depth scratch). Says why when
+    /// the page is smaller than requested.
+    pub fn new(
+        requested: u32,
+        limits: &wgpu::Limits,
+        spare_layer: bool,
+        bytes_per_texel: u64,
+        scratch_bytes: u64,
+    ) -> (AtlasLimits, Option<String>) {
+        let mut page_size = requested.min(limits.max_texture_dimension_2d).max(MIN_TILE);
+        let mut note = (page_size < requested)
+            .then(|| format!("map_size {requested} exceeds the device limit; using {page_size}"));
+        let layers = limits
+            .max_texture_array_layers
+            .saturating_sub(u32::from(spare_layer))
+            .clamp(1, MAX_PAGES);
+        let max_pages = |page: u32| {
+            let texels = u64::from(page).pow(2);
+            let room = MEMORY_BUDGET.saturating_sub(texels * scratch_bytes);
+            (room / (texels * bytes_per_texel)).min(u64::from(layers)) as u32
+        };
+        while max_pages(page_size) == 0 && page_size > MIN_TILE {
+            page_size /= 2;
+            note = Some(format!(
+                "one {requested}² map exceeds {} MiB; using {page_size}",
+                MEMORY_BUDGET >> 20
+            ));
+        }
+        let limits = AtlasLimits {
+            page_size,
+            max_pages: max_pages(page_size).max(1),
+        };
+        (limits, note)
+    }
+
+    /// The largest tier: tiles of `page_size >> max_tier` are at least [`MIN_TILE`] texels and
+    /// a multiple of [`TILE_ALIGN`].
+    pub fn max_tier(&self) -> u32 {
+        let aligned = self
+            .page_size
+            .trailing_zeros()
+            .saturating_sub(TILE_ALIGN.ilog2());
+        let sized = (self.page_size / MIN_TILE).max(1).ilog2();
+        aligned.min(sized)
+    }
+
+    /// Texels per side of a tile of `tier`.
+    pub fn tile_size(&self, tier: u32) -> u32 {
+        self.page_size >> tier
+    }
+}
+
+/// The tier a light wants from its screen rectangle `scissor` (x, y, width, height) on a
+/// `screen`: 0 (full size) when it spans at least [`FULL_TIER_SPAN`] of the screen, one more
+/// per halving of its span, the smallest wanted tier for lights off screen.
+pub fn wanted_tier(scissor: [u32; 4], screen: UVec2) -> u32 {
+    let span = (scissor[2] as f32 / screen.x.max(1) as f32)
+        .max(scissor[3] as f32 / screen.y.max(1) as f32);
+    if span <= 0.0 {
+        return WANTED_TIERS - 1;
+    }
+    let halvings = (FULL_TIER_SPAN / span).log2().ceil().max(0.0);
+    (halvings as u32).min(WANTED_TIERS - 1)
+}
+
+/// Every light's tier and every layer's tile.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Allocation {
+    /// Per light: its tier (its tiles are `page_size >> tier` texels).
+    pub tiers: Vec<u32>,
+    /// Per layer, lights in order and each light's layers in order. Layers that did not fit
+    /// even at the smallest tier have an empty tile (size 0): they are not rendered, and
+    /// lookups find them lit.
+    pub tiles: Vec<MapTile>,
+    /// Layers left without a tile.
+    pub unfitted: u32,
+    /// Pages in use.
+    pub pages: u32,
+    /// Texels the tiles cover.
+    pub texels: u64,
+}
+
+/// Tiles for lights with `layers[i]` layers each that want tier `wanted[i]`: the wanted
+/// tiers where they fit in `limits`, else the least important (largest wanted tier, then
+/// latest) of the largest tiles drop a tier until they do. Tiles are packed largest first
+/// along a Z-order curve, which leaves no gaps between tiles whose sides halve.
+pub fn allocate(layers: &[u32], wanted: &[u32], limits: &AtlasLimits) -> Allocation {
+    let max_tier = limits.max_tier();
+    let mut tiers: Vec<u32> = wanted.iter().map(|&w| w.min(max_tier)).collect();
+    let texels = |tiers: &[u32]| -> u64 {
+        let sizes = tiers.iter().map(|&t| u64::from(limits.tile_size(t)).pow(2));
+        layers
+            .iter()
+            .zip(sizes)
+            .map(|(&n, s)| u64::from(n) * s)
+            .sum()
+    };
+    let page_texels = u64::from(limits.page_size).pow(2);
+    let capacity = u64::from(limits.max_pages) * page_texels;
+    let mut used = texels(&tiers);
+    while used > capacity {
+        let demoted = (0..tiers.len())
+            .filter(|&i| layers[i] > 0 && tiers[i] < max_tier)
+            .min_by_key(|&i| (tiers[i], std::cmp::Reverse((wanted[i], i))));
+        let Some(i) = demoted else { break };
+        let size = u64::from(limits.tile_size(tiers[i]));
+        used -= u64::from(layers[i]) * 3 * (size / 2).pow(2);
+        tiers[i] += 1;
+    }
+    let mut order: Vec<(u32, usize, u32)> = (0..tiers.len())
+        .flat_map(|i| (0..layers[i]).map(move |k| (i, k)))
+        .map(|(i, k)| (tiers[i], i, k))
+        .collect();
+    order.sort_unstable();
+    let first_layer: Vec<u32> = layers
+        .iter()
+        .scan(0, |next, &n| {
+            let first = *next;
+            *next += n;
+            Some(first)
+        })
+        .collect();
+    let mut tiles = vec![MapTile::default(); layers.iter().sum::<u32>() as usize];
+    let mut offset = 0u64;
+    let mut unfitted = 0;
+    for (tier, light, k) in order {
+        let size = limits.tile_size(tier);
+        let area = u64::from(size).pow(2);
+        let page = offset / page_texels;
+        if offset + area > capacity {
+            unfitted += 1;
+            continue;
+        }
+        let [x, y] = z_order((offset % page_texels) / area);
+        tiles[(first_layer[light] + k) as usize] = MapTile {
+            origin: [x * size, y * size],
+            size,
+            page: page as u32,
+        };
+        offset += area;
+    }
+    Allocation {
+        tiers,
+        tiles,
+        unfitted,
+        pages: offset.div_ceil(page_texels) as u32,
+        texels: offset,
+    }
+}
+
+/// The cell at `index` along a Z-order (Morton) curve.
+fn z_order(index: u64) -> [u32; 2] {
+    let (mut x, mut y) = (0u32, 0u32);
+    for bit in 0..32 {
+        x |= (((index >> (2 * bit)) & 1) as u32) << bit;
+        y |= (((index >> (2 * bit + 1)) & 1) as u32) << bit;
+    }
+    [x, y]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn limits(page_size: u32, max_pages: u32) -> AtlasLimits {
+        AtlasLimits {
+            page_size,
+            max_pages,
+        }
+    }
+
+    /// No two tiles overlap and every tile lies inside its page and the pages in use.
+    fn assert_packed(a: &Allocation, l: &AtlasLimits) {
+        for (i, t) in a.tiles.iter().enumerate() {
+            assert!(t.origin[0] + t.size <= l.page_size && t.origin[1] + t.size <= l.page_size);
+            assert!(
+                t.page < a.pages && a.pages <= l.max_pages,
+                "{t:?} of {}",
+                a.pages
+            );
+            assert_eq!(t.origin[0] % t.size, 0);
+            for u in &a.tiles[i + 1..] {
+                let apart = t.page != u.page
+                    || t.origin[0] + t.size <= u.origin[0]
+                    || u.origin[0] + u.size <= t.origin[0]
+                    || t.origin[1] + t.size <= u.origin[1]
+                    || u.origin[1] + u.size <= t.origin[1];
+                assert!(apart, "{t:?} overlaps {u:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn wanted_tiers_follow_the_screen_span() {
+        let screen = UVec2::new(400, 200);
+        assert_eq!(wanted_tier([0, 0, 400, 200], screen), 0);
+        assert_eq!(wanted_tier([0, 0, 100, 10], screen), 0);
+        assert_eq!(wanted_tier([0, 0, 99, 10], screen), 1);
+        assert_eq!(wanted_tier([0, 0, 20, 25], screen), 1);
+        assert_eq!(wanted_tier([0, 0, 10, 24], screen), 2);
+        assert_eq!(wanted_tier([0, 0, 1, 1], screen), WANTED_TIERS - 1);
+        assert_eq!(wanted_tier([5, 5, 0, 0], screen), WANTED_TIERS - 1);
+    }
+
+    #[test]
+    fn wanted_tiers_are_kept_when_they_fit() {
+        let l = limits(2048, 8);
+        let a = allocate(&[6, 1, 1, 0], &[0, 1, 3, 0], &l);
+        assert_eq!(a.tiers, vec![0, 1, 3, 0]);
+        assert_eq!(a.tiles.len(), 8);
+        assert!(a.tiles[..6].iter().all(|t| t.size == 2048));
+        assert_eq!((a.tiles[6].size, a.tiles[7].size), (1024, 256));
+        // Six full pages, then the 1024 and 256 tiles share the seventh.
+        assert_eq!(a.pages, 7);
+        assert_eq!(a.tiles[6].page, 6);
+        assert_eq!(
+            a.tiles[7],
+            MapTile {
+                origin: [1024, 0],
+                size: 256,
+                page: 6
+            }
+        );
+        assert_packed(&a, &l);
+    }
+
+    #[test]
+    fn the_least_important_of_the_largest_tiles_drop_first() {
+        // Room for two full pages: three full-size lights cannot all stay.
+        let l = limits(1024, 2);
+        // The last drops a tier, which is not enough; then the second.
+        let a = allocate(&[1, 1, 1], &[0, 0, 0], &l);
+        assert_eq!(a.tiers, vec![0, 1, 1]);
+        assert_packed(&a, &l);
+        // The light that wanted less drops first; the one that wanted full size keeps it.
+        let a = allocate(&[1, 1, 1], &[1, 0, 0], &l);
+        assert_eq!(a.tiers, vec![1, 0, 1]);
+        assert_eq!(a.unfitted, 0);
+        assert_packed(&a, &l);
+    }
+
+    #[test]
+    fn any_number_of_lights_fits_the_default_webgpu_limits() {
+        let webgpu = wgpu::Limits::default();
+        let (l, note) = AtlasLimits::new(2048, &webgpu, false, 4, 0);
+        assert_eq!(note, None);
+        assert_eq!(l, limits(2048, 64), "1 GiB of 2048² depth pages");
+        // 1024 point lights, all wanting full size: 6144 faces.
+        let a = allocate(&[6; 1024], &[0; 1024], &l);
+        assert!(a.pages <= 64 && a.texels <= 64 * 2048 * 2048);
+        // The budget is shared evenly: 256² and 128² faces, the earlier lights keeping more.
+        assert!(
+            a.tiers.iter().all(|&t| t == 3 || t == 4),
+            "{:?}",
+            &a.tiers[..8]
+        );
+        assert!(a.tiers.windows(2).all(|w| w[0] <= w[1]));
+        assert!(a.texels > 48 * 2048 * 2048, "most of the budget is used");
+        assert_packed(&a, &l);
+        // Lights that want less keep more: half of them off screen.
+        let wanted: Vec<u32> = (0..1024).map(|i| if i % 2 == 0 { 0 } else { 3 }).collect();
+        let a = allocate(&[6; 1024], &wanted, &l);
+        assert!(a.tiers.iter().step_by(2).all(|&t| t <= a.tiers[1]));
+        assert_packed(&a, &l);
+    }
+
+    #[test]
+    fn pages_shrink_to_the_device_and_the_budget() {
+        let small = wgpu::Limits {
+            max_texture_dimension_2d: 4096,
+            max_texture_array_layers: 3,
+            ..wgpu::Limits::default()
+        };
+        let (l, note) = AtlasLimits::new(8192, &small, true, 4, 0);
+        assert_eq!(l, limits(4096, 2), "one layer kept spare");
+        // The texel budget follows the requested size: 64 full-size maps' worth.
+        let many = wgpu::Limits {
+            max_texture_array_layers: 2048,
+            ..wgpu::Limits::default()
+        };
+        assert_eq!(
+            AtlasLimits::new(256, &many, false, 4, 0).0,
+            limits(256, MAX_PAGES)
+        );
+        assert!(note.unwrap().contains("device limit"));
+        // 16 bytes a texel and an 8192² page (1 GiB) do not fit beside a depth scratch.
+        let (l, note) = AtlasLimits::new(8192, &wgpu::Limits::default(), false, 16, 4);
+        assert_eq!(l.page_size, 4096);
+        assert!(note.unwrap().contains("exceeds"));
+        assert_eq!(
+            u64::from(l.max_pages),
+            ((1 << 30) - (4096u64 * 4096 * 4)) / (4096 * 4096 * 16)
+        );
+    }
+
+    #[test]
+    fn tiers_stay_aligned_on_pages_of_any_allowed_size() {
+        for page_size in [256, 768, 1280, 2048, 8192] {
+            let l = limits(page_size, 4);
+            let smallest = l.tile_size(l.max_tier());
+            assert!(smallest >= MIN_TILE && smallest.is_multiple_of(TILE_ALIGN));
+            assert_eq!(smallest << l.max_tier(), page_size);
+            let a = allocate(&[6; 100], &[0; 100], &l);
+            assert!(a.pages <= 4 && a.unfitted == 0);
+            assert_packed(&a, &l);
+        }
+    }
+
+    #[test]
+    fn layers_past_the_last_page_get_empty_tiles() {
+        // One 256² page holds 256 of the smallest (16²) tiles: 300 cube maps cannot fit.
+        let l = limits(256, 1);
+        let a = allocate(&[6; 300], &[0; 300], &l);
+        assert_eq!(a.tiers, vec![4; 300]);
+        assert_eq!((a.pages, a.unfitted), (1, 1800 - 256));
+        let fitted: Vec<MapTile> = a.tiles.iter().copied().filter(|t| t.size > 0).collect();
+        assert_eq!(fitted.len(), 256);
+        let packed = Allocation {
+            tiles: fitted,
+            ..a.clone()
+        };
+        assert_packed(&packed, &l);
+        // The earlier lights keep theirs.
+        assert!(a.tiles[..256].iter().all(|t| t.size == 16));
+    }
+
+    #[test]
+    fn z_order_visits_quads_first() {
+        let cells: Vec<[u32; 2]> = (0..8).map(z_order).collect();
+        assert_eq!(
+            cells,
+            [
+                [0, 0],
+                [1, 0],
+                [0, 1],
+                [1, 1],
+                [2, 0],
+                [3, 0],
+                [2, 1],
+                [3, 1]
+            ]
+        );
+    }
+}
