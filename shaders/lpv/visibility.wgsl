@@ -52,9 +52,11 @@ fn fs_visibility(in: FullscreenOut) -> @location(0) vec4<f32> {
     light_position = light.position;
     let texel = texel_world(s.position, light);
     let p = s.position + s.normal * (shadow.normal_offset * texel);
+    let parallel = light.kind == LIGHT_DIRECTIONAL;
     var direction = light.direction;
-    if light.kind != LIGHT_DIRECTIONAL {
+    if !parallel {
         direction = normalize(p - light.position);
     }
-    return vec4<f32>(grid_pcf(p, tangent_frame(direction), texel, 3));
+    let plane = TapPlane(p, s.normal, select(light.position, light.direction, parallel), parallel);
+    return vec4<f32>(grid_pcf(plane, tangent_frame(direction), texel, 3));
 }

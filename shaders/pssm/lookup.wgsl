@@ -75,7 +75,7 @@ fn split_visibility(s: Surface, split: u32, direction: vec3<f32>, r: mat2x2<f32>
     let texel = pssm.texel[split / 4u][split % 4u];
     let p = s.position + s.normal * (pssm.normal_offset * texel);
     let frame = tangent_frame(direction);
-    return filter_map(pssm.map_filter, p, frame, texel, r, tap_near, false);
+    return filter_map(pssm.map_filter, TapPlane(p, s.normal, direction, true), frame, texel, r, tap_near, false);
 }
 
 struct Outputs {

@@ -112,7 +112,8 @@ fn fs_warped(in: FullscreenOut) -> Outputs {
     // (spot) or along it (directional, where only differences matter).
     let spot = light.kind != LIGHT_DIRECTIONAL;
     let near = select(-1e30, 0.0, spot);
-    let visibility = filter_map(warped.map_filter, p, frame, texel, r, near, spot);
+    let plane = TapPlane(p, s.normal, select(light.direction, light.position, spot), !spot);
+    let visibility = filter_map(warped.map_filter, plane, frame, texel, r, near, spot);
     out.visibility = vec4<f32>(visibility);
     if warped.diagnostics == 1u {
         let depth = -(camera.view * vec4<f32>(s.position, 1.0)).z;

@@ -7,8 +7,9 @@
 //       (1 when p projects inside the map else 0, p's depth along the map's axis, the stored
 //       depth there in the same units),
 //
-// and calls the filters with a tangent frame (`tangent_frame`) perpendicular to the light's
-// rays at p, so taps are placed in world space and each is projected by itself (seamless
+// and calls the filters with the receiver's `TapPlane` and a tangent frame (`tangent_frame`)
+// perpendicular to the light's rays at the receiver: taps are placed in world space across the
+// rays, moved along their ray onto the receiver's plane and each projected by itself (seamless
 // across cube faces).
 
 #import "shadow-maps/layers.wgsl"
@@ -82,24 +83,60 @@ fn rotation(pixel: vec2<f32>) -> mat2x2<f32> {
     return mat2x2<f32>(c, s, -s, c);
 }
 
+// The receiver's tangent plane and the light's rays, for placing filter taps.
+struct TapPlane {
+    // The lookup point (on the plane) and the receiver's normal there.
+    point: vec3<f32>,
+    normal: vec3<f32>,
+    // The light's position (rays from a point) or, when `parallel`, its direction of travel.
+    apex: vec3<f32>,
+    parallel: bool,
+}
+
+// Largest depth change per unit of offset across the rays when a tap moves onto the receiver's
+// plane (a receiver at 83 degrees to the rays): steeper receivers keep the rest as slope.
+const TAP_PLANE_MAX_SLOPE: f32 = 64.0;
+
+// The tap q (across the light's rays at the lookup point) moved along its own ray onto the
+// receiver's plane, so it compares the receiver's depth there: a flat receiver never shadows
+// itself, however wide the kernel or close the light. Taps whose ray does not travel into the
+// plane's front stay where they are.
+fn on_receiver(plane: TapPlane, q: vec3<f32>) -> vec3<f32> {
+    var ray = plane.apex;
+    if !plane.parallel {
+        ray = normalize(q - plane.apex);
+    }
+    let into = dot(plane.normal, ray);
+    if into > -1e-4 {
+        return q;
+    }
+    let limit = TAP_PLANE_MAX_SLOPE * distance(q, plane.point);
+    let along = dot(plane.normal, plane.point - q) / into;
+    return q + ray * clamp(along, -limit, limit);
+}
+
+// The tap at `offset` (world units along the frame's axes) from the lookup point.
+fn plane_tap(plane: TapPlane, frame: mat2x3<f32>, offset: vec2<f32>) -> vec3<f32> {
+    return on_receiver(plane, plane.point + frame[0] * offset.x + frame[1] * offset.y);
+}
+
 // n x n bilinear comparison taps one texel apart.
-fn grid_pcf(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, n: i32) -> f32 {
+fn grid_pcf(plane: TapPlane, frame: mat2x3<f32>, texel: f32, n: i32) -> f32 {
     var sum = 0.0;
     let h = n / 2;
     for (var j = -h; j <= h; j++) {
         for (var i = -h; i <= h; i++) {
-            sum += shadow_tap(p + (frame[0] * f32(i) + frame[1] * f32(j)) * texel, true);
+            sum += shadow_tap(plane_tap(plane, frame, vec2<f32>(f32(i), f32(j)) * texel), true);
         }
     }
     return sum / f32(n * n);
 }
 
 // 32 bilinear taps on a rotated Poisson disc of world radius `radius`.
-fn poisson_pcf(p: vec3<f32>, frame: mat2x3<f32>, radius: f32, r: mat2x2<f32>) -> f32 {
+fn poisson_pcf(plane: TapPlane, frame: mat2x3<f32>, radius: f32, r: mat2x2<f32>) -> f32 {
     var sum = 0.0;
     for (var k = 0u; k < 32u; k++) {
-        let o = r * POISSON_32[k] * radius;
-        sum += shadow_tap(p + frame[0] * o.x + frame[1] * o.y, true);
+        sum += shadow_tap(plane_tap(plane, frame, r * POISSON_32[k] * radius), true);
     }
     return sum / 32.0;
 }
@@ -116,9 +153,10 @@ struct PcssLight {
 }
 
 // Percentage-closer soft shadows: average blocker depth from a 16-tap search, then a Poisson
-// kernel sized by the penumbra the light's size gives at that blocker depth.
-fn pcss(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: PcssLight) -> f32 {
-    let center = shadow_depths(p);
+// kernel sized by the penumbra the light's size gives at that blocker depth. Search taps lie on
+// the receiver's plane, so the receiver is never its own blocker.
+fn pcss(plane: TapPlane, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: PcssLight) -> f32 {
+    let center = shadow_depths(plane.point);
     if center.x == 0.0 {
         return 1.0;
     }
@@ -131,8 +169,7 @@ fn pcss(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: Pcs
     var blockers = 0.0;
     var blocker_sum = 0.0;
     for (var k = 0u; k < 16u; k++) {
-        let o = r * POISSON_16[k] * search;
-        let d = shadow_depths(p + frame[0] * o.x + frame[1] * o.y);
+        let d = shadow_depths(plane_tap(plane, frame, r * POISSON_16[k] * search));
         if d.x > 0.0 && d.z < d.y {
             blockers += 1.0;
             blocker_sum += d.z;
@@ -146,7 +183,7 @@ fn pcss(p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: Pcs
     if light.perspective {
         penumbra /= max(blocker, 1e-30);
     }
-    return poisson_pcf(p, frame, clamp(penumbra, texel, light.max_texels * texel), r);
+    return poisson_pcf(plane, frame, clamp(penumbra, texel, light.max_texels * texel), r);
 }
 
 // Filters, one per variant of the library's Rust `Filter` choice (`FILTER_` and its name in
@@ -172,22 +209,23 @@ struct MapFilter {
     light_size: f32,
 }
 
-// Visibility at p (1 = lit) through filter `f`: `frame` spans the plane across the light's
-// rays, `texel` is a map texel's world size there and `r` the pixel's rotation; PCSS sizes
-// its search from the map's `near` plane (scaled by distance on `perspective` maps).
-fn filter_map(f: MapFilter, p: vec3<f32>, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, near: f32, perspective: bool) -> f32 {
+// Visibility at the receiver `plane` (1 = lit) through filter `f`: `frame` spans the plane
+// across the light's rays, `texel` is a map texel's world size there and `r` the pixel's
+// rotation; PCSS sizes its search from the map's `near` plane (scaled by distance on
+// `perspective` maps).
+fn filter_map(f: MapFilter, plane: TapPlane, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, near: f32, perspective: bool) -> f32 {
     var visibility = 1.0;
     switch f.mode {
-        case FILTER_NONE: { visibility = shadow_tap(p, false); }
-        case FILTER_HARDWARE2X2: { visibility = shadow_tap(p, true); }
-        case FILTER_PCF3X3: { visibility = grid_pcf(p, frame, texel, 3); }
-        case FILTER_PCF5X5: { visibility = grid_pcf(p, frame, texel, 5); }
-        case FILTER_PCF7X7: { visibility = grid_pcf(p, frame, texel, 7); }
-        case FILTER_PCF9X9: { visibility = grid_pcf(p, frame, texel, 9); }
-        case FILTER_POISSON: { visibility = poisson_pcf(p, frame, f.kernel_texels * texel, r); }
+        case FILTER_NONE: { visibility = shadow_tap(plane.point, false); }
+        case FILTER_HARDWARE2X2: { visibility = shadow_tap(plane.point, true); }
+        case FILTER_PCF3X3: { visibility = grid_pcf(plane, frame, texel, 3); }
+        case FILTER_PCF5X5: { visibility = grid_pcf(plane, frame, texel, 5); }
+        case FILTER_PCF7X7: { visibility = grid_pcf(plane, frame, texel, 7); }
+        case FILTER_PCF9X9: { visibility = grid_pcf(plane, frame, texel, 9); }
+        case FILTER_POISSON: { visibility = poisson_pcf(plane, frame, f.kernel_texels * texel, r); }
         default: {
             let light = PcssLight(f.light_size, near, perspective, f.search_texels);
-            visibility = pcss(p, frame, texel, r, light);
+            visibility = pcss(plane, frame, texel, r, light);
         }
     }
     return visibility;

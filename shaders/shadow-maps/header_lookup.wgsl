@@ -59,5 +59,8 @@ fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
 fn look_up(h: MapHeader, f: MapFilter, r: Receiver, pixel: vec2<f32>) -> f32 {
     looked_up = h;
     let frame = tangent_frame(header_ray(h, r.lookup));
-    return filter_map(f, r.lookup, frame, r.texel, rotation(pixel), h.near, h.perspective == 1u);
+    let light = lights[h.light];
+    let parallel = h.perspective == 0u;
+    let plane = TapPlane(r.lookup, r.surface.normal, select(light.position, light.direction, parallel), parallel);
+    return filter_map(f, plane, frame, r.texel, rotation(pixel), h.near, h.perspective == 1u);
 }

@@ -187,6 +187,44 @@ pub fn judge_scene_on(
     }
 }
 
+/// Scenes whose point and spot lights hang 0.2 to 0.5 m in front of a wall or desk (files in
+/// `scenes/`): receivers right behind a soft light.
+pub const NEAR_WALL_SCENES: [&str; 3] = ["wall-lamps.ron", "sconce-corridor.ron", "desk-lamp.ron"];
+
+/// Judges `technique` with `params` on every [`NEAR_WALL_SCENES`] scene at 256x256 and asserts
+/// that each light it supports keeps its mae against the area reference within `bound`, or
+/// within the bound `exceptions` names for that (scene file, light). Returns the number of
+/// lights judged.
+pub fn assert_soft_near_walls(
+    technique: &str,
+    params: &[(&str, &str)],
+    bound: f64,
+    exceptions: &[(&str, usize, f64)],
+) -> usize {
+    let mut judged = 0;
+    for scene in NEAR_WALL_SCENES {
+        let run = judge(scene, technique, params, glam::UVec2::new(256, 256));
+        for light in 0..run.loaded.lights.len() {
+            if run.judged.scores[light].metrics.is_none() {
+                continue;
+            }
+            let m = run.metrics(light);
+            eprintln!(
+                "{technique} on {scene}, light {light} ({}): mae {:.4}",
+                run.loaded.lights[light].kind.name(),
+                m.mae
+            );
+            let bound = exceptions
+                .iter()
+                .find(|(s, l, _)| *s == scene && *l == light)
+                .map_or(bound, |e| e.2);
+            run.assert_bounds(light, &m, &[(Metric::Mae, bound)]);
+            judged += 1;
+        }
+    }
+    judged
+}
+
 impl JudgeRun {
     /// The metrics of `light`; panics if the technique does not support its kind.
     pub fn metrics(&self, light: usize) -> zoo_judge::Metrics {

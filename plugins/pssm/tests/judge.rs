@@ -4,7 +4,7 @@
 use zoo_plugin_pssm as _;
 
 use zoo_host::glam::UVec2;
-use zoo_host::test_support::judge;
+use zoo_host::test_support::{assert_soft_near_walls, judge};
 
 const SIZE: UVec2 = UVec2::new(256, 256);
 
@@ -99,4 +99,14 @@ fn warped_maps_beat_one_uniform_map_on_vista() {
         lispsm < 0.5 * uniform && psm < uniform,
         "lispsm {lispsm}, psm {psm}, uniform {uniform}"
     );
+}
+
+#[test]
+fn pcss_near_walls_matches_the_area_reference() {
+    // pssm and lispsm shadow the scenes' suns (grazing the walls); psm their spots as well.
+    let mut lights = 0;
+    for technique in ["pssm", "lispsm", "psm"] {
+        lights += assert_soft_near_walls(technique, &[("filter", "Pcss")], 0.03, &[]);
+    }
+    assert_eq!(lights, 2 + 2 + 6);
 }
