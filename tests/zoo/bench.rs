@@ -28,6 +28,7 @@ fn plan(techniques: &[&str], path: PathMode, frames: u32, set: &[(&str, &str, &s
             .collect(),
         flicker: true,
         cpu_timing: false,
+        reuse_unchanged: false,
     }
 }
 

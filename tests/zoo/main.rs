@@ -13,6 +13,7 @@ mod indirect_light;
 mod judge;
 mod kit;
 mod many_lights;
+mod map_caching;
 mod perspective_aliasing;
 mod plugin_failure;
 mod recorder;

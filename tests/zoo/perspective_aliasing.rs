@@ -5,7 +5,8 @@
 use shadow_zoo::bench::{self, BenchPlan, PathMode, parse_sweep, run_configuration};
 use zoo_host::ShaderLibrary;
 use zoo_host::glam::UVec2;
-use zoo_host::test_support::{gpu, judge, scene_path};
+use zoo_host::test_support::{JudgeRun, gpu, judge, judge_scene, scene_from_ron, scene_path};
+use zoo_host::{Renderer, View};
 
 const SIZE: UVec2 = UVec2::new(256, 256);
 
@@ -46,6 +47,7 @@ fn stabilised_splits_flicker_less_along_the_vista_walk() {
         set: vec![("pssm".into(), "map_size".into(), "1024".into())],
         flicker: true,
         cpu_timing: false,
+        reuse_unchanged: false,
     };
     let gpu = gpu();
     let mut flicker = std::collections::HashMap::new();
@@ -148,4 +150,55 @@ fn warped_and_split_maps_put_more_texels_near_the_viewer() {
             near_density[0]
         );
     }
+}
+#[test]
+fn psm_warps_a_wide_spot_above_a_long_view_and_beats_its_cone_map() {
+    // A wide spot high behind the viewer over a long floor: the warp spends the map's texels
+    // near the viewer, where the cone map is coarsest, so PSM keeps it (no fallback) and
+    // scores better than the cone map at the same 512 texels.
+    let scene = scene_from_ron(
+        "wide-spot-vista",
+        r#"(
+            name: "wide-spot-vista",
+            camera: (position: (0.0, 1.6, 12.0), target: (0.0, 0.8, 0.0), fov_y_degrees: 60, near: 0.1, far: 100),
+            lights: [
+                Spot(position: (4.0, 5.0, 14.0), direction: (-0.2, -1.0, -1.0), intensity: 300, range: 60,
+                     angle_degrees: 80, softness: 0.1),
+            ],
+            objects: [
+                (name: "floor", mesh: Plane(size: 60)),
+                (name: "near post", mesh: Cylinder(radius: 0.05, height: 1.5, segments: 16), transform: (translation: (0.4, 0.0, 9.5))),
+                (name: "ball", mesh: Sphere(radius: 0.3, segments: 32, rings: 16), transform: (translation: (-0.6, 0.6, 8.0))),
+                (name: "box", mesh: Box(size: (1.0, 1.0, 1.0)), transform: (translation: (1.0, 0.5, 0.0))),
+                (name: "far box", mesh: Box(size: (2.0, 2.0, 2.0)), transform: (translation: (-2.0, 1.0, -15.0))),
+            ],
+        )"#,
+    );
+    let small = [("map_size", "512")];
+    let psm = judge_scene(scene.clone(), "psm", &small, SIZE);
+    let cone = judge_scene(scene, "sm-pcf", &small, SIZE);
+    let core = |run: &JudgeRun| {
+        let m = run.metrics(0);
+        m.false_shadow_core + m.false_lit_core
+    };
+    let mut renderer = Renderer::new(gpu(), psm.loaded.clone(), SIZE).unwrap();
+    let values = small
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect::<Vec<_>>();
+    let registration = zoo_host::find_technique("psm").unwrap();
+    let mut params = zoo_host::params::defaults(&(registration.params)());
+    zoo_host::params::apply_assignments(&(registration.params)(), &mut params, &values).unwrap();
+    renderer.set_technique("psm", &params).unwrap();
+    renderer.render(&View::Final).unwrap();
+    let fallbacks = (renderer.wait_for_counters().into_iter())
+        .find(|(name, _)| name == "standard-fit fallbacks")
+        .map(|(_, v)| v);
+    eprintln!(
+        "wide spot: psm core {} (fallbacks {fallbacks:?}), cone map {}",
+        core(&psm),
+        core(&cone)
+    );
+    assert_eq!(fallbacks, Some(0.0));
+    assert!(core(&psm) < 0.5 * core(&cone));
 }

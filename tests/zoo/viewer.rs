@@ -79,14 +79,19 @@ fn clicking_a_technique_switches_it_on_the_next_frame() {
     harness.run();
     assert_eq!(harness.state().technique, "sm-pcf");
     assert_eq!(harness.state().renderer.technique().id, "sm-pcf");
-    // Its passes were rendered and timed.
-    let timings = harness.state().timings.clone().unwrap();
-    assert!(
-        timings
-            .passes
-            .iter()
-            .any(|p| p.name.starts_with("Shadow map"))
-    );
+    // Its passes were rendered and timed; frames that change nothing keep the maps, until
+    // the user asks for every map every frame.
+    let map_passes = |harness: &Harness<'_, ViewerState>| {
+        let timings = harness.state().timings.clone().unwrap();
+        (timings.passes.iter())
+            .filter(|p| p.name.starts_with("Shadow map"))
+            .count()
+    };
+    assert_eq!(map_passes(&harness), 0, "a static frame renders no maps");
+    harness.get_by_label("keep unchanged shadow maps").click();
+    harness.run();
+    assert!(!harness.state().renderer.reuse_unchanged());
+    assert!(map_passes(&harness) > 0, "every frame renders the maps");
     // Its parameter panel is generated from the schema.
     assert!(harness.query_all_by_label("map_size").next().is_some());
     harness.get_by_label("cull_front");

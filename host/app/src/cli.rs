@@ -69,6 +69,11 @@ pub struct BenchArgs {
     /// (for CPU drivers such as lavapipe, whose timestamps miss compute work).
     #[arg(long)]
     pub cpu_timing: bool,
+    /// Let techniques keep work whose inputs did not change between frames (shadow maps of
+    /// lights that did not move), as the viewer does; by default every measured frame does
+    /// all of its work.
+    #[arg(long)]
+    pub reuse_unchanged: bool,
     /// Read WGSL from DIR first (laid out as `shaders/`; files it lacks come from the
     /// copies built in), so edited shaders take effect without a rebuild.
     #[arg(long, value_name = "DIR")]

@@ -403,6 +403,10 @@ pub struct RenderContext<'a> {
     /// The technique resource being shown this frame, if any: work that only feeds a debug
     /// view can be skipped otherwise.
     pub debug_view: Option<&'a str>,
+    /// Whether work from earlier frames whose inputs did not change may be kept (shadow maps of
+    /// lights that did not move); when false, the frame does all of its work (for measuring
+    /// it).
+    pub reuse_unchanged: bool,
 }
 
 /// A shadow technique instance. Created by its registration's factory; dropping it frees its

@@ -45,6 +45,20 @@ pub fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+/// `../shared/models` beside the repository (real third-party meshes, not part of it), when
+/// present; says that the test skips its part otherwise.
+pub fn shared_models() -> Option<PathBuf> {
+    let dir = workspace_root().join("../shared/models");
+    if dir.join("spot.obj").exists() {
+        return Some(dir);
+    }
+    eprintln!(
+        "SKIPPED: {} is absent, so the real meshes are left out",
+        dir.display()
+    );
+    None
+}
+
 /// Path of a scene shipped in `scenes/`.
 pub fn scene_path(name: &str) -> PathBuf {
     workspace_root().join("scenes").join(name)

@@ -120,12 +120,12 @@ impl MomentMaps {
         recorder: &mut PassRecorder<'_>,
         s: &MomentSettings,
     ) -> TechniqueResult {
-        let (Some(maps), Some(group)) = (self.maps.maps(), self.maps.lookup_group()) else {
-            return Err(TechniqueError::not_prepared());
-        };
         let label = self.label;
         self.maps
             .record(ctx, recorder, &format!("{label} moments"))?;
+        let (Some(maps), Some(group)) = (self.maps.maps(), self.maps.lookup_group()) else {
+            return Err(TechniqueError::not_prepared());
+        };
         let lights = self.maps.lights();
         let blur = format!("{label} blur");
         let passes = self.maps.tile_passes();

@@ -1,5 +1,7 @@
 //! A technique's shadow maps for the current lights and camera: the layer plan, the map
-//! arrays and the depth pass that fills them, kept up to date from one call per frame.
+//! arrays and the depth pass that fills them, kept up to date from one call per frame. A
+//! layer's map is rendered again only when what it holds changes (its light, its fit, its
+//! tile, the scene or the technique's parameters).
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::technique::{DebugImage, ViewMapping};
@@ -50,6 +52,35 @@ impl TilePass<'_> {
     }
 }
 
+/// What one layer's map holds: it is rendered again only when this changes. The layer camera
+/// follows the light and its fit; casters are static between scene changes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct LayerContent {
+    view_proj: zoo_host::glam::Mat4,
+    tile: MapTile,
+    /// The light's range, which culls casters.
+    range: f32,
+}
+
+impl LayerContent {
+    fn of(maps: &LightMaps, face: usize, light: &zoo_host::Light) -> LayerContent {
+        LayerContent {
+            view_proj: maps.frustums[face].view_proj,
+            tile: maps.tiles[face],
+            range: light.range,
+        }
+    }
+}
+
+/// One tile this frame renders: the index of its light's maps, the layer within the light and
+/// whether it is the first on its page.
+#[derive(Debug, Clone, Copy)]
+struct FramePass {
+    light: usize,
+    face: usize,
+    first_on_page: bool,
+}
+
 /// Shadow maps of every light in an atlas ([`crate::atlas`]): depth maps, or colour maps
 /// (moments, fluxes) with a one-page depth scratch when built with a [`ColorOutput`].
 pub struct ShadowMapSet {
@@ -69,6 +100,10 @@ pub struct ShadowMapSet {
     fitted: bool,
     /// Per layer: whether [`Self::record`] renders it (all, unless [`Self::cull`] says not).
     kept: Vec<bool>,
+    /// Per layer: what its map holds now (none where it holds nothing valid).
+    rendered: Vec<Option<LayerContent>>,
+    /// The tiles this frame renders ([`Self::begin_frame`]).
+    frame: Vec<FramePass>,
 }
 
 impl ShadowMapSet {
@@ -107,6 +142,8 @@ impl ShadowMapSet {
             allocation: None,
             fitted: false,
             kept: Vec::new(),
+            rendered: Vec::new(),
+            frame: Vec::new(),
         })
     }
 
@@ -134,6 +171,10 @@ impl ShadowMapSet {
         layout: &dyn LayerPlan,
     ) -> bool {
         self.update_bounds(ctx, changes);
+        if changes.scene || changes.params {
+            // New casters, or parameters that may change what the maps hold.
+            self.rendered.clear();
+        }
         let limits = self.atlas_limits(ctx, resolution);
         if self.fitted && changes == Changes::default() && self.limits == Some(limits) {
             return false;
@@ -160,6 +201,9 @@ impl ShadowMapSet {
         self.lights = lights;
         let shrink = changes.scene || changes.lights;
         let new_maps = self.make_pages(ctx, limits.page_size, allocation.pages, shrink);
+        if new_maps {
+            self.rendered.clear();
+        }
         self.allocation = Some(allocation);
         self.fitted = true;
         self.kept.clear();
@@ -238,28 +282,88 @@ impl ShadowMapSet {
         true
     }
 
-    /// The layers to render this frame (kept ones), page by page: tiles of one page are
-    /// disjoint, so a depth scratch cleared at each page's first tile serves them all.
-    pub fn tile_passes(&self) -> Vec<TilePass<'_>> {
-        let mut passes: Vec<TilePass<'_>> = (self.lights.iter())
-            .flat_map(|maps| {
-                (maps.tiles.iter().enumerate()).map(move |(face, &tile)| TilePass {
-                    maps,
-                    face,
-                    layer: maps.first_layer + face as u32,
-                    tile,
-                    first_on_page: false,
-                })
-            })
-            .filter(|pass| pass.tile.size > 0 && self.is_kept(pass.layer))
-            .collect();
-        passes.sort_by_key(|pass| (pass.tile.page, pass.layer));
-        let mut page = None;
-        for pass in &mut passes {
-            pass.first_on_page = page != Some(pass.tile.page);
-            page = Some(pass.tile.page);
+    /// Decides which tiles this frame renders: every kept tile of each page on which a kept
+    /// tile's content changed (a page is cleared as a whole, so its other kept tiles render
+    /// again; tiles of pages left alone keep their maps), or every kept tile when the frame
+    /// may not reuse work ([`RenderContext::reuse_unchanged`]). [`Self::record`] calls it; a
+    /// technique that renders the tiles with its own pass calls it before
+    /// [`Self::tile_passes`].
+    pub fn begin_frame(&mut self, ctx: &RenderContext<'_>) {
+        if !ctx.reuse_unchanged {
+            self.rendered.clear();
         }
-        passes
+        let lights = ctx.lights;
+        let layers: usize = self.lights.iter().map(|l| l.frustums.len()).sum();
+        self.rendered.resize(layers, None);
+        let mut dirty_pages = std::collections::BTreeSet::new();
+        for maps in &self.lights {
+            for (face, tile) in maps.tiles.iter().enumerate() {
+                let layer = maps.first_layer as usize + face;
+                let content = Some(LayerContent::of(maps, face, &lights[maps.light]));
+                if tile.size > 0 && self.is_kept(layer as u32) && self.rendered[layer] != content {
+                    dirty_pages.insert(tile.page);
+                }
+            }
+        }
+        let mut frame = Vec::new();
+        for (index, maps) in self.lights.iter().enumerate() {
+            for (face, tile) in maps.tiles.iter().enumerate() {
+                if !dirty_pages.contains(&tile.page) {
+                    continue;
+                }
+                let layer = maps.first_layer as usize + face;
+                let drawn = tile.size > 0 && self.is_kept(layer as u32);
+                self.rendered[layer] =
+                    drawn.then(|| LayerContent::of(maps, face, &lights[maps.light]));
+                if drawn {
+                    frame.push((tile.page, layer, index, face));
+                }
+            }
+        }
+        frame.sort_unstable();
+        let mut page = None;
+        self.frame = (frame.into_iter())
+            .map(|(tile_page, _, light, face)| {
+                let first_on_page = page != Some(tile_page);
+                page = Some(tile_page);
+                FramePass {
+                    light,
+                    face,
+                    first_on_page,
+                }
+            })
+            .collect();
+    }
+
+    /// The tiles this frame renders ([`Self::begin_frame`]), page by page: tiles of one page
+    /// are disjoint, so a depth scratch cleared at each page's first tile serves them all.
+    pub fn tile_passes(&self) -> Vec<TilePass<'_>> {
+        (self.frame.iter())
+            .map(|pass| {
+                let maps = &self.lights[pass.light];
+                TilePass {
+                    maps,
+                    face: pass.face,
+                    layer: maps.first_layer + pass.face as u32,
+                    tile: maps.tiles[pass.face],
+                    first_on_page: pass.first_on_page,
+                }
+            })
+            .collect()
+    }
+
+    /// The atlas pages that hold a kept tile, in order.
+    pub fn kept_pages(&self) -> Vec<u32> {
+        let pages: std::collections::BTreeSet<u32> = (self.lights.iter())
+            .flat_map(|maps| {
+                (maps.tiles.iter().enumerate())
+                    .filter(|(face, tile)| {
+                        tile.size > 0 && self.is_kept(maps.first_layer + *face as u32)
+                    })
+                    .map(|(_, tile)| tile.page)
+            })
+            .collect();
+        pages.into_iter().collect()
     }
 
     /// Every light's layers, in light order.
@@ -290,11 +394,17 @@ impl ShadowMapSet {
         })
     }
 
-    /// Workload counters: map layers in use, the atlas (pages, page size, texels used and the
-    /// budget) and how many lights have maps of each size.
+    /// Workload counters: map layers in use, maps and pages rendered in the last frame, the
+    /// atlas (pages, page size, texels used and the budget) and how many lights have maps of
+    /// each size.
     pub fn counters(&self) -> Vec<(String, f64)> {
         let layers: usize = self.lights.iter().map(|l| l.frustums.len()).sum();
-        let mut counters = vec![("map layers".into(), layers as f64)];
+        let pages_rendered = (self.frame.iter()).filter(|p| p.first_on_page).count();
+        let mut counters = vec![
+            ("map layers".into(), layers as f64),
+            ("maps rendered".into(), self.frame.len() as f64),
+            ("atlas pages rendered".into(), pages_rendered as f64),
+        ];
         if let (Some(limits), Some(allocation)) = (self.limits, &self.allocation) {
             let budget = u64::from(limits.max_pages) * u64::from(limits.page_size).pow(2);
             counters.extend([
@@ -358,13 +468,15 @@ impl ShadowMapSet {
         self.depth.as_ref()
     }
 
-    /// Renders every kept layer, one pass each named by [`layer_pass_name`] with `base`.
+    /// Renders this frame's tiles ([`Self::begin_frame`]), one pass each named by
+    /// [`layer_pass_name`] with `base`.
     pub fn record(
-        &self,
+        &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         base: &str,
     ) -> TechniqueResult {
+        self.begin_frame(ctx);
         let depth = self
             .depth
             .as_ref()

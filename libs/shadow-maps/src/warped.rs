@@ -4,7 +4,7 @@
 //! the viewer by putting a perspective into the light's projection.
 
 use zoo_host::glam::camera::rh::{proj::directx, view::look_to_mat4};
-use zoo_host::glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
+use zoo_host::glam::{Mat4, UVec2, Vec2, Vec3, Vec3Swizzles, Vec4, Vec4Swizzles};
 use zoo_host::scene::{Camera, Light, LightKind};
 
 use crate::cascades::slice_corners;
@@ -282,6 +282,64 @@ pub fn psm_frustum(
     })
 }
 
+/// How coarse `frustum`'s map (of `resolution` texels a side) is where the view sees it: the
+/// largest ratio of a map texel's world size, across the light's rays, to a screen pixel's
+/// (of a `size` view), over a 5×5×5 lattice of the `receivers` box at points the camera sees
+/// and the light reaches. Points the map does not cover count as infinitely coarse; lower is
+/// sharper. For choosing between fits of one light.
+pub fn worst_texel_to_pixel(
+    frustum: &LightFrustum,
+    light: &Light,
+    camera: &Camera,
+    size: UVec2,
+    resolution: u32,
+    receivers: &[Vec3; 8],
+) -> f32 {
+    let aspect = size.x as f32 / size.y.max(1) as f32;
+    let view = camera.view();
+    let view_proj = camera.projection(aspect) * view;
+    let (lo, hi) = transformed_bounds(Mat4::IDENTITY, receivers);
+    let pixel_per_depth = 2.0 * (camera.fov_y * 0.5).tan() / size.y.max(1) as f32;
+    let texels_per_unit = resolution as f32 * 0.5;
+    let lattice = (0..125).map(|i| {
+        let t = Vec3::new((i % 5) as f32, (i / 5 % 5) as f32, (i / 25) as f32) / 4.0;
+        lo + (hi - lo) * t
+    });
+    let mut worst = 0.0f32;
+    for p in lattice {
+        let clip = view_proj * p.extend(1.0);
+        let seen = clip.w > 0.0 && clip.xyz().abs().cmple(Vec3::splat(clip.w)).all();
+        if !seen || !light.reaches(p) {
+            continue;
+        }
+        let ray = match light.kind {
+            LightKind::Directional => light.direction,
+            _ => (p - light.position).normalize_or(light.direction),
+        };
+        let pixel = pixel_per_depth * -view.transform_point3(p).z;
+        let map = |q: Vec3| {
+            let c = frustum.view_proj * q.extend(1.0);
+            (c.w > 0.0).then(|| c.xyz() / c.w)
+        };
+        let Some(centre) = map(p).filter(|m| m.xy().abs().cmple(Vec2::ONE).all()) else {
+            return f32::INFINITY;
+        };
+        let up = up_for(ray);
+        let across = [
+            ray.cross(up).normalize(),
+            ray.cross(ray.cross(up)).normalize(),
+        ];
+        for axis in across {
+            let moved = match map(p + axis * pixel) {
+                Some(m) => (m.xy() - centre.xy()).length() * texels_per_unit,
+                None => return f32::INFINITY,
+            };
+            worst = worst.max(1.0 / moved.max(1e-12));
+        }
+    }
+    worst
+}
+
 /// The smallest fraction of a PSM map the view may cover before the fit gives up.
 pub const MIN_MAP_USE: f32 = 0.05;
 
@@ -528,6 +586,46 @@ mod tests {
         let (r, b) = (map(&fit.frustum, receiver), map(&fit.frustum, blocker));
         assert!((r.truncate() - b.truncate()).length() < 1e-3);
         assert!(b.z < r.z);
+    }
+
+    #[test]
+    fn coarseness_halves_with_twice_the_texels_at_any_scale_and_an_uncovered_view_is_infinite() {
+        let light = sun(Vec3::new(0.5, -0.8, -0.3).normalize());
+        let base = camera();
+        let size = UVec2::new(320, 200);
+        let coarseness_at = |s: f32, resolution: u32| {
+            let c = Camera {
+                position: base.position * s,
+                target: base.target * s,
+                near: base.near * s,
+                far: base.far * s,
+                ..base
+            };
+            let scaled = [(ground().0 * s, ground().1 * s)];
+            let fit = psm_frustum(
+                &light,
+                &c,
+                1.6,
+                (0.1 * s, 60.0 * s),
+                &scaled,
+                &scaled,
+                0.002,
+            )
+            .expect("the sun warps");
+            let slice = slice_corners(&c, 1.6, 0.1 * s, 60.0 * s);
+            let receivers = receiver_box(&slice, &scaled);
+            worst_texel_to_pixel(&fit.frustum, &light, &c, size, resolution, &receivers)
+        };
+        let base_value = coarseness_at(1.0, 1024);
+        assert!(base_value.is_finite() && base_value > 0.0);
+        let relative = |a: f32| (a / base_value - 1.0).abs();
+        assert!(relative(2.0 * coarseness_at(1.0, 2048)) < 1e-3);
+        assert!(relative(coarseness_at(100.0, 1024)) < 1e-3);
+        let nowhere = LightFrustum::warped(Mat4::IDENTITY, Mat4::from_translation(Vec3::X * 10.0));
+        let slice = slice_corners(&base, 1.6, 0.1, 60.0);
+        let receivers = receiver_box(&slice, &[ground()]);
+        let uncovered = worst_texel_to_pixel(&nowhere, &light, &base, size, 1024, &receivers);
+        assert_eq!(uncovered, f32::INFINITY);
     }
 
     #[test]

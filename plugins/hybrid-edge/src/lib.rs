@@ -427,6 +427,7 @@ impl ShadowTechnique for Hybrid {
         let gpu = self.gpu.get_mut()?;
         let exact = p.restriction == Restriction::TriangleIds;
         if exact {
+            gpu.maps.begin_frame(ctx);
             let depth = gpu.maps.maps().ok_or_else(TechniqueError::not_prepared)?;
             let passes = gpu.maps.tile_passes();
             gpu.ids.record(ctx, recorder, depth, &passes, IDS_PASS)?;
@@ -538,6 +539,12 @@ impl ShadowTechnique for Hybrid {
         // Biases live in the map and volume pipelines (`flags(rebuild)`); the rest applies at
         // the next frame.
         Ok(self.params.update(values)?)
+    }
+
+    fn counters(&self) -> Vec<(String, f64)> {
+        self.gpu
+            .built()
+            .map_or(Vec::new(), |gpu| gpu.maps.counters())
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

@@ -12,9 +12,10 @@ use zoo_host::params::ParamError;
 use zoo_host::prelude::*;
 use zoo_host::scene::Light;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+use zoo_shadow_maps::cascades::slice_corners;
 use zoo_shadow_maps::cascades::visible_depth_range;
 use zoo_shadow_maps::light_space::LightFrustum;
-use zoo_shadow_maps::warped::{lispsm_frustum, psm_frustum};
+use zoo_shadow_maps::warped::{lispsm_frustum, psm_frustum, receiver_box, worst_texel_to_pixel};
 use zoo_shadow_maps::{
     DepthState, FilterParams, LayerPlan, LightMaps, LookupPass, LookupShader, MapFilter,
     MapFilters, MapParams, PlanInputs, ShadowMapSet, StandardLayers, light_size,
@@ -105,6 +106,38 @@ struct WarpedLayers {
     fallbacks: Cell<u32>,
 }
 
+impl WarpedLayers {
+    /// Whether the `warped` map of a spot `light` resolves the view more finely than the
+    /// light's standard cone map: seen from a light low over the ground, behind or beside the
+    /// viewer, post-perspective space can spend the map's texels worse than the cone does.
+    fn sharper(
+        &self,
+        warped: &LightFrustum,
+        light: &Light,
+        resolution: u32,
+        inputs: &PlanInputs<'_>,
+    ) -> bool {
+        let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
+        let (near, far) = visible_depth_range(inputs.camera, aspect, inputs.objects);
+        let slice = slice_corners(inputs.camera, aspect, near, far);
+        let receivers = receiver_box(&slice, inputs.objects);
+        let coarseness = |frustum: &LightFrustum| {
+            worst_texel_to_pixel(
+                frustum,
+                light,
+                inputs.camera,
+                inputs.size,
+                resolution,
+                &receivers,
+            )
+        };
+        let standard = StandardLayers.frustums(light, resolution, inputs);
+        standard
+            .first()
+            .is_none_or(|s| coarseness(warped) < coarseness(s))
+    }
+}
+
 impl LayerPlan for WarpedLayers {
     fn layers(&self, light: &Light) -> u32 {
         match (self.warp, light.kind) {
@@ -146,7 +179,10 @@ impl LayerPlan for WarpedLayers {
                 inputs.casters,
                 near_fraction,
             )
-            .map(|fit| fit.frustum),
+            .map(|fit| fit.frustum)
+            .filter(|warped| {
+                light.kind != LightKind::Spot || self.sharper(warped, light, resolution, inputs)
+            }),
         };
         fit.map(|f| vec![f]).unwrap_or_else(|| {
             self.fallbacks.set(self.fallbacks.get() + 1);

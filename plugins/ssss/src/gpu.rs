@@ -411,8 +411,7 @@ impl MinFilter {
             self.maps = Some((layered.texture, layered.view, resolution, depth.layers));
         }
         // The atlas pages that hold a rendered tile.
-        let mut kept: Vec<u32> = set.tile_passes().iter().map(|p| p.tile.page).collect();
-        kept.dedup();
+        let kept = set.kept_pages();
         let bytes: &[u8] = bytemuck::cast_slice(&kept);
         let size = (bytes.len() as u64).max(4);
         if self.kept.as_ref().is_none_or(|b| b.size() < size) {

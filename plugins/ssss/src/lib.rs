@@ -438,7 +438,7 @@ impl ShadowTechnique for Ssss {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
-        let gpu = self.gpu.get()?;
+        let gpu = self.gpu.get_mut()?;
         gpu.maps.record(ctx, recorder, MAP_PASS)?;
         if let Some(translucent) = &gpu.translucent {
             translucent.record(ctx, recorder, &gpu.maps, TRANSLUCENT_PASS)?;

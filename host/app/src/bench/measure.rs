@@ -72,6 +72,7 @@ pub fn run_configuration(
     renderer.set_technique(config.technique.id, &config.params)?;
     renderer.set_pipeline_statistics(!plan.cpu_timing);
     renderer.set_cpu_timing(plan.cpu_timing);
+    renderer.set_reuse_unchanged(plan.reuse_unchanged);
     let (t0, t1) = paths::duration(&scene.paths);
     let mut pass_samples: Vec<PassSamples> = Vec::new();
     let (mut frame_gpu, mut technique_gpu, mut frame_cpu) = (Vec::new(), Vec::new(), Vec::new());

@@ -111,6 +111,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
                         techniques,
                         flicker: !args.no_flicker,
                         cpu_timing: args.cpu_timing,
+                        reuse_unchanged: args.reuse_unchanged,
                     })
                 })
                 .collect::<anyhow::Result<Vec<_>>>()

@@ -106,6 +106,8 @@ pub struct BenchPlan {
     pub flicker: bool,
     /// Time passes on the CPU clock ([`zoo_host::Renderer::set_cpu_timing`]).
     pub cpu_timing: bool,
+    /// Let frames keep unchanged work ([`zoo_host::Renderer::set_reuse_unchanged`]).
+    pub reuse_unchanged: bool,
 }
 
 /// One measured configuration.
@@ -237,6 +239,7 @@ pub fn plan_from_args(args: &BenchArgs, scene: &Path) -> anyhow::Result<BenchPla
         set,
         flicker: !args.no_flicker,
         cpu_timing: args.cpu_timing,
+        reuse_unchanged: args.reuse_unchanged,
     })
 }
 

@@ -379,8 +379,22 @@ Source: {}",
         }
     }
 
-    /// The bottom panel: per-pass times, a rolling frame-time plot, counters and memory.
-    pub fn timing_panel(&self, ui: &mut egui::Ui) {
+    /// The bottom panel: per-pass times, a rolling frame-time plot, counters and memory, and
+    /// whether frames keep unchanged work (off shows every pass's full cost each frame).
+    pub fn timing_panel(&mut self, ui: &mut egui::Ui) {
+        let mut reuse = self.renderer.reuse_unchanged();
+        let toggled = ui
+            .checkbox(&mut reuse, "keep unchanged shadow maps")
+            .on_hover_text(
+                "Off: every frame renders every map, so the pass times show its full cost",
+            )
+            .changed();
+        if toggled {
+            self.renderer.set_reuse_unchanged(reuse);
+            if let Some(ab) = &mut self.ab {
+                ab.renderer.set_reuse_unchanged(reuse);
+            }
+        }
         let Some(timings) = &self.timings else {
             return;
         };

@@ -299,7 +299,10 @@ impl ViewerState {
         let gpu = self.renderer.gpu().clone();
         let renderer = match Renderer::with_shaders(gpu, scene.clone(), size, self.shaders.clone())
         {
-            Ok(renderer) => renderer,
+            Ok(mut renderer) => {
+                renderer.set_reuse_unchanged(self.renderer.reuse_unchanged());
+                renderer
+            }
             Err(e) => {
                 self.scene_error = Some(format!("{}: {e}", path.display()));
                 return;
@@ -335,7 +338,9 @@ impl ViewerState {
         let gpu = self.renderer.gpu().clone();
         let scene = self.renderer.scene().clone();
         match AbCompare::new(gpu, scene, self.renderer.size(), self.shaders.clone()) {
-            Ok(ab) => {
+            Ok(mut ab) => {
+                ab.renderer
+                    .set_reuse_unchanged(self.renderer.reuse_unchanged());
                 self.ab = Some(ab);
                 let id = self.technique_b.clone();
                 self.select_technique_b(&id);

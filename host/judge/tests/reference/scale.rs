@@ -5,13 +5,11 @@
 //! within 0.0005 at every scale; a kilometre-scale scene with a detailed closed mesh near the
 //! camera is judged as exactly as a small one (sv-zfail's core error at most 0.001).
 
-use std::path::PathBuf;
-
 use glam::UVec2;
 use shadow_zoo as _;
 use zoo_host::judging::{Judged, SceneReference, judge_technique};
 use zoo_host::params;
-use zoo_host::test_support::{gpu, scene_path};
+use zoo_host::test_support::{gpu, scene_path, shared_models};
 use zoo_host::{Renderer, Scene, registry};
 use zoo_judge::{ErrorClass, LightReference, error_class};
 
@@ -129,12 +127,6 @@ fn curved_is_judged_the_same_at_every_scale() {
     assert_scale_invariant("curved.ron");
 }
 
-/// `../shared/models` beside the repository, when present.
-fn shared_models() -> Option<PathBuf> {
-    let dir = zoo_host::test_support::workspace_root().join("../shared/models");
-    dir.join("spot.obj").exists().then_some(dir)
-}
-
 /// Fraction of core pixels in error (false shadow + false lit) for `light`.
 fn core_error(judged: &Judged, light: usize) -> f64 {
     let m = judged.scores[light].metrics.expect("supported");
@@ -144,7 +136,6 @@ fn core_error(judged: &Judged, light: usize) -> f64 {
 #[test]
 fn a_kilometre_scene_with_a_mesh_near_the_camera_is_judged_exactly() {
     let Some(models) = shared_models() else {
-        eprintln!("skipped: ../shared/models (the third-party test meshes) is absent");
         return;
     };
     // A 1.6 km ground, the closed `spot` mesh (about 1.4 m tall) 3 m in front of the camera,

@@ -71,6 +71,9 @@ pub struct Renderer {
     technique: ActiveTechnique,
     /// Why the technique's last slot assignment was refused, until the next frame reports it.
     slot_error: Option<TechniqueError>,
+    /// Whether techniques may keep work whose inputs did not change (see
+    /// [`RenderContext::reuse_unchanged`]).
+    reuse_unchanged: bool,
 }
 
 fn create_output(gpu: &GpuContext, size: UVec2) -> (wgpu::Texture, wgpu::TextureView) {
@@ -112,6 +115,7 @@ macro_rules! render_context {
             lights: &$renderer.lights,
             size: $renderer.size,
             debug_view: $resource,
+            reuse_unchanged: $renderer.reuse_unchanged,
         }
     };
 }
@@ -171,6 +175,7 @@ impl Renderer {
             statistics: None,
             technique,
             slot_error: None,
+            reuse_unchanged: true,
         };
         renderer.update_slots();
         Ok(renderer)
@@ -331,6 +336,18 @@ impl Renderer {
             self.update_slots();
         }
         Ok(())
+    }
+
+    /// Whether techniques may keep work from earlier frames whose inputs did not change (shadow
+    /// maps of lights that did not move, for example): on by default; off, every frame does
+    /// all of its work, as when measuring a technique's full cost per frame.
+    pub fn set_reuse_unchanged(&mut self, reuse: bool) {
+        self.reuse_unchanged = reuse;
+    }
+
+    /// Whether techniques may keep unchanged work ([`Self::set_reuse_unchanged`]).
+    pub fn reuse_unchanged(&self) -> bool {
+        self.reuse_unchanged
     }
 
     /// Moves the camera.
