@@ -94,12 +94,13 @@ struct TapPlane {
 }
 
 // Largest depth change per unit of offset across the rays when a tap moves onto the receiver's
-// plane (a receiver at 83 degrees to the rays): steeper receivers keep the rest as slope.
+// plane (rays about 89 degrees from the receiver's normal): steeper receivers keep the rest as
+// slope.
 const TAP_PLANE_MAX_SLOPE: f32 = 64.0;
 
 // The tap q (across the light's rays at the lookup point) moved along its own ray onto the
-// receiver's plane, so it compares the receiver's depth there: a flat receiver never shadows
-// itself, however wide the kernel or close the light. Taps whose ray does not travel into the
+// receiver's plane, so it compares the receiver's depth there: a flat receiver lit at up to
+// about 89 degrees never shadows itself, however wide the kernel or close the light. Taps whose ray does not travel into the
 // plane's front stay where they are.
 fn on_receiver(plane: TapPlane, q: vec3<f32>) -> vec3<f32> {
     var ray = plane.apex;

@@ -1,7 +1,7 @@
 //! A technique's shadow maps for the current lights and camera: the layer plan, the map
 //! arrays and the depth pass that fills them, kept up to date from one call per frame. A
 //! layer's map is rendered again only when what it holds changes (its light, its fit, its
-//! tile, the scene or the technique's parameters).
+//! tile, the scene or the technique's parameters) or another tile of its page does.
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::technique::{DebugImage, ViewMapping};
@@ -208,6 +208,11 @@ impl ShadowMapSet {
         self.fitted = true;
         self.kept.clear();
         let replaced = self.depth_pass.write_cameras(ctx.gpu, &self.lights) || new_maps;
+        if replaced {
+            // Techniques rebuild what they keep beside the maps (hybrid's triangle ids) when
+            // the maps or cameras are replaced: every tile renders again.
+            self.rendered.clear();
+        }
         let lookup = &mut self.lookup;
         let maps = self.color.as_ref().or(self.depth.as_ref());
         if let (Some(maps), Some(cameras)) = (maps, self.depth_pass.cameras())
@@ -285,9 +290,9 @@ impl ShadowMapSet {
     /// Decides which tiles this frame renders: every kept tile of each page on which a kept
     /// tile's content changed (a page is cleared as a whole, so its other kept tiles render
     /// again; tiles of pages left alone keep their maps), or every kept tile when the frame
-    /// may not reuse work ([`RenderContext::reuse_unchanged`]). [`Self::record`] calls it; a
-    /// technique that renders the tiles with its own pass calls it before
-    /// [`Self::tile_passes`].
+    /// may not reuse work ([`RenderContext::reuse_unchanged`]). Once a frame: [`Self::record`]
+    /// calls it; a technique that renders the tiles with its own pass instead calls it before
+    /// [`Self::tile_passes`] (and not `record`).
     pub fn begin_frame(&mut self, ctx: &RenderContext<'_>) {
         if !ctx.reuse_unchanged {
             self.rendered.clear();

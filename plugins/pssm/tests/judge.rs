@@ -132,8 +132,13 @@ fn grazing_spot_over_meshes(models: &std::path::Path) -> zoo_host::Scene {
         model("spot.obj"),
         model("teapot.obj")
     );
+    let hall_camera = "camera: (position: (2.0, 6.0, 9.0), target: (1.0, 0.5, 0.0)";
+    assert!(
+        text.contains(hall_camera),
+        "grazing-spot-hall's camera changed"
+    );
     let text = format!("{}{meshes}{}", &text[..start], &text[end..]).replace(
-        "camera: (position: (2.0, 6.0, 9.0), target: (1.0, 0.5, 0.0)",
+        hall_camera,
         "camera: (position: (0.0, 1.2, -3.0), target: (3.0, 0.5, 1.0)",
     );
     scene_from_ron("grazing-spot-meshes", &text)
