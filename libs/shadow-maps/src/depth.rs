@@ -274,22 +274,9 @@ impl DepthPass {
                 .into_iter()
                 .collect();
             let depth_page = if color.is_some() { 0 } else { page };
-            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&tile_pass.name(base)),
-                color_attachments: &colors,
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth.layer_views[depth_page],
-                    depth_ops: Some(wgpu::Operations {
-                        load: tile_pass.load_op(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            tile_pass.tile.restrict(&mut pass);
+            let depth_view = &depth.layer_views[depth_page];
+            let mut pass =
+                tile_pass.begin(recorder, base, &colors, depth_view, tile_pass.load_op(1.0));
             pass.set_pipeline(&self.pipeline);
             let offset = tile_pass.layer as u64 * CAMERA_STRIDE;
             pass.set_bind_group(0, bind_group, &[offset as u32]);

@@ -3,7 +3,7 @@
 //! layer's map is rendered again only when what it holds changes (its light, its fit, its
 //! tile, the scene or the technique's parameters) or another tile of its page does.
 
-use zoo_host::gpu::PassRecorder;
+use zoo_host::gpu::{PassRecorder, RecordedRenderPass};
 use zoo_host::technique::{DebugImage, ViewMapping};
 use zoo_host::{Changes, RenderContext, TechniqueResult, wgpu};
 
@@ -41,6 +41,35 @@ impl TilePass<'_> {
     /// The pass's name: [`layer_pass_name`] with `base`.
     pub fn name(&self, base: &str) -> String {
         layer_pass_name(base, self.maps, self.face)
+    }
+
+    /// Opens the tile's render pass, named by [`Self::name`] with `base`, on `colors` and the
+    /// depth page `depth` (loaded by `depth_load`, stored), restricted to the tile.
+    pub fn begin<'r>(
+        &self,
+        recorder: &'r mut PassRecorder<'_>,
+        base: &str,
+        colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
+        depth: &wgpu::TextureView,
+        depth_load: wgpu::LoadOp<f32>,
+    ) -> RecordedRenderPass<'r> {
+        let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&self.name(base)),
+            color_attachments: colors,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: depth_load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.tile.restrict(&mut pass);
+        pass
     }
 
     /// Clear on the page's first pass, else keep what the page's other tiles hold.

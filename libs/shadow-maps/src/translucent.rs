@@ -166,22 +166,8 @@ impl TranslucentPass {
                 &maps.layer_views[page],
                 tile_pass.load_op(wgpu::Color::WHITE),
             )];
-            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&tile_pass.name(base)),
-                color_attachments: &colors,
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth.layer_views[page],
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Load,
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            tile_pass.tile.restrict(&mut pass);
+            let depth_view = &depth.layer_views[page];
+            let mut pass = tile_pass.begin(recorder, base, &colors, depth_view, wgpu::LoadOp::Load);
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
             let offset = tile_pass.layer as u64 * CAMERA_STRIDE;

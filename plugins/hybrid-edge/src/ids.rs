@@ -210,25 +210,13 @@ impl IdMaps {
         };
         for tile_pass in passes {
             let page = tile_pass.tile.page as usize;
-            let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&tile_pass.name(base)),
-                color_attachments: &[zoo_host::gpu::color_attachment(
-                    &bound.ids.layer_views[page],
-                    tile_pass.load_op(clear),
-                )],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth.layer_views[page],
-                    depth_ops: Some(wgpu::Operations {
-                        load: tile_pass.load_op(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            tile_pass.tile.restrict(&mut pass);
+            let colors = [zoo_host::gpu::color_attachment(
+                &bound.ids.layer_views[page],
+                tile_pass.load_op(clear),
+            )];
+            let depth_view = &depth.layer_views[page];
+            let mut pass =
+                tile_pass.begin(recorder, base, &colors, depth_view, tile_pass.load_op(1.0));
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
             let offset = (tile_pass.layer as u64 * CAMERA_STRIDE) as u32;
