@@ -1,6 +1,9 @@
 // Hybrid shadows, pass 2: classify every pixel from its shadow-map neighbourhood
 // ((2r + 1)² nearest depth comparisons one texel apart): all lit is lit, all shadowed is
-// shadowed, mixed is the edge band. Lit and shadowed pixels get their visibility here.
+// shadowed, mixed is the edge band. So is a pixel the samples call lit whose own light ray may
+// cross a caster thinner than a texel, which the samples miss: the coverage maps
+// (`hybrid-edge/coverage.wgsl`) hold the nearest depth of any caster touching each texel. Lit
+// and shadowed pixels get their visibility here.
 // Edge pixels are resolved exactly, depending on the restriction:
 // - depth band (`fs_band`): edge pixels are left lit and get their own depth in the band's
 //   depth image (every other pixel holds 1), so the shadow volumes drawn next are rejected
@@ -23,8 +26,9 @@ struct EdgeLight {
     radius: u32,
     // Restriction (RESTRICTION_* below).
     restriction: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // 1: pixels the coverage maps cannot clear join the band.
+    coverage: u32,
+    _pad: u32,
 }
 
 // Restrictions, one per variant of the Rust `Restriction` parameter.
@@ -34,6 +38,12 @@ const RESTRICTION_TRIANGLEIDS: u32 = 2u;
 const RESTRICTION_TILES: u32 = 3u;
 
 @group(2) @binding(0) var<uniform> edge: EdgeLight;
+// The coverage maps (laid out like the depth maps): the id of the triangle nearest the light
+// among those touching each texel (NO_TRIANGLE where none); the scene's vertices (six floats
+// each) and indices.
+@group(4) @binding(0) var coverage_ids: texture_2d_array<u32>;
+@group(4) @binding(1) var<storage, read> scene_vertices: array<f32>;
+@group(4) @binding(2) var<storage, read> scene_indices: array<u32>;
 
 const CLASS_LIT: vec4<f32> = vec4<f32>(0.95, 0.9, 0.6, 1.0);
 const CLASS_SHADOWED: vec4<f32> = vec4<f32>(0.15, 0.2, 0.45, 1.0);
@@ -79,6 +89,95 @@ const LIT: u32 = 1u;
 const SHADOWED: u32 = 2u;
 const EDGE: u32 = 3u;
 
+const NO_TRIANGLE: u32 = 0xffffffffu;
+
+fn vertex_position(index: u32) -> vec3<f32> {
+    let base = index * 6u;
+    return vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
+}
+
+// How far towards the light a surface moves before it meets the coverage map's triangle, in
+// texels: depth precision, and the planes of a curved receiver's neighbouring triangles.
+const COVERAGE_CLEARANCE: f32 = 0.02;
+
+// The step from p to the neighbour of `pixel` along `step` or against it, whichever lies
+// nearer p (pixels beside a silhouette take the surface they belong to), oriented along `step`.
+fn nearer_step(pixel: vec2<i32>, p: vec3<f32>, step: vec2<i32>) -> vec3<f32> {
+    let ahead = load_surface(pixel + step);
+    let behind = load_surface(pixel - step);
+    let forward = ahead.position - p;
+    let backward = p - behind.position;
+    if !behind.valid || (ahead.valid && dot(forward, forward) < dot(backward, backward)) {
+        return forward;
+    }
+    return backward;
+}
+
+// The normal of the triangle under `pixel` (shading normals bend away from it near a
+// terminator, where a triangle faces away from the light while its shading normal does not),
+// from the positions of its neighbours, on the shading normal's side.
+fn face_normal(pixel: vec2<i32>, s: Surface) -> vec3<f32> {
+    let across = cross(nearer_step(pixel, s.position, vec2<i32>(1, 0)), nearer_step(pixel, s.position, vec2<i32>(0, 1)));
+    if dot(across, across) == 0.0 {
+        return s.normal;
+    }
+    let n = normalize(across);
+    return select(n, -n, dot(n, s.normal) < 0.0);
+}
+
+// The depth of triangle `id`'s plane where map point `m` lies, within the triangle's own depth
+// range (0 where the triangle reaches behind a perspective layer's eye: it may block).
+fn plane_depth(id: u32, m: MapPoint) -> f32 {
+    let camera = layer_cameras[m.layer].camera;
+    var corners: array<vec3<f32>, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        let clip = camera.view_proj * vec4<f32>(vertex_position(scene_indices[3u * id + k]), 1.0);
+        if clip.w <= 1e-6 {
+            return 0.0;
+        }
+        corners[k] = clip.xyz / clip.w;
+    }
+    let ndc = vec2<f32>(m.uv.x * 2.0 - 1.0, 1.0 - m.uv.y * 2.0);
+    let e1 = corners[1] - corners[0];
+    let e2 = corners[2] - corners[0];
+    let area = e1.x * e2.y - e1.y * e2.x;
+    let low = min(corners[0].z, min(corners[1].z, corners[2].z));
+    let high = max(corners[0].z, max(corners[1].z, corners[2].z));
+    if abs(area) < 1e-14 {
+        return high;
+    }
+    let slope = vec2<f32>(e1.z * e2.y - e2.z * e1.y, e2.z * e1.x - e1.z * e2.x) / area;
+    return clamp(corners[0].z + dot(slope, ndc - corners[0].xy), low, high);
+}
+
+// Whether a caster may cross the light ray of the pixel's surface: its triangle faces away
+// from the light, or the plane of the coverage map's triangle under the ray lies nearer the
+// light than the surface there.
+fn coverage_blocked(c: Classified, pixel: vec2<i32>) -> bool {
+    let p = c.surface.position;
+    var to_light = -c.light.direction;
+    var clearance = COVERAGE_CLEARANCE * c.texel;
+    if c.light.kind != LIGHT_DIRECTIONAL {
+        to_light = c.light.position - p;
+        clearance = min(clearance, 0.5 * length(to_light));
+        to_light = normalize(to_light);
+    }
+    if dot(face_normal(pixel, c.surface), to_light) <= 0.0 {
+        return true;
+    }
+    let layer = header_layer(edge.map, p);
+    let m = map_point(layer, p);
+    if !m.inside {
+        return false;
+    }
+    let id = textureLoad(coverage_ids, tile_texel(m.tile, m.uv), m.tile.page, 0).r;
+    if id == NO_TRIANGLE {
+        return false;
+    }
+    let moved = map_point(layer, p + to_light * clearance);
+    return plane_depth(id, m) < moved.depth;
+}
+
 // Pixels without a surface or outside the light's range and cone are discarded (lit, out of
 // the band).
 fn classify(pixel: vec2<f32>) -> Classified {
@@ -95,6 +194,8 @@ fn classify(pixel: vec2<f32>) -> Classified {
         c.kind = EDGE;
     } else if lit == 0u {
         c.kind = SHADOWED;
+    } else if edge.coverage == 1u && coverage_blocked(c, vec2<i32>(pixel)) {
+        c.kind = EDGE;
     } else {
         c.kind = LIT;
     }
@@ -123,18 +224,9 @@ fn fs_band(in: FullscreenOut) -> BandOut {
     return out;
 }
 
-// Triangle ids of the shadow map's front-most triangles (NO_TRIANGLE where none), and the
-// scene's vertices (six floats each) and indices, for the exact test.
-@group(4) @binding(0) var triangle_ids: texture_2d_array<u32>;
-@group(4) @binding(1) var<storage, read> scene_vertices: array<f32>;
-@group(4) @binding(2) var<storage, read> scene_indices: array<u32>;
-
-const NO_TRIANGLE: u32 = 0xffffffffu;
-
-fn vertex_position(index: u32) -> vec3<f32> {
-    let base = index * 6u;
-    return vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
-}
+// Triangle ids of the shadow map's front-most triangles (NO_TRIANGLE where none), for the
+// exact test.
+@group(4) @binding(3) var triangle_ids: texture_2d_array<u32>;
 
 // Whether triangle `id` crosses the ray origin + t·direction for t in (0, t_max)
 // (Möller–Trumbore).

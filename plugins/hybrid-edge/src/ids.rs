@@ -4,18 +4,21 @@
 //! library's depth pass, so the depth maps and the ids come from one rasterisation.
 
 use zoo_host::gpu::PassRecorder;
-use zoo_host::kit::{bind_group, bind_group_layout, storage, texture};
+use zoo_host::kit::{bind_group, bind_group_layout, texture};
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
-use zoo_shadow_maps::{CAMERA_STRIDE, DepthState, LayerCamera, MAP_FORMAT, MapArray, TilePass};
+use zoo_shadow_maps::{DepthState, MAP_FORMAT, MapArray, TilePass};
 
 use crate::NO_TRIANGLE;
+use crate::casters::{caster_group, caster_layout, draw_casters};
+use crate::coverage::{coverage_entries, coverage_resources};
 
 /// The id maps of one set of depth maps, and the bind groups over them.
 struct Bound {
-    /// The depth maps, layer cameras and scene vertices these were made for.
+    /// The depth maps, layer cameras, scene vertices and coverage maps these were made for.
     depth: wgpu::Texture,
     cameras: wgpu::Buffer,
     vertices: wgpu::Buffer,
+    coverage: wgpu::Texture,
     ids: MapArray,
     camera_group: wgpu::BindGroup,
     lookup_group: wgpu::BindGroup,
@@ -25,7 +28,8 @@ struct Bound {
 pub(crate) struct IdMaps {
     pipeline: wgpu::RenderPipeline,
     camera_layout: wgpu::BindGroupLayout,
-    /// Group 4 of `fs_band_ids`: the ids, the scene's vertices and indices.
+    /// Group 4 of `fs_band_ids`: the coverage maps' ids, the scene's vertices and indices, and
+    /// the triangle ids.
     pub(crate) lookup_layout: wgpu::BindGroupLayout,
     bound: Option<Bound>,
 }
@@ -35,40 +39,18 @@ impl IdMaps {
     pub(crate) fn new(ctx: &RenderContext<'_>, state: DepthState) -> TechniqueResult<IdMaps> {
         let device = &ctx.gpu.device;
         let module = ctx.shaders.create_module(device, "hybrid-edge/ids.wgsl")?;
-        let vertex = wgpu::ShaderStages::VERTEX;
-        let camera_layout = bind_group_layout(
-            device,
-            "hybrid id map camera layout",
-            &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: vertex,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
-                    },
-                    count: None,
-                },
-                storage(1, vertex, true),
-                storage(2, vertex, true),
-                storage(3, vertex, true),
-            ],
+        let camera_layout = caster_layout(device, "hybrid id map camera layout");
+        let [coverage_ids, vertices, indices] = coverage_entries();
+        let ids = texture(
+            3,
+            wgpu::ShaderStages::FRAGMENT,
+            wgpu::TextureSampleType::Uint,
+            wgpu::TextureViewDimension::D2Array,
         );
-        let fragment = wgpu::ShaderStages::FRAGMENT;
         let lookup_layout = bind_group_layout(
             device,
             "hybrid id lookup layout",
-            &[
-                texture(
-                    0,
-                    fragment,
-                    wgpu::TextureSampleType::Uint,
-                    wgpu::TextureViewDimension::D2Array,
-                ),
-                storage(1, fragment, true),
-                storage(2, fragment, true),
-            ],
+            &[coverage_ids, vertices, indices, ids],
         );
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("hybrid id map pipeline layout"),
@@ -117,18 +99,20 @@ impl IdMaps {
         })
     }
 
-    /// Makes id maps and bind groups for `depth` (the depth maps) and `cameras` (their layer
-    /// cameras) when they changed.
+    /// Makes id maps and bind groups for `depth` (the depth maps), `cameras` (their layer
+    /// cameras) and `coverage` (their coverage maps) when they changed.
     pub(crate) fn prepare(
         &mut self,
         ctx: &RenderContext<'_>,
         depth: &MapArray,
         cameras: &wgpu::Buffer,
+        coverage: &MapArray,
     ) {
         let current = self.bound.as_ref().is_some_and(|b| {
             b.depth == depth.texture
                 && &b.cameras == cameras
                 && b.vertices == ctx.scene_buffers.vertices
+                && b.coverage == coverage.texture
         });
         if current {
             return;
@@ -142,35 +126,22 @@ impl IdMaps {
             wgpu::TextureFormat::R32Uint,
         );
         let buffers = ctx.scene_buffers;
-        let camera_group = bind_group(
-            device,
-            "hybrid id map cameras",
-            &self.camera_layout,
-            &[
-                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: cameras,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
-                }),
-                buffers.vertices.as_entire_binding(),
-                buffers.indices.as_entire_binding(),
-                buffers.triangle_objects.as_entire_binding(),
-            ],
-        );
+        let camera_group = caster_group(ctx, "hybrid id map cameras", &self.camera_layout, cameras);
         let lookup_group = bind_group(
             device,
             "hybrid id lookup",
             &self.lookup_layout,
             &[
-                wgpu::BindingResource::TextureView(&ids.array_view),
-                buffers.vertices.as_entire_binding(),
-                buffers.indices.as_entire_binding(),
-            ],
+                coverage_resources(ctx, coverage).as_slice(),
+                &[wgpu::BindingResource::TextureView(&ids.array_view)],
+            ]
+            .concat(),
         );
         self.bound = Some(Bound {
             depth: depth.texture.clone(),
             cameras: cameras.clone(),
             vertices: buffers.vertices.clone(),
+            coverage: coverage.texture.clone(),
             ids,
             camera_group,
             lookup_group,
@@ -217,11 +188,13 @@ impl IdMaps {
             let depth_view = &depth.layer_views[page];
             let mut pass =
                 tile_pass.begin(recorder, base, &colors, depth_view, tile_pass.load_op(1.0));
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            let offset = (tile_pass.layer as u64 * CAMERA_STRIDE) as u32;
-            pass.set_bind_group(1, &bound.camera_group, &[offset]);
-            pass.draw(0..ctx.scene_buffers.index_count, 0..1);
+            draw_casters(
+                ctx,
+                &mut pass,
+                &self.pipeline,
+                &bound.camera_group,
+                tile_pass,
+            );
         }
         Ok(())
     }

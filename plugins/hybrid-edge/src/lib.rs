@@ -3,7 +3,10 @@
 //!
 //! Per light: (1) a shadow map from the shadow-map library; (2) a full-screen pass classifies
 //! each pixel from its (2r + 1)² shadow-map neighbourhood (nearest comparisons one texel apart)
-//! into lit, shadowed or edge, writes the visibility of lit and shadowed pixels, and writes the
+//! into lit, shadowed or edge (a pixel the samples call lit joins the edge band when a caster
+//! thinner than a texel may cross its light ray: conservatively rasterised coverage maps hold
+//! the nearest depth of any caster touching each texel), writes the visibility of lit and
+//! shadowed pixels, and writes the
 //! edge pixels' depth into a depth image whose other pixels hold 1; (3) the light's shadow
 //! volumes (from the shadow-volume library) are counted like z-fail against that image with a
 //! `Greater` depth test, so outside the band every volume fragment fails the early depth test
@@ -21,6 +24,8 @@
 //! - `Everywhere`: every pixel in the band (plain shadow volumes through the same passes), to
 //!   measure what the restriction saves.
 
+mod casters;
+mod coverage;
 mod ids;
 mod tiles;
 
@@ -32,6 +37,7 @@ use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::{DepthState, LightMaps, LookupPass, LookupShader, MapHeader, ShadowMapSet};
 
+use coverage::CoverageMaps;
 use ids::IdMaps;
 use tiles::Tiles;
 use zoo_shadow_volumes::{VolumeGenerator, Volumes, band_volume_pipeline, stencil_state};
@@ -51,6 +57,9 @@ zoo_host::technique_params! {
         map_size: u32 = 2048, range(256, 8192), step(256);
         /// Neighbourhood radius r in texels: (2r + 1)² taps decide lit, shadowed or edge.
         radius: u32 = 1, range(1, 4), step(1);
+        /// Send pixels whose light ray may cross a caster thinner than a map texel (which the
+        /// map's samples miss) to the exact pass, from conservatively rasterised coverage maps.
+        coverage: bool = true;
         /// How edge pixels are resolved: volumes restricted to the band by a depth image (and
         /// optionally to its screen tiles), exact tests against the map's triangle ids, or
         /// volumes everywhere.
@@ -74,11 +83,13 @@ struct EdgeLight {
     map: MapHeader,
     radius: u32,
     restriction: u32,
-    _pad: [u32; 2],
+    coverage: u32,
+    _pad: u32,
 }
 
 const SHADER: &str = "hybrid-edge/band.wgsl";
 const IDS_PASS: &str = "Hybrid id map";
+const COVERAGE_PASS: &str = "Hybrid coverage map";
 const TILES_PASS: &str = "Hybrid tiles";
 /// Passes that only feed debug views.
 const DEBUG_PASS: &str = "Hybrid debug view";
@@ -92,6 +103,7 @@ const CLASS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const CLASS_VIEW: &str = "classification";
 const COUNTS_VIEW: &str = "stencil counts";
 const TILES_VIEW: &str = "active tiles";
+const COVERAGE_VIEW: &str = "coverage maps";
 const COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
 /// Stencil levels the count view distinguishes, shown as ids 1..=10: counts 1..=8, then 255 and
 /// 254 (-1 and -2 wrapped); any other non-zero count is id 11.
@@ -139,6 +151,7 @@ struct Gpu {
     /// The band's classification: volumes next, or exact id tests.
     band: LookupPass<EdgeLight>,
     band_ids: LookupPass<EdgeLight>,
+    coverage: CoverageMaps,
     ids: IdMaps,
     /// The tile restriction, built when first chosen.
     tiles: Option<Tiles>,
@@ -175,6 +188,7 @@ impl Gpu {
         };
         let maps = ShadowMapSet::new(ctx, "hybrid shadow maps", state, None)?;
         let generator = VolumeGenerator::new(ctx, "hybrid")?;
+        let coverage = CoverageMaps::new(ctx)?;
         let ids = IdMaps::new(ctx, state)?;
         let device = &ctx.gpu.device;
         let module = ctx.shaders.create_module(device, SHADER)?;
@@ -194,8 +208,9 @@ impl Gpu {
             };
             LookupPass::new(ctx, &maps, BAND_PASS, shader)
         };
-        let band = band_pass("fs_band", &[])?;
-        let band_ids = band_pass("fs_band_ids", &[&ids.lookup_layout])?;
+        let (band_groups, id_groups) = ([&coverage.lookup_layout], [&ids.lookup_layout]);
+        let band = band_pass("fs_band", &band_groups)?;
+        let band_ids = band_pass("fs_band_ids", &id_groups)?;
         let bias = wgpu::DepthBiasState {
             constant: p.volume_bias as i32,
             slope_scale: 0.0,
@@ -270,6 +285,7 @@ impl Gpu {
             generator,
             band,
             band_ids,
+            coverage,
             ids,
             tiles: None,
             volume_bias: bias,
@@ -348,7 +364,8 @@ fn edge_light(p: &HybridParams, maps: &LightMaps, restriction: u32) -> EdgeLight
         map: MapHeader::new(maps, p.normal_offset),
         radius: p.radius,
         restriction,
-        _pad: [0; 2],
+        coverage: u32::from(p.coverage),
+        _pad: 0,
     }
 }
 
@@ -387,6 +404,13 @@ impl ShadowTechnique for Hybrid {
             &gpu.targets.tiles.0,
             true,
         ));
+        if let Some(coverage) = gpu.coverage.maps() {
+            out.push(ResourceInfo::texture(
+                COVERAGE_VIEW,
+                &coverage.texture,
+                true,
+            ));
+        }
         if let Some(ids) = gpu.ids.maps() {
             out.push(ResourceInfo::texture("triangle ids", &ids.texture, false));
         }
@@ -403,10 +427,12 @@ impl ShadowTechnique for Hybrid {
             gpu.lights = ctx.lights.len();
         }
         gpu.maps.prepare(ctx, changes, self.params.map_size, true);
-        if self.params.restriction == Restriction::TriangleIds
-            && let (Some(depth), Some(cameras)) = (gpu.maps.maps(), gpu.maps.cameras())
-        {
-            gpu.ids.prepare(ctx, depth, cameras);
+        if let (Some(depth), Some(cameras)) = (gpu.maps.maps(), gpu.maps.cameras()) {
+            gpu.coverage.prepare(ctx, depth, cameras);
+            let coverage = gpu.coverage.maps().expect("prepared above");
+            if self.params.restriction == Restriction::TriangleIds {
+                gpu.ids.prepare(ctx, depth, cameras, coverage);
+            }
         }
         if self.params.restriction == Restriction::Tiles {
             if gpu.tiles.is_none() {
@@ -434,6 +460,10 @@ impl ShadowTechnique for Hybrid {
         } else {
             gpu.maps.record(ctx, recorder, MAP_PASS)?;
         }
+        if p.coverage {
+            let passes = gpu.maps.tile_passes();
+            gpu.coverage.record(ctx, recorder, &passes, COVERAGE_PASS)?;
+        }
         let restriction = gpu.restriction_codes.code(p.restriction.index());
         let uniform = |l: &LightMaps, _| Some(edge_light(p, l, restriction));
         let lookups = match exact {
@@ -441,7 +471,11 @@ impl ShadowTechnique for Hybrid {
             false => gpu.band.write(ctx, &gpu.maps, p.debug_light, uniform),
         };
         let band_pass = if exact { &gpu.band_ids } else { &gpu.band };
-        let ids = gpu.ids.lookup_group();
+        let group = match exact {
+            true => gpu.ids.lookup_group(),
+            false => gpu.coverage.lookup_group(),
+        }
+        .ok_or_else(TechniqueError::not_prepared)?;
         for (k, lookup) in lookups.iter().enumerate() {
             let light = lookup.maps.light;
             let band = &gpu.targets.band.1;
@@ -459,15 +493,7 @@ impl ShadowTechnique for Hybrid {
                         store: wgpu::StoreOp::Store,
                     }),
                 };
-                let ids = ids.filter(|_| exact);
-                if exact && ids.is_none() {
-                    return Err(TechniqueError::not_prepared());
-                }
-                let bind = |pass: &mut wgpu::RenderPass<'_>| {
-                    if let Some(ids) = ids {
-                        pass.set_bind_group(4, ids, &[]);
-                    }
-                };
+                let bind = |pass: &mut wgpu::RenderPass<'_>| pass.set_bind_group(4, group, &[]);
                 band_pass.record_one(
                     ctx,
                     recorder,
@@ -563,6 +589,13 @@ impl ShadowTechnique for Hybrid {
                 mapping: ViewMapping::Integer,
             }),
             "shadow maps" => gpu.maps.debug_image(self.params.debug_light),
+            COVERAGE_VIEW => {
+                let light = gpu.maps.debug_light(self.params.debug_light)?;
+                Some(DebugImage {
+                    view: &gpu.coverage.maps()?.layer_views[light.tiles[0].page as usize],
+                    mapping: ViewMapping::Integer,
+                })
+            }
             _ => None,
         }
     }
@@ -624,7 +657,8 @@ mod tests {
         let (size, fields) = zoo_host::mirror_fields!(EdgeLight {
             map,
             radius,
-            restriction
+            restriction,
+            coverage
         });
         check_mirror(&source, "EdgeLight", size, &fields, SizeRule::Equal).unwrap();
         ChoiceCodes::read(&source, "RESTRICTION", Restriction::NAMES).unwrap();

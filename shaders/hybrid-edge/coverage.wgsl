@@ -1,0 +1,114 @@
+// Hybrid shadows, coverage maps: every caster triangle rendered conservatively from one
+// shadow-map layer, into every texel it touches, writing its id. The depth map samples texel
+// centres and misses casters thinner than a texel; the band pass tests a pixel's own light
+// ray against the plane of the triangle stored in its texel here (`coverage_blocked` in
+// `hybrid-edge/band.wgsl`).
+//
+// Each triangle grows by half a texel on every side in the vertex shader: its edges move out
+// by the half texel's extent along their normals and the corners go where the moved edges
+// meet (overestimating conservative rasterisation); the triangle's box grown by half a texel
+// discards what the growth adds beyond sharp corners. The depth test keeps, per texel, the
+// triangle whose plane is nearest the light at the texel's centre, within the triangle's own
+// depth range (so a receiver's own triangle, not a steep one behind it, holds its texel).
+
+#import "hybrid-edge/casters.wgsl"
+
+struct CoverageVertex {
+    @builtin(position) clip: vec4<f32>,
+    // The position in the layer's normalised device coordinates.
+    @location(0) ndc: vec2<f32>,
+    // The triangle's box grown by half a texel: min x, min y, max x, max y.
+    @location(1) @interpolate(flat) bounds: vec4<f32>,
+    // The triangle's nearest and farthest depth.
+    @location(2) @interpolate(flat) depths: vec2<f32>,
+    @location(3) @interpolate(flat) triangle: u32,
+}
+
+struct CoverageOut {
+    @location(0) triangle: u32,
+    @builtin(frag_depth) depth: f32,
+}
+
+// 2D cross product.
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+// The line through a and b moved out by `half` (half a texel per axis), as (normal, offset):
+// points x with dot(normal, x) <= offset are on the triangle's side. `orientation` is the
+// sign of the triangle's area.
+fn grown_edge(a: vec2<f32>, b: vec2<f32>, orientation: f32, half: vec2<f32>) -> vec3<f32> {
+    let d = b - a;
+    let normal = vec2<f32>(d.y, -d.x) * orientation;
+    return vec3<f32>(normal, dot(normal, a) + dot(abs(normal), half));
+}
+
+// Where two edge lines (normal, offset) meet.
+fn meet(e: vec3<f32>, f: vec3<f32>) -> vec2<f32> {
+    let det = cross2(e.xy, f.xy);
+    return vec2<f32>(e.z * f.y - f.z * e.y, e.x * f.z - f.x * e.z) / det;
+}
+
+@vertex
+fn vs_coverage(@builtin(vertex_index) vertex: u32) -> CoverageVertex {
+    var out: CoverageVertex;
+    out.clip = OUTSIDE_CLIP;
+    let triangle = vertex / 3u;
+    out.triangle = triangle;
+    if !casts_shadows(triangle) {
+        return out;
+    }
+    let corner = vertex % 3u;
+    var clip: array<vec4<f32>, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        clip[k] = layer_camera.view_proj * vec4<f32>(triangle_corner(triangle, k), 1.0);
+    }
+    // A triangle that reaches behind a perspective layer's eye is drawn as it is (clipped by
+    // the rasteriser, not grown).
+    if min(clip[0].w, min(clip[1].w, clip[2].w)) <= 1e-6 {
+        out.clip = clip[corner];
+        out.bounds = vec4<f32>(-2.0, -2.0, 2.0, 2.0);
+        out.depths = vec2<f32>(0.0, 1.0);
+        return out;
+    }
+    var ndc: array<vec3<f32>, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        ndc[k] = clip[k].xyz / clip[k].w;
+    }
+    let e1 = ndc[1].xy - ndc[0].xy;
+    let e2 = ndc[2].xy - ndc[0].xy;
+    let area = cross2(e1, e2);
+    // Seen edge on, a triangle covers nothing.
+    if abs(area) < 1e-14 {
+        return out;
+    }
+    let half = vec2<f32>(1.0 / f32(layer_camera.tile.size));
+    let orientation = sign(area);
+    let before = (corner + 2u) % 3u;
+    let after = (corner + 1u) % 3u;
+    let incoming = grown_edge(ndc[before].xy, ndc[corner].xy, orientation, half);
+    let outgoing = grown_edge(ndc[corner].xy, ndc[after].xy, orientation, half);
+    let position = meet(incoming, outgoing);
+    // The triangle's plane: depth = ndc[0].z + dot(slope, xy - ndc[0].xy).
+    let dz1 = ndc[1].z - ndc[0].z;
+    let dz2 = ndc[2].z - ndc[0].z;
+    let slope = vec2<f32>(dz1 * e2.y - dz2 * e1.y, dz2 * e1.x - dz1 * e2.x) / area;
+    out.clip = vec4<f32>(position, ndc[0].z + dot(slope, position - ndc[0].xy), 1.0);
+    out.ndc = position;
+    let low = min(ndc[0], min(ndc[1], ndc[2]));
+    let high = max(ndc[0], max(ndc[1], ndc[2]));
+    out.bounds = vec4<f32>(low.xy - half, high.xy + half);
+    out.depths = vec2<f32>(low.z, high.z);
+    return out;
+}
+
+@fragment
+fn fs_coverage(in: CoverageVertex) -> CoverageOut {
+    if any(in.ndc < in.bounds.xy) || any(in.ndc > in.bounds.zw) {
+        discard;
+    }
+    var out: CoverageOut;
+    out.triangle = in.triangle;
+    out.depth = clamp(clamp(in.clip.z, in.depths.x, in.depths.y), 0.0, 1.0);
+    return out;
+}
