@@ -491,7 +491,7 @@ impl ShadowTechnique for Ssss {
             .filter(|&layer| gpu.maps.is_kept(layer))
             .count();
         let shadowed = self.layers.of_light.iter().filter(|l| l.is_some()).count();
-        counters.push(("map layers rendered".into(), kept as f64));
+        counters.push(("map layers kept".into(), kept as f64));
         counters.push(("screen-space layers".into(), f64::from(self.layers.count)));
         counters.push(("lights on screen".into(), shadowed as f64));
         counters
