@@ -3,8 +3,11 @@
 // drawn once per listed tile, clipped to the tile by clip distances, so nothing is rasterised
 // outside the edge tiles.
 
+// Invocations along each side of a tile's scan (`SCAN_SIDE` in `tiles.rs`).
+const SCAN_SIDE: u32 = 8u;
+
 struct TileParams {
-    // Tile side in pixels (a multiple of 8).
+    // Tile side in pixels (a multiple of SCAN_SIDE).
     tile_size: u32,
     tiles_x: u32,
     tiles_y: u32,
@@ -20,7 +23,7 @@ struct TileParams {
 
 var<workgroup> has_edge: atomic<u32>;
 
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(SCAN_SIDE, SCAN_SIDE)
 fn cs_tiles(
     @builtin(workgroup_id) tile: vec3<u32>,
     @builtin(local_invocation_id) local: vec3<u32>,
@@ -31,7 +34,7 @@ fn cs_tiles(
     }
     workgroupBarrier();
     let size = textureDimensions(band_depth);
-    let span = params.tile_size / 8u;
+    let span = params.tile_size / SCAN_SIDE;
     for (var y = 0u; y < span; y++) {
         for (var x = 0u; x < span; x++) {
             let pixel = tile.xy * params.tile_size + local.xy * span + vec2<u32>(x, y);

@@ -12,6 +12,8 @@
 
 const FLAG_CASTS: u32 = 1u;
 const FLAG_CLOSED: u32 = 2u;
+// `EdgeRecord::info` (host scene crate): the face count below bit 24, the edge kind above.
+const EDGE_FACE_COUNT_MASK: u32 = 0x00ffffffu;
 const MODE_PER_TRIANGLE: u32 = 1u;
 
 struct Params {
@@ -156,7 +158,7 @@ fn edges_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
         return;
     }
     let edge = edges[e];
-    let count = edge.w & 0x00ffffffu;
+    let count = edge.w & EDGE_FACE_COUNT_MASK;
     var m = 0;
     for (var k = 0u; k < count; k++) {
         let incidence = edge_faces[edge.z + k];

@@ -42,13 +42,23 @@ pub struct EdgeRecord {
 }
 
 impl EdgeRecord {
+    /// Bit at which [`EdgeRecord::info`] stores the [`EdgeKind`]; the face count fills the bits
+    /// below (`EDGE_KIND_SHIFT` and `EDGE_FACE_COUNT_MASK` in `shadow-volumes/volumes.wgsl`).
+    pub const KIND_SHIFT: u32 = 24;
+    /// Mask of the face count in [`EdgeRecord::info`].
+    pub const FACE_COUNT_MASK: u32 = (1 << Self::KIND_SHIFT) - 1;
+
+    /// Packs a face count and a connectivity class into [`EdgeRecord::info`].
+    pub fn pack_info(face_count: u32, kind: EdgeKind) -> u32 {
+        face_count.min(Self::FACE_COUNT_MASK) | (kind as u32) << Self::KIND_SHIFT
+    }
     /// Number of incident faces.
     pub fn face_count(&self) -> u32 {
-        self.info & 0x00ff_ffff
+        self.info & Self::FACE_COUNT_MASK
     }
     /// Connectivity class.
     pub fn kind(&self) -> EdgeKind {
-        match self.info >> 24 {
+        match self.info >> Self::KIND_SHIFT {
             0 => EdgeKind::Manifold,
             1 => EdgeKind::Boundary,
             _ => EdgeKind::NonManifold,
@@ -155,7 +165,7 @@ fn build_object(mesh: &MeshData, range: Range<usize>, out: &mut Adjacency) {
             v0: key.0,
             v1: key.1,
             first_face: out.edge_faces.len() as u32,
-            info: faces.len() as u32 | (kind as u32) << 24,
+            info: EdgeRecord::pack_info(faces.len() as u32, kind),
         });
         out.edge_faces.extend_from_slice(faces);
     }

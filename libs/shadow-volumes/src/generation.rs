@@ -20,6 +20,8 @@ zoo_host::param_choice! {
 
 const FLAG_CASTS: u32 = 1;
 const FLAG_CLOSED: u32 = 2;
+/// Invocations per workgroup of both entry points (`@workgroup_size` in the shader).
+pub const WORKGROUP_SIZE: u32 = 64;
 /// Bytes between the per-light parameter slots (a uniform dynamic-offset slot).
 const SLOT: u64 = 256;
 /// Draw arguments followed by the silhouette counter (`DrawArgs` in the shader).
@@ -60,9 +62,10 @@ pub fn volume_capacity(scene: &Scene, volumes: Volumes) -> u64 {
     (6 * triangles + sides).max(3)
 }
 
-/// Workgroups (x, y) of 64 invocations covering `items` (more than 65535 groups go 2D).
+/// Workgroups (x, y) of [`WORKGROUP_SIZE`] invocations covering `items` (more than 65535
+/// groups go 2D).
 pub fn dispatch_size(items: u32) -> (u32, u32) {
-    let groups = items.div_ceil(64).max(1);
+    let groups = items.div_ceil(WORKGROUP_SIZE).max(1);
     let x = groups.min(65535);
     (x, groups.div_ceil(x))
 }
@@ -305,6 +308,7 @@ impl VolumeGenerator {
 mod tests {
     use super::*;
     use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_struct};
+    use zoo_host::scene::EdgeRecord;
 
     #[test]
     fn gpu_structs_mirror_the_shader() {
@@ -325,6 +329,36 @@ mod tests {
         assert_eq!(
             wgsl_struct(&source, "DrawArgs").unwrap().size as u64,
             ARGS_BYTES
+        );
+    }
+
+    #[test]
+    fn shared_numbers_match_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose("shadow-volumes/volumes.wgsl")
+            .unwrap()
+            .source;
+        let constant = |name| zoo_host::gpu::layout::wgsl_integer_constant(&source, name);
+        assert_eq!(constant("FLAG_CASTS"), Ok(i64::from(FLAG_CASTS)));
+        assert_eq!(constant("FLAG_CLOSED"), Ok(i64::from(FLAG_CLOSED)));
+        assert_eq!(
+            constant("EDGE_FACE_COUNT_MASK"),
+            Ok(i64::from(EdgeRecord::FACE_COUNT_MASK))
+        );
+        for entry in ["triangles", "edges_main"] {
+            let size = zoo_host::gpu::layout::wgsl_workgroup_size(&source, entry);
+            assert_eq!(size, Ok([WORKGROUP_SIZE, 1, 1]), "{entry}");
+        }
+        let info = EdgeRecord::pack_info(3, EdgeKind::NonManifold);
+        let record = EdgeRecord {
+            v0: 0,
+            v1: 1,
+            first_face: 0,
+            info,
+        };
+        assert_eq!(
+            (record.face_count(), record.kind()),
+            (3, EdgeKind::NonManifold)
         );
     }
 

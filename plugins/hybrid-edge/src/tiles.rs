@@ -45,6 +45,10 @@ pub(crate) struct Tiles {
     bound: Option<Bound>,
 }
 
+/// Invocations along each side of the list pass's scan of a tile (`SCAN_SIDE` in the shader,
+/// its workgroup's side); tiles are a multiple of it.
+const SCAN_SIDE: u32 = 8;
+
 /// Format of the active-tiles view.
 pub(crate) const OVERLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
@@ -158,8 +162,8 @@ impl Tiles {
         size: UVec2,
         tile_size: u32,
     ) {
-        // The list pass scans a tile with 8 x 8 invocations.
-        let tile_size = tile_size.max(8).div_ceil(8) * 8;
+        // The list pass scans a tile with SCAN_SIDE x SCAN_SIDE invocations.
+        let tile_size = tile_size.max(SCAN_SIDE).div_ceil(SCAN_SIDE) * SCAN_SIDE;
         let tiles = size.as_vec2() / tile_size as f32;
         let params = TileParams {
             tile_size,
@@ -334,5 +338,17 @@ mod tests {
                 .source;
             check_mirror(&source, "TileParams", size, &fields, SizeRule::Equal).unwrap();
         }
+    }
+
+    #[test]
+    fn the_scan_side_is_the_shader_s() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose("hybrid-edge/tiles.wgsl")
+            .unwrap()
+            .source;
+        let side = zoo_host::gpu::layout::wgsl_integer_constant(&source, "SCAN_SIDE");
+        assert_eq!(side, Ok(i64::from(SCAN_SIDE)));
+        let size = zoo_host::gpu::layout::wgsl_workgroup_size(&source, "cs_tiles");
+        assert_eq!(size, Ok([SCAN_SIDE, SCAN_SIDE, 1]));
     }
 }

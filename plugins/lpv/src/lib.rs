@@ -758,6 +758,8 @@ mod tests {
             cascades
         });
         check_mirror(&source, "LpvData", size, &fields, SizeRule::Equal).unwrap();
+        let (size, fields) = zoo_host::mirror_fields!(gpu::GpuCascade { min, cell });
+        check_mirror(&source, "Cascade", size, &fields, SizeRule::Equal).unwrap();
         let (size, fields) = zoo_host::mirror_fields!(RsmCamera {
             view_proj,
             eye,

@@ -416,3 +416,24 @@ zoo_host::register_technique! {
     params: PlanarParams::schema,
     create: create,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+
+    #[test]
+    fn projection_mirrors_the_shader() {
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose("planar/planar.wgsl")
+            .unwrap()
+            .source;
+        let (size, fields) = zoo_host::mirror_fields!(Projection {
+            shadow_matrix,
+            plane,
+            light,
+            params
+        });
+        check_mirror(&source, "Projection", size, &fields, SizeRule::Equal).unwrap();
+    }
+}

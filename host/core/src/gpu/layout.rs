@@ -54,6 +54,18 @@ pub fn wgsl_integer_constant(source: &str, name: &str) -> Result<i64, String> {
     }
 }
 
+/// The `@workgroup_size` of compute entry point `entry` in WGSL `source`, so a dispatch written
+/// in Rust can be checked against the shader.
+pub fn wgsl_workgroup_size(source: &str, entry: &str) -> Result<[u32; 3], String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    module
+        .entry_points
+        .iter()
+        .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
+        .map(|e| e.workgroup_size)
+        .ok_or_else(|| format!("no compute entry point `{entry}` in the shader"))
+}
+
 /// The WGSL values of a choice parameter's options (see [`param_choice!`](crate::param_choice)),
 /// read from the shader that switches on them: option `Pcf3x3` of prefix `FILTER` is constant
 /// `FILTER_PCF3X3`. The numbers live only in the shader; a missing or repeated constant, or

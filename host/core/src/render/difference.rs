@@ -126,3 +126,23 @@ impl ImageDifference {
         image::RgbaImage::from_raw(size.x, size.y, bytes)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout::{SizeRule, check_mirror};
+
+    #[test]
+    fn params_mirror_the_shader() {
+        let source = ShaderLibrary::embedded()
+            .compose("host/difference.wgsl")
+            .unwrap()
+            .source;
+        let (size, fields) = crate::mirror_fields!(DifferenceParams {
+            gain,
+            context,
+            _pad
+        });
+        check_mirror(&source, "DifferenceParams", size, &fields, SizeRule::Equal).unwrap();
+    }
+}
