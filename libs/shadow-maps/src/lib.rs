@@ -12,6 +12,7 @@
 //! live in WGSL: `shaders/shadow-maps/`.
 
 pub mod atlas;
+pub mod atlas_space;
 pub mod blur;
 pub mod cascades;
 pub mod culling;

@@ -142,19 +142,23 @@ pub struct PlanInputs<'a> {
 
 /// Consecutive layers for every light with the frusta `layout` fits, each light's maps at
 /// the tier the atlas gives it within `limits` (from its span on screen, [`wanted_tier`]).
+/// With the `previous` frame's allocation, lights keep their wanted tiers within the
+/// hysteresis and their tiles where their tiers hold ([`allocate`]).
 pub fn plan_with(
     inputs: &PlanInputs<'_>,
     layout: &dyn LayerPlan,
     limits: &AtlasLimits,
+    previous: Option<&Allocation>,
 ) -> (Vec<LightMaps>, Allocation) {
     let layers: Vec<u32> = inputs.lights.iter().map(|l| layout.layers(l)).collect();
     let scissors: Vec<[u32; 4]> = (inputs.lights.iter())
         .map(|light| light_scissor(light, inputs.view_proj, inputs.size))
         .collect();
-    let wanted: Vec<u32> = (scissors.iter())
-        .map(|&scissor| wanted_tier(scissor, inputs.size))
+    let previous = previous.filter(|p| p.layers == layers);
+    let wanted: Vec<u32> = (scissors.iter().enumerate())
+        .map(|(i, &scissor)| wanted_tier(scissor, inputs.size, previous.map(|p| p.wanted[i])))
         .collect();
-    let allocation = allocate(&layers, &wanted, limits);
+    let allocation = allocate(&layers, &wanted, limits, previous);
     let mut next_layer = 0;
     let lights = (inputs.lights.iter().enumerate())
         .map(|(i, light)| {

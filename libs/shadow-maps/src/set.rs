@@ -218,7 +218,9 @@ impl ShadowMapSet {
             casters: &self.casters,
             stable,
         };
-        let (lights, allocation) = plan_with(&inputs, layout, &limits);
+        // A new scene or new parameters start from a fresh packing.
+        let previous = (!(changes.scene || changes.params)).then_some(self.allocation.as_ref());
+        let (lights, allocation) = plan_with(&inputs, layout, &limits, previous.flatten());
         if allocation.unfitted > 0 && self.allocation.as_ref().is_none_or(|a| a.unfitted == 0) {
             zoo_host::log::warn!(
                 "{}: {} map layers do not fit the atlas even at {}²; their lights are unshadowed there",

@@ -28,6 +28,9 @@ pub struct ConfigResult {
     pub technique_gpu: Summary,
     pub frame_cpu: Summary,
     pub counters: Vec<(String, f64)>,
+    /// Counters whose value changed between measured frames, with their value per measured
+    /// frame (work kept or redone along the path, such as `maps rendered`).
+    pub varying_counters: Vec<(String, Vec<f64>)>,
     pub flicker: Option<f64>,
     pub timing_source: TimingSource,
     pub triangles: usize,
@@ -78,6 +81,7 @@ pub fn run_configuration(
     let (mut frame_gpu, mut technique_gpu, mut frame_cpu) = (Vec::new(), Vec::new(), Vec::new());
     let mut timing_source = TimingSource::GpuTimestamps;
     let mut flicker = Flicker::default();
+    let mut counter_frames: Vec<Vec<(String, f64)>> = Vec::new();
     for f in 0..plan.warmup + plan.frames {
         let measured = f.saturating_sub(plan.warmup);
         let time = if plan.frames > 1 {
@@ -102,6 +106,7 @@ pub fn run_configuration(
         frame_gpu.push(timings.frame_total());
         technique_gpu.push(timings.total(PassOwner::Technique));
         frame_cpu.push(cpu);
+        counter_frames.push(renderer.wait_for_counters());
         for pass in &timings.passes {
             let index = match pass_samples.iter().position(|p| p.name == pass.name) {
                 Some(i) => i,
@@ -166,9 +171,65 @@ pub fn run_configuration(
         frame_gpu: Summary::of(&frame_gpu),
         technique_gpu: Summary::of(&technique_gpu),
         frame_cpu: Summary::of(&frame_cpu),
-        counters: renderer.wait_for_counters(),
+        counters: counter_frames.last().cloned().unwrap_or_default(),
+        varying_counters: varying_counters(&counter_frames),
         flicker,
         timing_source,
         triangles,
     })
+}
+
+/// The counters of `frames` (each frame's counters) whose value is not the same in every frame,
+/// with the value per frame (0 where a frame lacks it).
+fn varying_counters(frames: &[Vec<(String, f64)>]) -> Vec<(String, Vec<f64>)> {
+    let mut names: Vec<&str> = Vec::new();
+    for (name, _) in frames.iter().flatten() {
+        if !names.contains(&name.as_str()) {
+            names.push(name);
+        }
+    }
+    names
+        .into_iter()
+        .map(|name| {
+            let values = frames
+                .iter()
+                .map(|frame| {
+                    frame
+                        .iter()
+                        .find(|(n, _)| n == name)
+                        .map_or(0.0, |(_, v)| *v)
+                })
+                .collect::<Vec<f64>>();
+            (name.to_string(), values)
+        })
+        .filter(|(_, values)| values.windows(2).any(|w| w[0] != w[1]))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::varying_counters;
+
+    #[test]
+    fn only_counters_that_change_are_listed_per_frame() {
+        let frame = |maps: f64, pages: Option<f64>| {
+            let mut counters = vec![("map layers".to_string(), 12.0)];
+            counters.push(("maps rendered".to_string(), maps));
+            counters.extend(pages.map(|p| ("atlas pages rendered".to_string(), p)));
+            counters
+        };
+        let frames = [
+            frame(12.0, Some(2.0)),
+            frame(0.0, None),
+            frame(3.0, Some(1.0)),
+        ];
+        assert_eq!(
+            varying_counters(&frames),
+            vec![
+                ("maps rendered".to_string(), vec![12.0, 0.0, 3.0]),
+                ("atlas pages rendered".to_string(), vec![2.0, 0.0, 1.0]),
+            ]
+        );
+        assert!(varying_counters(&[frame(5.0, None), frame(5.0, None)]).is_empty());
+    }
 }

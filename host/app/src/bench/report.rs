@@ -367,6 +367,28 @@ pub fn bench_md(
             );
         }
     }
+    let varying: Vec<&ConfigResult> = results
+        .iter()
+        .filter(|r| !r.varying_counters.is_empty())
+        .collect();
+    if !varying.is_empty() {
+        let _ = writeln!(
+            w,
+            "\n## Counters that change between frames (value per measured frame)\n"
+        );
+        for r in varying {
+            for (name, values) in &r.varying_counters {
+                let values: Vec<String> = values.iter().map(|v| v.to_string()).collect();
+                let _ = writeln!(
+                    w,
+                    "- {} `{}` {name}: {}",
+                    r.config.run,
+                    r.config.label(),
+                    values.join(", ")
+                );
+            }
+        }
+    }
     out
 }
 
