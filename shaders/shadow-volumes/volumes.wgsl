@@ -15,6 +15,8 @@ const FLAG_CLOSED: u32 = 2u;
 // `EdgeRecord::info` (host scene crate): the face count below bit 24, the edge kind above.
 const EDGE_FACE_COUNT_MASK: u32 = 0x00ffffffu;
 const MODE_PER_TRIANGLE: u32 = 1u;
+// Invocations per workgroup of both entry points (`WORKGROUP_SIZE` in the library).
+const WORKGROUP_SIZE: u32 = 64u;
 
 struct Params {
     light: u32,
@@ -96,10 +98,10 @@ fn emit_side(u: vec3<f32>, v: vec3<f32>) {
 
 // Invocation index over a 2D dispatch (more than 65535 workgroups).
 fn invocation(id: vec3<u32>, groups: vec3<u32>) -> u32 {
-    return id.y * groups.x * 64u + id.x;
+    return id.y * groups.x * WORKGROUP_SIZE + id.x;
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(WORKGROUP_SIZE)
 fn triangles(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let t = invocation(id, groups);
     if t >= params.triangle_count {
@@ -151,7 +153,7 @@ fn triangles(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
     }
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(WORKGROUP_SIZE)
 fn edges_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let e = invocation(id, groups);
     if e >= params.edge_count || params.mode == MODE_PER_TRIANGLE {

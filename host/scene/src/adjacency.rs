@@ -43,7 +43,7 @@ pub struct EdgeRecord {
 
 impl EdgeRecord {
     /// Bit at which [`EdgeRecord::info`] stores the [`EdgeKind`]; the face count fills the bits
-    /// below (`EDGE_KIND_SHIFT` and `EDGE_FACE_COUNT_MASK` in `shadow-volumes/volumes.wgsl`).
+    /// below (`EDGE_FACE_COUNT_MASK` in `shadow-volumes/volumes.wgsl`, which reads only them).
     pub const KIND_SHIFT: u32 = 24;
     /// Mask of the face count in [`EdgeRecord::info`].
     pub const FACE_COUNT_MASK: u32 = (1 << Self::KIND_SHIFT) - 1;

@@ -3,8 +3,9 @@
 //! importance on screen; when the tiles do not fit the device's pages and the memory budget,
 //! the least important of the largest tiles drop a tier, so any number of lights fits. From
 //! frame to frame a light keeps its tier until its span moves clearly past the tier's bounds,
-//! and its tiles stay where they were while its tier does, so its maps need not be rendered
-//! again.
+//! and its tiles stay where they were while its tier does: only pages that take a moved tile
+//! are rendered again (pages are cleared whole), unless the free squares do not fit and the
+//! atlas is packed anew.
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::glam::UVec2;
@@ -27,8 +28,9 @@ pub const FULL_TIER_SPAN: f32 = 0.25;
 /// Tiers a light can want from its screen span (the budget may lower it further).
 pub const WANTED_TIERS: u32 = 4;
 /// A light keeps the tier it wanted last frame until its span moves this many halvings past
-/// the tier's bounds (a quarter: about 19 % larger or smaller), so a camera moving slowly does
-/// not make a light at a bound change tiers, and its maps re-render, every few frames.
+/// the tier's bounds (a quarter: about 19 % larger or 16 % smaller), so a camera moving
+/// slowly does not make a light at a bound change tiers, and its maps re-render, every few
+/// frames.
 pub const TIER_HYSTERESIS: f32 = 0.25;
 
 /// Where one layer's map lies in the atlas (`MapTile` in `shadow-maps/layers.wgsl`).
@@ -152,24 +154,25 @@ pub struct Allocation {
     pub tiles: Vec<MapTile>,
     /// Layers left without a tile.
     pub unfitted: u32,
-    /// Pages in use.
+    /// Pages in use: the highest page holding a tile, plus one (pages below it may be empty).
     pub pages: u32,
     /// Texels the tiles cover.
     pub texels: u64,
-    /// What it was made for: layers and wanted tier per light, and the atlas's limits (a
-    /// later allocation keeps its tiles only for the same layers and limits).
+    /// Per light: its layers (a later allocation keeps tiles only for the same layers).
     pub layers: Vec<u32>,
+    /// Per light: the tier it wanted (the next frame's hysteresis starts from it).
     pub wanted: Vec<u32>,
+    /// The limits it was made within (a later allocation keeps tiles only within the same).
     pub limits: AtlasLimits,
 }
 
 /// Tiles for lights with `layers[i]` layers each that want tier `wanted[i]`: the wanted
 /// tiers where they fit in `limits`, else the least important (largest wanted tier, then
 /// latest) of the largest tiles drop a tier until they do. With the `previous` frame's
-/// allocation for the same layers and limits, every light whose tier did not change keeps
-/// its tiles and the others take free squares around them ([`AtlasSpace`]); without one, or
-/// when those squares do not fit, tiles are packed largest first along a Z-order curve,
-/// which leaves no gaps between tiles whose sides halve.
+/// allocation for the same layers and limits (every layer fitted), every light whose tier
+/// did not change keeps its tiles and the others take free squares around them
+/// ([`AtlasSpace`]); without one, or when those squares do not fit, tiles are packed largest
+/// first along a Z-order curve, which leaves no gaps between tiles whose sides halve.
 pub fn allocate(
     layers: &[u32],
     wanted: &[u32],
@@ -178,7 +181,7 @@ pub fn allocate(
 ) -> Allocation {
     let tiers = tiers_within(layers, wanted, limits);
     let kept = previous
-        .filter(|p| p.layers == layers && p.limits == *limits)
+        .filter(|p| p.layers == layers && p.limits == *limits && p.unfitted == 0)
         .and_then(|p| place_around(p, layers, &tiers, limits))
         .map(|tiles| (tiles, 0));
     let (tiles, unfitted) = kept.unwrap_or_else(|| pack(layers, &tiers, limits));
@@ -522,7 +525,7 @@ mod tests {
         let wanted: Vec<u32> = (0..1024).map(|i| (i % 4) as u32).collect();
         let layers = [6; 1024];
         let before = allocate(&layers, &wanted, &l, None);
-        // Ten lights come closer: they want more, and the budget moves texels to them.
+        // Eleven lights come closer: they want more, and the budget moves texels to them.
         let mut closer = wanted.clone();
         for w in closer.iter_mut().skip(5).step_by(97) {
             *w = 0;

@@ -44,15 +44,15 @@ impl AtlasSpace {
     /// Marks `tile` (of tier `tier`) as used; false, changing nothing, when it is not an
     /// aligned square of that tier on a page of the atlas or overlaps a tile already placed.
     pub fn reserve(&mut self, tile: MapTile, tier: u32) -> bool {
+        if tier > self.limits.max_tier() {
+            return false;
+        }
         let size = self.limits.tile_size(tier);
         let aligned = tile.size == size
             && size > 0
-            && tier <= self.limits.max_tier()
             && tile.page < self.limits.max_pages
-            && tile
-                .origin
-                .iter()
-                .all(|&o| o % size == 0 && o + size <= self.limits.page_size);
+            && (tile.origin.iter())
+                .all(|&o| o.is_multiple_of(size) && o + size <= self.limits.page_size);
         if !aligned {
             return false;
         }

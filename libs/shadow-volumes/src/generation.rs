@@ -345,6 +345,7 @@ mod tests {
             constant("EDGE_FACE_COUNT_MASK"),
             Ok(i64::from(EdgeRecord::FACE_COUNT_MASK))
         );
+        assert_eq!(constant("WORKGROUP_SIZE"), Ok(i64::from(WORKGROUP_SIZE)));
         for entry in ["triangles", "edges_main"] {
             let size = zoo_host::gpu::layout::wgsl_workgroup_size(&source, entry);
             assert_eq!(size, Ok([WORKGROUP_SIZE, 1, 1]), "{entry}");
