@@ -188,21 +188,23 @@ impl LayerBlur {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+    use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror};
 
     #[test]
     fn blur_params_mirror_the_shader() {
-        let source = zoo_host::ShaderLibrary::embedded()
-            .compose("shadow-maps/blur.wgsl")
-            .unwrap()
-            .source;
-        let (size, fields) = zoo_host::mirror_fields!(BlurParams {
+        let mirror = zoo_host::mirror_fields!(BlurParams {
             tile,
             radius,
             sigma,
             vertical,
             _pad
         });
-        check_mirror(&source, "BlurParams", size, &fields, SizeRule::Equal).unwrap();
+        check_embedded_mirror(
+            "shadow-maps/blur.wgsl",
+            "BlurParams",
+            mirror,
+            SizeRule::Equal,
+        )
+        .unwrap();
     }
 }

@@ -295,21 +295,19 @@ impl DepthPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+    use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror};
 
     #[test]
     fn layer_cameras_mirror_the_shader() {
-        let source = zoo_host::ShaderLibrary::embedded()
-            .compose("shadow-maps/depth.wgsl")
-            .unwrap()
-            .source;
-        let (size, fields) = zoo_host::mirror_fields!(LayerCamera {
+        let mirror = zoo_host::mirror_fields!(LayerCamera {
             view_proj,
             eye,
             inv_view_proj,
             tile
         });
-        check_mirror(&source, "LayerCamera", size, &fields, SizeRule::Equal).unwrap();
+        let size = mirror.0;
+        let shader = "shadow-maps/depth.wgsl";
+        check_embedded_mirror(shader, "LayerCamera", mirror, SizeRule::Equal).unwrap();
         assert_eq!(CAMERA_STRIDE % 256, 0, "a dynamic-offset slot");
         assert!(size as u64 <= CAMERA_STRIDE);
     }

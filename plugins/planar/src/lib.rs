@@ -420,20 +420,16 @@ zoo_host::register_technique! {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror};
+    use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror};
 
     #[test]
     fn projection_mirrors_the_shader() {
-        let source = zoo_host::ShaderLibrary::embedded()
-            .compose("planar/planar.wgsl")
-            .unwrap()
-            .source;
-        let (size, fields) = zoo_host::mirror_fields!(Projection {
+        let mirror = zoo_host::mirror_fields!(Projection {
             shadow_matrix,
             plane,
             light,
             params
         });
-        check_mirror(&source, "Projection", size, &fields, SizeRule::Equal).unwrap();
+        check_embedded_mirror("planar/planar.wgsl", "Projection", mirror, SizeRule::Equal).unwrap();
     }
 }

@@ -113,6 +113,22 @@ pub enum SizeRule {
     AtLeast,
 }
 
+/// [`check_mirror`] against struct `name` of the built-in shader `shader` (a path under
+/// `shaders/`, imports resolved), with `mirror` as [`mirror_fields!`](crate::mirror_fields)
+/// gives it.
+pub fn check_embedded_mirror(
+    shader: &str,
+    name: &str,
+    mirror: (usize, Vec<(&str, usize)>),
+    rule: SizeRule,
+) -> Result<(), String> {
+    let composed = crate::ShaderLibrary::embedded()
+        .compose(shader)
+        .map_err(|e| format!("{shader}: {e}"))?;
+    let (size, fields) = mirror;
+    check_mirror(&composed.source, name, size, &fields, rule).map_err(|e| format!("{shader}: {e}"))
+}
+
 /// Compares the Rust layout (`size`, and `fields` as (WGSL member name, Rust offset)) with
 /// WGSL struct `name` in `source`: every member must be at the same offset, members starting
 /// with `_` (padding) may be left out, and the sizes must follow `rule`.
@@ -240,6 +256,29 @@ mod tests {
             transmittance
         });
         check_mirror(&source, "Object", size, &fields, SizeRule::Equal).unwrap();
+    }
+
+    #[test]
+    fn embedded_mirrors_name_the_shader_on_failure() {
+        let mirror = crate::mirror_fields!(GpuLight {
+            position,
+            kind,
+            direction
+        });
+        let missing = check_embedded_mirror("nowhere.wgsl", "GpuLight", mirror, SizeRule::Equal);
+        assert!(missing.unwrap_err().contains("nowhere.wgsl"));
+        let mirror = crate::mirror_fields!(GpuLight {
+            position,
+            kind,
+            direction
+        });
+        let drifted = check_embedded_mirror(
+            "common/frame.wgsl",
+            "CameraUniform",
+            mirror,
+            SizeRule::Equal,
+        );
+        assert!(drifted.unwrap_err().contains("common/frame.wgsl"));
     }
 
     #[test]

@@ -198,15 +198,11 @@ impl DebugViewPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::layout::{SizeRule, check_mirror};
+    use crate::gpu::layout::{SizeRule, check_embedded_mirror};
 
     #[test]
     fn view_params_mirror_the_shader() {
-        let source = ShaderLibrary::embedded()
-            .compose("host/debug_view.wgsl")
-            .unwrap()
-            .source;
-        let (size, fields) = crate::mirror_fields!(ViewParams {
+        let mirror = crate::mirror_fields!(ViewParams {
             mode,
             channel,
             min_value,
@@ -217,6 +213,12 @@ mod tests {
             slice_axis,
             slice_index
         });
-        check_mirror(&source, "ViewParams", size, &fields, SizeRule::Equal).unwrap();
+        check_embedded_mirror(
+            "host/debug_view.wgsl",
+            "ViewParams",
+            mirror,
+            SizeRule::Equal,
+        )
+        .unwrap();
     }
 }

@@ -130,19 +130,16 @@ impl ImageDifference {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::layout::{SizeRule, check_mirror};
+    use crate::gpu::layout::{SizeRule, check_embedded_mirror};
 
     #[test]
     fn params_mirror_the_shader() {
-        let source = ShaderLibrary::embedded()
-            .compose("host/difference.wgsl")
-            .unwrap()
-            .source;
-        let (size, fields) = crate::mirror_fields!(DifferenceParams {
+        let mirror = crate::mirror_fields!(DifferenceParams {
             gain,
             context,
             _pad
         });
-        check_mirror(&source, "DifferenceParams", size, &fields, SizeRule::Equal).unwrap();
+        let shader = "host/difference.wgsl";
+        check_embedded_mirror(shader, "DifferenceParams", mirror, SizeRule::Equal).unwrap();
     }
 }
