@@ -1,10 +1,10 @@
 // Debug views: one grid as a 3D image (the accumulated light's mean intensity per channel, the
-// occluders' mean blocking potential, or the emitters' mean normal), and the grid bounds on
-// screen.
+// occluders, or the emitters' mean normal), and the grid bounds on screen.
 
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
 #import "lpv/volume.wgsl"
+#import "lpv/blocking.wgsl"
 
 @group(2) @binding(0) var<storage, read> lpv: LpvData;
 @group(2) @binding(1) var<storage, read> accumulated: array<vec4<f32>>;
@@ -42,10 +42,17 @@ fn cs_volume(@builtin(global_invocation_id) id: vec3<u32>) {
             value = length(mean) * (0.5 + 0.5 * normalize(mean));
         }
     } else {
-        let total = cells_per_grid() * lpv.settings.cascade_count;
-        let light_view = f32(occluder_sums[cell * 4u]);
-        let camera_view = f32(occluder_sums[(total + cell) * 4u]);
-        value = vec3<f32>(SH_Y0 * max(light_view, camera_view) / lpv.settings.occluder_scale);
+        // Faces: the covered share of the cell's face box along x, y and z as red, green and
+        // blue; the geometry volume: its mean blocking potential, grey.
+        let c = vec3<i32>(id);
+        for (var s = 0u; s < view_count(); s++) {
+            let o = occluders(k, s, c);
+            if lpv.settings.params.occlusion == OCCLUSION_FACES {
+                value = max(value, o.xyz);
+            } else {
+                value = max(value, vec3<f32>(SH_Y0 * o.x));
+            }
+        }
     }
     textureStore(volume_out, vec3<i32>(id), vec4<f32>(value, 1.0));
 }

@@ -1,11 +1,11 @@
 // Injection (seed 002 §5.1, §5.2): every reflective-shadow-map texel is a virtual point light
 // whose clamped-cosine lobe of intensity goes into the cell it lies in, after moving half a
-// cell along its normal (so a surface does not light itself); its surfel's blocking potential
-// B(w) = A_s s^-2 <n_s, w>+ goes into the geometry volume, whose cells are centred on the
-// light grid's corners. The camera's G-buffer adds occluders the light does not see. Sums are
-// fixed point (integer atomics), resolved by `resolve.wgsl`.
+// cell along its normal (so a surface does not light itself); its surfel goes into the
+// occluders (`lpv/occluders.wgsl`). The camera's G-buffer adds occluders the light does not
+// see. Sums are fixed point (integer atomics), resolved by `resolve.wgsl`.
 
 #import "lpv/volume.wgsl"
+#import "lpv/occluders.wgsl"
 
 @group(0) @binding(0) var<storage, read> lpv: LpvData;
 @group(0) @binding(1) var rsm_flux: texture_2d_array<f32>;
@@ -31,28 +31,6 @@ fn add_sums(moment: bool, cell: u32, channel: u32, value: vec4<f32>) {
             atomicAdd(&moment_sums[base + k], scaled[k]);
         } else {
             atomicAdd(&light_sums[base + k], scaled[k]);
-        }
-    }
-}
-
-// Adds a surfel of area `area` and normal `n` at `p` to the occluders of `source`.
-fn add_occluder(source: u32, p: vec3<f32>, n: vec3<f32>, area: f32) {
-    let total = cells_per_grid() * lpv.settings.cascade_count;
-    for (var k = 0u; k < lpv.settings.cascade_count; k++) {
-        let g = lpv.cascades[k];
-        // Occluder cells are centred on light-cell corners: round, not floor.
-        let c = vec3<i32>(round((p - g.min) / g.cell));
-        if !inside_grid(c) {
-            continue;
-        }
-        let share = 1.0 / f32(max(lpv.settings.map_count, 1u));
-        let b = share * min(area / (g.cell * g.cell), 1.0) * sh_cosine_lobe(n);
-        let base = (source * total + cell_index(k, c)) * 4u;
-        let scaled = vec4<i32>(round(b * lpv.settings.occluder_scale));
-        for (var j = 0u; j < 4u; j++) {
-            if scaled[j] != 0 {
-                atomicAdd(&occluder_sums[base + j], scaled[j]);
-            }
         }
     }
 }
@@ -91,5 +69,7 @@ fn cs_inject(@builtin(global_invocation_id) id: vec3<u32>) {
             add_sums(true, cell, 2u, flux.b * moment);
         }
     }
-    add_occluder(0u, position.xyz, n, normal.w);
+    // Every map sees the same surfaces: their surfels count once between them.
+    let share = 1.0 / f32(max(lpv.settings.map_count, 1u));
+    add_occluder(0u, position.xyz, n, normal.w, share);
 }

@@ -3,7 +3,8 @@
 // the cell's cross-section (I / s^2), the irradiance on a surface with normal n is the SH
 // product with the clamped cosine lobe around -n (light flowing towards the surface). The
 // indirect target gets irradiance over pi. Lookups move `damping` cells along the normal, so a
-// surface does not read the light it injected itself.
+// surface does not read the light it injected itself; with `lookup_blocking` they also leave
+// out the light of cells behind occluders (`corner_reach`).
 //
 // Grids combine from the coarsest in. A grid of cell s after N steps holds light that travelled
 // up to N s. With `coarse_far_light`, the next finer grid (cell s/2, N steps) carries the light
@@ -15,12 +16,14 @@
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
 #import "lpv/volume.wgsl"
+#import "lpv/blocking.wgsl"
 
 @group(2) @binding(0) var<storage, read> lpv: LpvData;
 @group(2) @binding(1) var<storage, read> accumulated: array<vec4<f32>>;
 @group(2) @binding(2) var indirect_out: texture_storage_2d<rgba16float, write>;
 @group(2) @binding(3) var<storage, read> near: array<vec4<f32>>;
 @group(2) @binding(4) var<storage, read> moments: array<vec4<f32>>;
+@group(2) @binding(5) var<storage, read> occluder_sums: array<i32>;
 
 // Band 1 over band 0 of the two-band projection of a uniform hemisphere about its axis:
 // y1 pi / (y0 2 pi) = sqrt(3)/2, where the clamped-cosine lookup facing the axis is zero.
@@ -40,23 +43,66 @@ struct Sample {
     channels: array<Channel, 3>,
 }
 
-// Trilinear values of grid k at p, each cell read once (cells outside the grid count as
-// dark). `with_near` also reads the light after half the steps.
+// How much of the light of each of the eight cells around a lookup point reaches it, by
+// corner bits (x 1, y 2, z 4) from `base`: with `lookup_blocking` and occlusion, the best
+// product of transmittances over the face crossings from `home`, the corner whose cell holds
+// the lookup point, to it; otherwise 1. Unreached cells count as dark, not renormalised away:
+// measured, renormalising brightens receivers beside emitters more than it restores light
+// to receivers beside walls.
+fn corner_reach(k: u32, base: vec3<i32>, home: u32) -> array<f32, 8> {
+    var reach = array<f32, 8>(1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0);
+    if lpv.settings.params.lookup_blocking == 0u || lpv.settings.params.occlusion == OCCLUSION_OFF {
+        return reach;
+    }
+    // Corners one, two and three steps from home, each from its best neighbour a step nearer.
+    for (var steps = 1u; steps <= 3u; steps++) {
+        for (var corner = 0u; corner < 8u; corner++) {
+            let away = corner ^ home;
+            if countOneBits(away) != steps {
+                continue;
+            }
+            var best = 0.0;
+            for (var axis = 0u; axis < 3u; axis++) {
+                let bit = 1u << axis;
+                if (away & bit) == 0u {
+                    continue;
+                }
+                let nearer = corner ^ bit;
+                let to = base + corner_offset(corner);
+                let t = transmittance(k, to, to - base - corner_offset(nearer));
+                best = max(best, reach[nearer] * t);
+            }
+            reach[corner] = best;
+        }
+    }
+    return reach;
+}
+
+// The offset of corner `corner` (bits x 1, y 2, z 4) from the base cell.
+fn corner_offset(corner: u32) -> vec3<i32> {
+    return vec3<i32>(i32(corner & 1u), i32((corner >> 1u) & 1u), i32((corner >> 2u) & 1u));
+}
+
+// Trilinear values of grid k at lookup point p, each cell read once (cells outside the grid
+// count as dark) and weighted by how much of its light reaches p (`corner_reach`).
+// `with_near` also reads the light after half the steps.
 fn sample_grid(k: u32, p: vec3<f32>, with_near: bool) -> Sample {
     let g = lpv.cascades[k];
     let u = (p - g.min) / g.cell - vec3<f32>(0.5);
     let base = vec3<i32>(floor(u));
     let f = u - floor(u);
+    let home = u32(f.x >= 0.5) | (u32(f.y >= 0.5) << 1u) | (u32(f.z >= 0.5) << 2u);
+    let reach = corner_reach(k, base, home);
     let oriented = lpv.settings.params.emitter_orientation != 0u;
     var out: Sample;
     for (var corner = 0u; corner < 8u; corner++) {
-        let o = vec3<i32>(i32(corner & 1u), i32((corner >> 1u) & 1u), i32((corner >> 2u) & 1u));
+        let o = corner_offset(corner);
         let c = base + o;
-        if !inside_grid(c) {
+        let w = mix(1.0 - f.x, f.x, f32(o.x)) * mix(1.0 - f.y, f.y, f32(o.y))
+            * mix(1.0 - f.z, f.z, f32(o.z)) * reach[corner];
+        if !inside_grid(c) || w == 0.0 {
             continue;
         }
-        let w = mix(1.0 - f.x, f.x, f32(o.x)) * mix(1.0 - f.y, f.y, f32(o.y))
-            * mix(1.0 - f.z, f.z, f32(o.z));
         let i = cell_index(k, c) * 3u;
         for (var ch = 0u; ch < 3u; ch++) {
             out.channels[ch].light += w * accumulated[i + ch];

@@ -370,10 +370,17 @@ fn compare_writes_the_indirect_light_it_scores() {
     let all = text(&out);
     assert!(out.status.success(), "{all}");
     let csv = std::fs::read_to_string(out_dir.join("indirect.csv")).unwrap();
+    let header = "scene,technique,view,indirect_rmse,leak,unlit_share";
+    assert_eq!(csv.lines().next(), Some(header), "{csv}");
     let row = csv.lines().nth(1).expect("a row for lpv");
     let fields: Vec<&str> = row.split(',').collect();
     assert_eq!(fields[..3], ["atrium", "lpv", "0"], "{csv}");
     let scored: f64 = fields[3].parse().unwrap();
+    let (leak, unlit): (f64, f64) = (fields[4].parse().unwrap(), fields[5].parse().unwrap());
+    assert!(
+        leak >= 0.0 && leak.is_finite() && (0.0..=1.0).contains(&unlit),
+        "{csv}"
+    );
     // The written values give back the score (Radiance HDR keeps about 1 % per value).
     let read = |name: &str| {
         let image = image::open(out_dir.join(name)).unwrap().into_rgb32f();

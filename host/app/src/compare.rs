@@ -10,7 +10,7 @@ use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use zoo_host::judge::Metrics;
 use zoo_host::judging::perceptual::{FlipScore, score_image};
-use zoo_host::judging::{Judged, LightScore, SceneReference, error_map, judge_technique};
+use zoo_host::judging::{Judged, Leak, LightScore, SceneReference, error_map, judge_technique};
 use zoo_host::params::{self, ParamValues};
 use zoo_host::scene::paths;
 use zoo_host::{Renderer, Scene, TechniqueRegistration};
@@ -35,8 +35,18 @@ pub struct JudgedView {
     /// FLIP of each judged technique's final image against the reference image, in the order
     /// of `judged`.
     pub flip: Vec<Option<FlipScore>>,
-    /// (technique, relative RMSE) of the techniques that add light.
-    pub indirect: Vec<(String, f64)>,
+    /// The indirect-light scores of the techniques that add light.
+    pub indirect: Vec<IndirectScore>,
+}
+
+/// One technique's indirect light judged against the one-bounce reference.
+#[derive(Debug, Clone)]
+pub struct IndirectScore {
+    pub technique: String,
+    /// Relative RMSE over the pixels with a surface.
+    pub rmse: f64,
+    /// Its light on surfaces no directly lit surface sees.
+    pub leak: Leak,
 }
 
 /// The times of `views` views spread evenly over the scene's paths, both ends included; one
@@ -232,8 +242,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             println!("view {} (time {:.2}):", v.view, v.time.unwrap_or(0.0));
         }
         print!("{}", summary_table(v));
-        for (technique, rmse) in &v.indirect {
-            println!("  {technique:16} indirect_rmse {rmse:.4}");
+        for score in &v.indirect {
+            println!(
+                "  {:16} indirect_rmse {:.4} leak {:.4} (unlit {:.3} of pixels)",
+                score.technique, score.rmse, score.leak.leak, score.leak.unlit_share
+            );
         }
     }
     println!(
@@ -548,20 +561,21 @@ fn summary_table(view: &JudgedView) -> String {
 /// Scores the indirect light of the techniques that add light in `view` against the
 /// one-bounce reference (traced once per view, with the area samples per pixel), writes an
 /// error map and the indirect light (`.hdr`) per technique and the reference's, and returns
-/// (technique, relative RMSE).
+/// their scores (relative RMSE and leak).
 fn judge_indirect(
     view: &mut JudgedView,
     renderer: &Renderer,
     args: &CompareArgs,
     several: bool,
-) -> anyhow::Result<Vec<(String, f64)>> {
+) -> anyhow::Result<Vec<IndirectScore>> {
     let mut scores = Vec::new();
     let (scene, lights) = (renderer.scene(), renderer.lights());
     let reference = &mut view.reference;
     for j in &view.judged {
-        let (Some(estimate), Some(rmse)) = (
+        let (Some(estimate), Some(rmse), Some(leak)) = (
             &j.indirect,
             j.indirect_rmse(reference, scene, lights, args.samples),
+            j.indirect_leak(reference, scene, lights, args.samples),
         ) else {
             continue;
         };
@@ -582,20 +596,29 @@ fn judge_indirect(
             let path = output_name("reference", view.view, several, "indirect.hdr");
             save_radiance(&args.out.join(path), expected, width)?;
         }
-        scores.push((j.technique.clone(), rmse));
+        scores.push(IndirectScore {
+            technique: j.technique.clone(),
+            rmse,
+            leak,
+        });
     }
     Ok(scores)
 }
 
-/// `indirect.csv`: the relative RMSE of each technique that adds light, per view (`None` when
-/// no technique adds light).
+/// `indirect.csv`: the relative RMSE and the leak of each technique that adds light, per view
+/// (`None` when no technique adds light).
 fn indirect_csv(scene: &str, views: &[JudgedView]) -> Option<String> {
-    let mut csv = String::from("scene,technique,view,indirect_rmse\n");
+    let mut csv = String::from("scene,technique,view,indirect_rmse,leak,unlit_share\n");
     let mut any = false;
     for v in views {
-        for (technique, rmse) in &v.indirect {
+        for score in &v.indirect {
             any = true;
-            writeln!(csv, "{scene},{technique},{},{rmse:.6}", v.view).expect("write to string");
+            writeln!(
+                csv,
+                "{scene},{},{},{:.6},{:.6},{:.6}",
+                score.technique, v.view, score.rmse, score.leak.leak, score.leak.unlit_share
+            )
+            .expect("write to string");
         }
     }
     any.then_some(csv)
@@ -790,13 +813,17 @@ fn report_md(r: &ReportInputs<'_>) -> String {
     if r.views.iter().any(|v| !v.indirect.is_empty()) {
         let _ = writeln!(
             w,
-            "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more); the values themselves in `reference-indirect.hdr` and `<technique>-indirect.hdr` (linear Radiance HDR).\n"
+            "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more); the values themselves in `reference-indirect.hdr` and `<technique>-indirect.hdr` (linear Radiance HDR). Leak: the technique's mean indirect light on the surfaces that no directly lit surface sees (the reference is exactly 0 there: no cosine ray found light, and none of the points traced as lit from every light is in view), as a fraction of the reference's mean over every surface; `unlit` is those surfaces' share of the pixels.\n"
         );
-        let _ = writeln!(w, "| technique | view | indirect_rmse |");
-        let _ = writeln!(w, "|---|---|---|");
+        let _ = writeln!(w, "| technique | view | indirect_rmse | leak | unlit |");
+        let _ = writeln!(w, "|---|---|---|---|---|");
         for v in r.views {
-            for (technique, rmse) in &v.indirect {
-                let _ = writeln!(w, "| {technique} | {} | {rmse:.4} |", v.view);
+            for score in &v.indirect {
+                let _ = writeln!(
+                    w,
+                    "| {} | {} | {:.4} | {:.4} | {:.3} |",
+                    score.technique, v.view, score.rmse, score.leak.leak, score.leak.unlit_share
+                );
             }
         }
     }

@@ -23,6 +23,8 @@ pub struct Reflectors {
     surfaces: Surfaces,
     /// Per triangle: albedo.
     albedo: Vec<Vec3>,
+    /// The corners' least and greatest coordinates.
+    bounds: (Vec3, Vec3),
 }
 
 /// Where a ray meets a reflector.
@@ -49,9 +51,24 @@ impl Reflectors {
 
     /// Reflectors from world-space triangles and their albedo.
     pub fn from_triangles(triangles: &[([Vec3; 3], Vec3)]) -> Reflectors {
+        let bounds = triangles.iter().flat_map(|(t, _)| t).fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
         Reflectors {
             surfaces: Surfaces::from_triangles(triangles.iter().map(|(t, _)| *t).collect()),
             albedo: triangles.iter().map(|(_, albedo)| *albedo).collect(),
+            bounds,
+        }
+    }
+
+    /// The least and greatest coordinates of every reflector (both the origin when there
+    /// are none).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        if self.albedo.is_empty() {
+            (Vec3::ZERO, Vec3::ZERO)
+        } else {
+            self.bounds
         }
     }
 

@@ -11,6 +11,7 @@
 
 mod bvh;
 mod indirect;
+mod leak;
 mod metrics;
 mod occluders;
 mod reference;
@@ -19,6 +20,7 @@ mod sampling;
 mod surfaces;
 
 pub use indirect::{ReflectorHit, Reflectors, one_bounce, reflected_direct, relative_rmse};
+pub use leak::{leak, lit_points, unlit_by_one_bounce};
 pub use metrics::{ErrorClass, Metrics, edge_band, error_class, percentile};
 pub use occluders::Occluders;
 pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, reference_visibility};

@@ -37,6 +37,15 @@ zoo_host::param_choice! {
     pub enum SliceAxis { X, Y, Z }
 }
 
+zoo_host::param_choice! {
+    /// What stops light crossing from a cell into the next: nothing; the published geometry
+    /// volume (the surfels' blocking potential as two-band SH on the cells' corners, which
+    /// stops at most 0.75 of light head-on, less at an angle); or the surfels' area projected
+    /// across each face box between two cell centres, which a wall through the box covers
+    /// whole, from either side.
+    pub enum Occlusion { Off, GeometryVolume, Faces }
+}
+
 zoo_host::technique_params! {
     /// Parameters of cascaded light propagation volumes.
     pub struct LpvParams {
@@ -48,10 +57,19 @@ zoo_host::technique_params! {
         iterations: u32 = 8, range(0, 64), step(1);
         /// Reflective-shadow-map resolution: its texels are the virtual point lights.
         rsm_size: u32 = 256, range(64, 1024), step(64);
-        /// Block propagation with the geometry volume.
-        occlusion: bool = true, flags(shader);
-        /// Add the camera's G-buffer surfels to the geometry volume.
+        /// What stops light crossing from a cell into the next.
+        occlusion: Occlusion = Occlusion::GeometryVolume, flags(shader);
+        /// Add the camera's G-buffer surfels to the occluders.
         camera_occluders: bool = true, flags(shader);
+        /// Occluders block this many times their covered share of a face (Faces) or their
+        /// blocking potential (GeometryVolume), up to all of it: above 1, sparse surfels, walls
+        /// ending inside a cell and the seams where walls meet block whole instead of letting
+        /// light through, at the cost of blocking light that passes beside them.
+        coverage_gain: f32 = 1.0, range(1.0, 16.0), step(0.5), flags(shader);
+        /// With occlusion, each of the eight cells a lookup interpolates counts by the
+        /// transmittance on the best path of face crossings to it from the cell holding the
+        /// lookup point (the light of a cell across a wall stays there).
+        lookup_blocking: bool = false, flags(shader);
         /// Lookups move this fraction of a cell along the normal (against self-bleeding).
         damping: f32 = 0.4, range(0.0, 1.0), step(0.05), flags(shader);
         /// Multiplies the indirect light.
@@ -407,7 +425,7 @@ impl ShadowTechnique for Lpv {
             drop(recorder.compute_pass(gpu::INJECT_PASS));
         }
         let screen = [ctx.size.x, ctx.size.y, 1];
-        if p.occlusion && p.camera_occluders {
+        if p.occlusion != Occlusion::Off && p.camera_occluders {
             s.camera_occluders.dispatch(
                 ctx,
                 recorder,
@@ -667,6 +685,7 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> TechniqueResult<Groups> {
                 ("indirect_out", view(&ctx.indirect.view)),
                 ("near", buffer(&v.near)),
                 ("moments", buffer(&v.moments[0])),
+                ("occluder_sums", buffer(&v.occluder_sums)),
             ],
         )?,
         debug_volume: s.debug_volume.bind(

@@ -11,7 +11,8 @@ use image::{Rgba, RgbaImage};
 use rayon::prelude::*;
 use zoo_judge::{
     DEFAULT_AREA_SAMPLES, ErrorClass, LightReference, Metrics, Occluders, Reflectors, SurfacePoint,
-    Surfaces, error_class, one_bounce, reference_visibility, relative_rmse,
+    Surfaces, error_class, leak, lit_points, one_bounce, reference_visibility, relative_rmse,
+    unlit_by_one_bounce,
 };
 
 use crate::gpu::{FrameTimings, PassOwner};
@@ -32,6 +33,19 @@ pub struct SceneReference {
     /// The one-bounce indirect reference per pixel, once [`Self::indirect`] computed it, with
     /// the samples and lights it was traced for.
     indirect: Option<(u32, Vec<Light>, Vec<glam::Vec3>)>,
+    /// The pixels no directly lit surface sees, once [`Self::unlit`] found them, for the
+    /// indirect reference they were found with.
+    unlit: Option<(u32, Vec<Light>, Vec<bool>)>,
+}
+
+/// How much indirect light a technique leaks onto surfaces no directly lit surface sees.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Leak {
+    /// Its mean indirect light on those pixels as a fraction of the reference's mean over every
+    /// surface pixel (0 where no pixel is unlit).
+    pub leak: f64,
+    /// The share of surface pixels that no directly lit surface sees.
+    pub unlit_share: f64,
 }
 
 impl SceneReference {
@@ -64,6 +78,7 @@ impl SceneReference {
             occluder_triangles: occluders.len(),
             seconds: start.elapsed().as_secs_f64(),
             indirect: None,
+            unlit: None,
         })
     }
 
@@ -86,6 +101,28 @@ impl SceneReference {
             self.indirect = Some((samples, lights.to_vec(), traced));
         }
         &self.indirect.as_ref().expect("computed above").2
+    }
+
+    /// The pixels whose surface no directly lit surface sees (their one-bounce light is 0):
+    /// the reference is 0 there and none of the points traced as lit from every light is in
+    /// view. Found when first asked for with these samples and lights.
+    pub fn unlit(&mut self, scene: &Scene, lights: &[Light], samples: u32) -> &[bool] {
+        let current = self
+            .unlit
+            .as_ref()
+            .is_some_and(|(s, l, _)| *s == samples && l.as_slice() == lights);
+        if !current {
+            let reference = self.indirect(scene, lights, samples).to_vec();
+            let start = Instant::now();
+            let occluders = Occluders::new(scene);
+            let reflectors = Reflectors::new(scene);
+            let points = surface_points(&self.gbuffer, &Surfaces::new(scene));
+            let lit = lit_points(&occluders, &reflectors, lights);
+            let unlit = unlit_by_one_bounce(&reflectors, &lit, &points, &reference);
+            self.seconds += start.elapsed().as_secs_f64();
+            self.unlit = Some((samples, lights.to_vec(), unlit));
+        }
+        &self.unlit.as_ref().expect("computed above").2
     }
 
     /// The pixels with a surface.
@@ -157,6 +194,27 @@ impl Judged {
         let mask = reference.surface_mask();
         let expected = reference.indirect(scene, lights, samples);
         Some(relative_rmse(expected, estimate, &mask))
+    }
+
+    /// Its indirect light on the surfaces no directly lit surface sees ([`Leak`]; `None` for
+    /// techniques that add no light). Traces the reference and finds those surfaces on first
+    /// use.
+    pub fn indirect_leak(
+        &self,
+        reference: &mut SceneReference,
+        scene: &Scene,
+        lights: &[Light],
+        samples: u32,
+    ) -> Option<Leak> {
+        let estimate = self.indirect.as_ref()?;
+        let mask = reference.surface_mask();
+        let unlit = reference.unlit(scene, lights, samples).to_vec();
+        let expected = reference.indirect(scene, lights, samples);
+        let surfaces = mask.iter().filter(|m| **m).count().max(1);
+        Some(Leak {
+            leak: leak(expected, estimate, &mask, &unlit),
+            unlit_share: unlit.iter().filter(|u| **u).count() as f64 / surfaces as f64,
+        })
     }
 }
 
