@@ -33,8 +33,10 @@ fn face_transmittance(k: u32, a: vec3<i32>, b: vec3<i32>) -> f32 {
     }
     let axis = select(select(2u, 1u, a.y != b.y), 0u, a.x != b.x);
     var covered = 0.0;
+    let total = cells_per_grid() * lpv.settings.cascade_count;
     for (var s = 0u; s < view_count(); s++) {
-        covered = max(covered, occluders(k, s, lower)[axis]);
+        let entry = (s * total + cell_index(k, lower)) * 4u + axis;
+        covered = max(covered, f32(occluder_sums[entry]) / lpv.settings.occluder_scale);
     }
     return 1.0 - clamp(lpv.settings.params.coverage_gain * covered, 0.0, 1.0);
 }

@@ -3,8 +3,8 @@
 // the cell's cross-section (I / s^2), the irradiance on a surface with normal n is the SH
 // product with the clamped cosine lobe around -n (light flowing towards the surface). The
 // indirect target gets irradiance over pi. Lookups move `damping` cells along the normal, so a
-// surface does not read the light it injected itself; with `lookup_blocking` they also leave
-// out the light of cells behind occluders (`corner_reach`).
+// surface does not read the light it injected itself; with `lookup_blocking` each cell's light
+// counts by the occluders' transmittance between it and the lookup point (`corner_reach`).
 //
 // Grids combine from the coarsest in. A grid of cell s after N steps holds light that travelled
 // up to N s. With `coarse_far_light`, the next finer grid (cell s/2, N steps) carries the light
@@ -67,9 +67,10 @@ fn corner_reach(k: u32, base: vec3<i32>, home: u32) -> array<f32, 8> {
                 if (away & bit) == 0u {
                     continue;
                 }
+                // The corner's light flows from its cell into the nearer one.
                 let nearer = corner ^ bit;
-                let to = base + corner_offset(corner);
-                let t = transmittance(k, to, to - base - corner_offset(nearer));
+                let into = base + corner_offset(nearer);
+                let t = transmittance(k, into, into - base - corner_offset(corner));
                 best = max(best, reach[nearer] * t);
             }
             reach[corner] = best;

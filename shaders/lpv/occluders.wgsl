@@ -6,7 +6,8 @@
 // grid's corners. With Faces, k < 3 is an axis: the surfels' area projected across that axis
 // over the face box of the cell, the box between its centre and the next cell's centre along
 // the axis, as a fraction of a cell face (so a wall through the box covers it whole, whichever
-// side the surfels were seen from).
+// side the surfels were seen from, when every reflective shadow map sees it: each map's
+// surfels count 1 / map count).
 
 // Adds a surfel of area `area` and unit normal `n` at `p` to the occluders of `source` in
 // every grid, weighted by `share`.

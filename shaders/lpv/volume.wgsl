@@ -9,8 +9,8 @@ const MAX_CASCADES: u32 = 4u;
 
 struct LpvSettings {
     // The plugin's parameters the shaders read (generated from their declaration: grid size,
-    // occlusion and camera occluders, damping, intensity, blend cells, coarse far light,
-    // emitter orientation and its cells, skipping dark cells).
+    // occlusion, camera occluders, coverage gain and lookup blocking, damping, intensity, blend
+    // cells, coarse far light, emitter orientation and its cells, skipping dark cells).
     params: LpvParams,
     cascade_count: u32,
     // Fixed-point scales of the injection sums (integer units per unit).

@@ -403,6 +403,47 @@ fn compare_writes_the_indirect_light_it_scores() {
 }
 
 #[test]
+fn compare_reports_light_through_walls_as_leak() {
+    // The east room of `doorway-rooms` sees the lit west room only through its doorway; with
+    // no occlusion the volumes carry the sunlit roof's and the west room's light through the
+    // 0.2 m walls onto it.
+    let out_dir = temp_dir("compare-leak").join("results");
+    let out = shadow_zoo(&[
+        "compare",
+        "--scene",
+        "scenes/doorway-rooms.ron",
+        "--techniques",
+        "lpv",
+        "--set",
+        "lpv.occlusion=Off",
+        "--size",
+        "64x48",
+        "--samples",
+        "16",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let csv = std::fs::read_to_string(out_dir.join("indirect.csv")).unwrap();
+    let fields: Vec<&str> = csv
+        .lines()
+        .nth(1)
+        .expect("a row for lpv")
+        .split(',')
+        .collect();
+    let (leak, unlit): (f64, f64) = (fields[4].parse().unwrap(), fields[5].parse().unwrap());
+    // Measured at 160x120: unlit 0.80 of the pixels, leak 63 (the unlit pixels get far more
+    // light than the reference's mean).
+    assert!(unlit > 0.5, "{csv}");
+    assert!(leak > 1.0, "{csv}");
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(
+        report.contains("| technique | view | indirect_rmse | leak | unlit |"),
+        "{report}"
+    );
+}
+
+#[test]
 fn compare_rejects_bad_input_clearly() {
     let dir = temp_dir("compare-bad");
     let no_lights = dir.join("dark.ron");

@@ -42,6 +42,7 @@ pub struct JudgedView {
 /// One technique's indirect light judged against the one-bounce reference.
 #[derive(Debug, Clone)]
 pub struct IndirectScore {
+    /// The technique's id.
     pub technique: String,
     /// Relative RMSE over the pixels with a surface.
     pub rmse: f64,

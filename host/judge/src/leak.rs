@@ -64,7 +64,7 @@ pub fn lit_points(
 fn light_ray(light: &Light, centre: Vec3, radius: f32, a: Vec2, b: Vec2) -> (Vec3, Vec3) {
     match light.kind {
         LightKind::Directional => {
-            let d = light.direction.normalize();
+            let d = light.direction.normalize_or(Vec3::NEG_Y);
             let (u, v) = basis(d);
             let across = (u * a.x + v * a.y) * radius;
             (centre - d * (2.0 * radius) + across, d)
@@ -80,7 +80,7 @@ fn light_ray(light: &Light, centre: Vec3, radius: f32, a: Vec2, b: Vec2) -> (Vec
             let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
             let azimuth = a.y.atan2(a.x);
             let axis = match light.kind {
-                LightKind::Spot => light.direction.normalize(),
+                LightKind::Spot => light.direction.normalize_or(Vec3::NEG_Y),
                 _ => Vec3::Y,
             };
             let (u, v) = basis(axis);

@@ -232,7 +232,7 @@ impl RsmTargets {
 pub const RSM_PASS: &str = "LPV RSM";
 /// The injection of virtual point lights and their surfels.
 pub const INJECT_PASS: &str = "LPV injection";
-/// The injection of the camera's surfels into the geometry volume.
+/// The injection of the camera's surfels into the occluders.
 pub const CAMERA_OCCLUDERS_PASS: &str = "LPV camera occluders";
 /// The pass that turns the fixed-point sums into the first step.
 pub const RESOLVE_PASS: &str = "LPV resolve";

@@ -42,7 +42,7 @@ zoo_host::param_choice! {
     /// volume (the surfels' blocking potential as two-band SH on the cells' corners, which
     /// stops at most 0.75 of light head-on, less at an angle); or the surfels' area projected
     /// across each face box between two cell centres, which a wall through the box covers
-    /// whole, from either side.
+    /// whole, from either side (when every light's map sees it: each map counts 1 / maps).
     pub enum Occlusion { Off, GeometryVolume, Faces }
 }
 

@@ -36,13 +36,24 @@ pub struct SceneReference {
     /// The pixels no directly lit surface sees, once [`Self::unlit`] found them, for the
     /// indirect reference they were found with.
     unlit: Option<(u32, Vec<Light>, Vec<bool>)>,
+    /// What the indirect reference and the unlit pixels trace, built once for both.
+    bounce: Option<BounceScene>,
+}
+
+/// The scene as the one-bounce reference traces it: every caster, every reflecting surface
+/// and this view's pixel surfaces.
+struct BounceScene {
+    occluders: Occluders,
+    reflectors: Reflectors,
+    points: Vec<Option<SurfacePoint>>,
 }
 
 /// How much indirect light a technique leaks onto surfaces no directly lit surface sees.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Leak {
     /// Its mean indirect light on those pixels as a fraction of the reference's mean over every
-    /// surface pixel (0 where no pixel is unlit).
+    /// surface pixel (0 where no pixel is unlit or it adds nothing there; infinite where the
+    /// reference is black everywhere and it adds light on them).
     pub leak: f64,
     /// The share of surface pixels that no directly lit surface sees.
     pub unlit_share: f64,
@@ -79,6 +90,7 @@ impl SceneReference {
             seconds: start.elapsed().as_secs_f64(),
             indirect: None,
             unlit: None,
+            bounce: None,
         })
     }
 
@@ -93,10 +105,8 @@ impl SceneReference {
             .is_some_and(|(s, l, _)| *s == samples && l.as_slice() == lights);
         if !current {
             let start = Instant::now();
-            let occluders = Occluders::new(scene);
-            let reflectors = Reflectors::new(scene);
-            let points = surface_points(&self.gbuffer, &Surfaces::new(scene));
-            let traced = one_bounce(&occluders, &reflectors, lights, &points, samples);
+            let b = self.bounce_scene(scene);
+            let traced = one_bounce(&b.occluders, &b.reflectors, lights, &b.points, samples);
             self.seconds += start.elapsed().as_secs_f64();
             self.indirect = Some((samples, lights.to_vec(), traced));
         }
@@ -114,15 +124,24 @@ impl SceneReference {
         if !current {
             let reference = self.indirect(scene, lights, samples).to_vec();
             let start = Instant::now();
-            let occluders = Occluders::new(scene);
-            let reflectors = Reflectors::new(scene);
-            let points = surface_points(&self.gbuffer, &Surfaces::new(scene));
-            let lit = lit_points(&occluders, &reflectors, lights);
-            let unlit = unlit_by_one_bounce(&reflectors, &lit, &points, &reference);
+            let b = self.bounce_scene(scene);
+            let lit = lit_points(&b.occluders, &b.reflectors, lights);
+            let unlit = unlit_by_one_bounce(&b.reflectors, &lit, &b.points, &reference);
             self.seconds += start.elapsed().as_secs_f64();
             self.unlit = Some((samples, lights.to_vec(), unlit));
         }
         &self.unlit.as_ref().expect("computed above").2
+    }
+
+    /// The scene as the one-bounce reference traces it, built on first use (a reference
+    /// belongs to one scene: its G-buffer's).
+    fn bounce_scene(&mut self, scene: &Scene) -> &BounceScene {
+        let gbuffer = &self.gbuffer;
+        self.bounce.get_or_insert_with(|| BounceScene {
+            occluders: Occluders::new(scene),
+            reflectors: Reflectors::new(scene),
+            points: surface_points(gbuffer, &Surfaces::new(scene)),
+        })
     }
 
     /// The pixels with a surface.

@@ -1,6 +1,7 @@
 //! The reference judge's integration tests in one test binary: closed-form shadows
-//! (`analytic`), the one-bounce reference (`indirect`), the leak measure's unlit surfaces (`leak`), ray origins at any scale (`origins`)
-//! and whole scenes rendered at any scale (`scale`, on the GPU).
+//! (`analytic`), the one-bounce reference (`indirect`), the leak measure's unlit surfaces
+//! (`leak`), ray origins at any scale (`origins`) and whole scenes rendered at any scale
+//! (`scale`, on the GPU).
 
 mod analytic;
 mod indirect;
