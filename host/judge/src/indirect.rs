@@ -113,7 +113,7 @@ pub fn reflected_direct(
 }
 
 /// Unit vectors perpendicular to `w` and to each other.
-fn basis(w: Vec3) -> (Vec3, Vec3) {
+pub(crate) fn basis(w: Vec3) -> (Vec3, Vec3) {
     let helper = if w.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
     let u = w.cross(helper).normalize();
     (u, w.cross(u))

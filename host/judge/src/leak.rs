@@ -12,7 +12,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use zoo_scene::{Light, LightKind};
 
-use crate::indirect::{Reflectors, reflected_direct};
+use crate::indirect::{Reflectors, basis, reflected_direct};
 use crate::occluders::Occluders;
 use crate::sampling::stratified_disk;
 use crate::surfaces::SurfacePoint;
@@ -89,13 +89,6 @@ fn light_ray(light: &Light, centre: Vec3, radius: f32, a: Vec2, b: Vec2) -> (Vec
             (light.position, direction.normalize())
         }
     }
-}
-
-/// Unit vectors perpendicular to unit `w` and to each other.
-fn basis(w: Vec3) -> (Vec3, Vec3) {
-    let helper = if w.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
-    let u = w.cross(helper).normalize();
-    (u, w.cross(u))
 }
 
 /// Per point: whether no directly lit surface sees it, that is its one-bounce `reference` is
