@@ -22,18 +22,26 @@ struct BlurParams {
 @group(0) @binding(0) var source: texture_2d_array<f32>;
 @group(1) @binding(0) var<uniform> params: BlurParams;
 
+// The kernel's weights exp(-k² / 2σ²) come incrementally (each is the previous one times a
+// ratio that itself shrinks by exp(-1 / σ²)), two exponentials a texel instead of one a tap,
+// and each weight serves both taps at its distance.
 @fragment
 fn fs_blur(in: FullscreenOut) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(in.position.xy);
     let step = select(vec2<i32>(1, 0), vec2<i32>(0, 1), params.vertical == 1u);
-    let r = i32(params.radius);
-    var sum = vec4<f32>(0.0);
-    var weights = 0.0;
-    for (var k = -r; k <= r; k++) {
-        let w = exp(-0.5 * f32(k * k) / (params.sigma * params.sigma));
-        let texel = clamp_to_tile(params.tile, pixel + step * k);
-        sum += w * textureLoad(source, texel, params.tile.page, 0);
-        weights += w;
+    let inverse_variance = 1.0 / (params.sigma * params.sigma);
+    var sum = textureLoad(source, clamp_to_tile(params.tile, pixel), params.tile.page, 0);
+    var weights = 1.0;
+    var w = 1.0;
+    var ratio = exp(-0.5 * inverse_variance);
+    let ratio_step = exp(-inverse_variance);
+    for (var k = 1; k <= i32(params.radius); k++) {
+        w *= ratio;
+        ratio *= ratio_step;
+        let ahead = textureLoad(source, clamp_to_tile(params.tile, pixel + step * k), params.tile.page, 0);
+        let behind = textureLoad(source, clamp_to_tile(params.tile, pixel - step * k), params.tile.page, 0);
+        sum += w * (ahead + behind);
+        weights += 2.0 * w;
     }
     return sum / weights;
 }

@@ -511,7 +511,17 @@ fn render_without_a_technique_writes_the_contact_sheet_and_its_table() {
     let dir = std::env::temp_dir().join(format!("zoo-cli-sheet-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let png = dir.join("sheet.png");
-    let out = shadow_zoo(&["render", "--size", "96x64", "--out", png.to_str().unwrap()]);
+    // One sun, so each technique renders one map (the default scene's sheet, rendered and
+    // judged in-process, is `contact_sheet`'s).
+    let out = shadow_zoo(&[
+        "render",
+        "--scene",
+        "scenes/skylight-room.ron",
+        "--size",
+        "96x64",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
     let all = text(&out);
     assert!(out.status.success(), "{all}");
     assert!(

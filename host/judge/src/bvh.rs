@@ -195,9 +195,22 @@ impl TriangleBvh {
 
     /// Whether `query` hits any triangle.
     pub(crate) fn any_hit(&self, query: &Query) -> bool {
+        self.any_hit_where(query, |_, _| true)
+    }
+
+    /// Whether `query` hits a triangle that `blocks(input index, distance)` accepts (masked
+    /// casters pass rays through their holes).
+    pub(crate) fn any_hit_where(
+        &self,
+        query: &Query,
+        mut blocks: impl FnMut(usize, f32) -> bool,
+    ) -> bool {
         let mut hit = false;
         self.traverse(query, |mut range, ray| {
-            hit = range.any(|i| self.triangles[i].intersect(ray) < f32::INFINITY);
+            hit = range.any(|i| {
+                let t = self.triangles[i].intersect(ray);
+                t < f32::INFINITY && blocks(self.sources[i], t)
+            });
             if hit { Visit::Stop } else { Visit::Continue }
         });
         hit

@@ -1,7 +1,7 @@
 //! Shadow-casting triangles, queried with occlusion rays.
 
-use glam::Vec3;
-use zoo_scene::Scene;
+use glam::{Vec2, Vec3};
+use zoo_scene::{AlphaMask, Scene, Textures};
 
 use crate::bvh::{Query, TriangleBvh};
 
@@ -14,15 +14,42 @@ struct TranslucentCasters {
     transmittance: Vec<Vec3>,
 }
 
-/// The occluding geometry of a scene: opaque casters, which block shadow rays, and
-/// translucent ones, each of which filters a ray that crosses it once by its transmittance
-/// colour (however many of its surfaces the ray crosses).
+/// Alpha-tested casters: their triangles with texture coordinates and each one's mask.
+struct MaskedCasters {
+    bvh: TriangleBvh,
+    /// Per input triangle: its corners, their texture coordinates and its mask.
+    triangles: Vec<([Vec3; 3], [Vec2; 3], AlphaMask)>,
+    textures: Textures,
+}
+
+impl MaskedCasters {
+    /// Whether the hit `t` along the ray on triangle `index` lands on the mask's coverage
+    /// (alpha at or above the cutoff), read where the hit point's barycentric coordinates put
+    /// it in the texture.
+    fn blocks(&self, index: usize, origin: Vec3, direction: Vec3, t: f32) -> bool {
+        let ([a, b, c], [ua, ub, uc], mask) = self.triangles[index];
+        let p = origin + direction * t;
+        let (e1, e2, d) = (b - a, c - a, p - a);
+        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let (d1, d2) = (d.dot(e1), d.dot(e2));
+        let det = d11 * d22 - d12 * d12;
+        let (v, w) = ((d22 * d1 - d12 * d2) / det, (d11 * d2 - d12 * d1) / det);
+        let uv = ua * (1.0 - v - w) + ub * v + uc * w;
+        self.textures.alpha(mask.layer, uv) >= mask.cutoff
+    }
+}
+
+/// The occluding geometry of a scene: opaque casters, which block shadow rays; masked ones,
+/// which block them where their alpha mask covers the hit point (exactly, at the texture's
+/// full resolution); and translucent ones, each of which filters a ray that crosses it once
+/// by its transmittance colour (however many of its surfaces the ray crosses).
 ///
 /// Triangles stay in world coordinates and nothing is measured against the scene's size:
 /// every hit farther than 0 from the ray origin counts (origins come off their surface by
 /// their error bound, [`crate::SurfacePoint::ray_origin`]).
 pub struct Occluders {
     opaque: TriangleBvh,
+    masked: Option<MaskedCasters>,
     translucent: Option<TranslucentCasters>,
 }
 
@@ -35,19 +62,35 @@ fn object_triangles(scene: &Scene, object: &zoo_scene::SceneObject) -> Vec<[Vec3
 }
 
 impl Occluders {
-    /// The triangles of every shadow-casting object of `scene`: opaque objects block, and
-    /// translucent ones (opacity below 1) filter.
+    /// The triangles of every shadow-casting object of `scene`: opaque objects block, masked
+    /// ones block where their mask covers, and translucent ones (opacity below 1) filter.
     pub fn new(scene: &Scene) -> Occluders {
         let mut opaque = Vec::new();
         let mut translucent = Vec::new();
+        let mut masked = Vec::new();
         for object in scene.objects.iter().filter(|o| o.casts_shadows) {
             let triangles = object_triangles(scene, object);
-            match object.transmittance() {
-                None => opaque.extend(triangles),
-                Some(t) => translucent.push((triangles, t)),
+            match (object.transmittance(), object.alpha_mask) {
+                (None, None) => opaque.extend(triangles),
+                (None, Some(mask)) => {
+                    let uvs = scene.mesh.indices[object.indices.clone()]
+                        .chunks_exact(3)
+                        .map(|t| [t[0], t[1], t[2]].map(|i| scene.mesh.uvs[i as usize]));
+                    masked.extend(triangles.into_iter().zip(uvs).map(|(p, uv)| (p, uv, mask)));
+                }
+                (Some(t), _) => translucent.push((triangles, t)),
             }
         }
-        Occluders::with_translucent(&opaque, &translucent)
+        let mut occluders = Occluders::with_translucent(&opaque, &translucent);
+        if !masked.is_empty() {
+            let corners: Vec<[Vec3; 3]> = masked.iter().map(|(p, _, _)| *p).collect();
+            occluders.masked = Some(MaskedCasters {
+                bvh: TriangleBvh::new(&corners),
+                triangles: masked,
+                textures: scene.textures.clone(),
+            });
+        }
+        occluders
     }
 
     /// Opaque occluders from world-space triangles.
@@ -78,13 +121,16 @@ impl Occluders {
         });
         Occluders {
             opaque: TriangleBvh::new(opaque),
+            masked: None,
             translucent,
         }
     }
 
-    /// Number of triangles (opaque and translucent).
+    /// Number of triangles (opaque, masked and translucent).
     pub fn len(&self) -> usize {
-        self.opaque.len() + self.translucent.as_ref().map_or(0, |t| t.bvh.len())
+        self.opaque.len()
+            + self.masked.as_ref().map_or(0, |m| m.bvh.len())
+            + self.translucent.as_ref().map_or(0, |t| t.bvh.len())
     }
 
     /// Whether there are no occluders.
@@ -103,7 +149,15 @@ impl Occluders {
     /// Exact for every direction, including axis-aligned ones and -0.0 components (turned
     /// into +0.0 before the slab tests' reciprocals).
     pub fn occluded(&self, origin: Vec3, direction: Vec3, tmax: f32) -> bool {
-        Query::new(origin, direction, tmax).is_some_and(|q| self.opaque.any_hit(&q))
+        Query::new(origin, direction, tmax).is_some_and(|q| self.blocked(&q, origin, direction))
+    }
+
+    /// Whether an opaque caster, or a masked one where its mask covers, is on `query`.
+    fn blocked(&self, query: &Query, origin: Vec3, direction: Vec3) -> bool {
+        self.opaque.any_hit(query)
+            || self.masked.as_ref().is_some_and(|m| {
+                (m.bvh).any_hit_where(query, |i, t| m.blocks(i, origin, direction, t))
+            })
     }
 
     /// The colour fraction of light that travels the segment: 0 when an opaque caster is on
@@ -112,7 +166,7 @@ impl Occluders {
         let Some(query) = Query::new(origin, direction, tmax) else {
             return Vec3::ONE;
         };
-        if self.opaque.any_hit(&query) {
+        if self.blocked(&query, origin, direction) {
             return Vec3::ZERO;
         }
         let Some(translucent) = &self.translucent else {

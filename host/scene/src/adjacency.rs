@@ -209,6 +209,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::NEG_Y, Vec3::Z],
             normals: vec![Vec3::Z; 5],
             indices: vec![0, 1, 2, 1, 0, 3, 0, 1, 4],
+            ..MeshData::default()
         };
         let adjacency = whole(&m);
         let shared: Vec<_> = adjacency
@@ -229,6 +230,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::NEG_Y],
             normals: vec![Vec3::Z; 4],
             indices: vec![0, 1, 2, 0, 1, 3],
+            ..MeshData::default()
         };
         assert_eq!(whole(&m).non_manifold_edges(), 1);
     }

@@ -159,6 +159,25 @@ pub struct ObjectDesc {
     /// Colour of the light a translucent caster lets through (linear RGB in [0, 1]).
     #[serde(default = "white")]
     pub transmission: Vec3,
+    /// Albedo image (PNG, JPEG or TGA, relative to the scene file) that multiplies `color`.
+    #[serde(default)]
+    pub texture: Option<String>,
+    /// Alpha mask image: where its alpha (its grey level, for images without alpha) is below
+    /// `alpha_cutoff`, the object has holes that neither show nor cast shadows.
+    #[serde(default)]
+    pub alpha_mask: Option<String>,
+    /// Coverage below which a masked texel is a hole, in [0, 1].
+    #[serde(default = "half")]
+    pub alpha_cutoff: f32,
+    /// For an OBJ file with an MTL library: whether its materials (colour, specular,
+    /// shininess, opacity, albedo texture and mask) are used (the default), or this object's
+    /// fields for every face instead.
+    #[serde(default = "yes")]
+    pub file_materials: bool,
+}
+
+fn half() -> f32 {
+    0.5
 }
 
 fn default_color() -> Vec3 {

@@ -3,6 +3,7 @@
 
 pub mod adjacency;
 pub mod description;
+pub mod material;
 pub mod mesh;
 pub mod paths;
 pub mod shading;
@@ -14,7 +15,10 @@ use glam::{Mat4, Vec3, Vec4};
 
 pub use adjacency::{Adjacency, EdgeKind, EdgeRecord};
 pub use description::*;
+pub use material::{AlphaMask, TextureLayer, TextureUse, Textures};
 pub use mesh::{MeshData, MeshReport};
+
+use material::{ObjectMaterial, TextureRequests, check_material, mesh_folder};
 
 /// Most lights a scene may hold.
 pub const MAX_LIGHTS: usize = 1024;
@@ -171,6 +175,10 @@ pub struct SceneObject {
     pub opacity: f32,
     /// Colour a translucent caster lets through.
     pub transmission: Vec3,
+    /// Layer of [`Scene::textures`] that multiplies `color`.
+    pub albedo_texture: Option<u32>,
+    /// The alpha test of a masked material.
+    pub alpha_mask: Option<AlphaMask>,
     /// What loading changed.
     pub report: MeshReport,
 }
@@ -209,6 +217,11 @@ pub struct Scene {
     pub adjacency: Adjacency,
     pub receivers: Vec<ReceiverPlane>,
     pub paths: PathsDesc,
+    /// The materials' textures.
+    pub textures: Textures,
+    /// What loading left out but could render without (unreadable textures and material
+    /// libraries), each naming the file; also logged.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
@@ -276,9 +289,16 @@ impl Scene {
         let mut mesh = MeshData::default();
         let mut objects = Vec::with_capacity(desc.objects.len());
         let mut receivers = Vec::new();
+        let mut textures = TextureRequests::default();
+        let mut warnings = Vec::new();
         for (i, object) in desc.objects.iter().enumerate() {
             let field = format!("objects[{i}]");
-            let (local, report) = build_mesh(&object.mesh, &field, path, base)?;
+            let (parts, report, file_warnings) = build_mesh(&object.mesh, &field, path, base)?;
+            warnings.extend(
+                file_warnings
+                    .into_iter()
+                    .map(|w| format!("{}: {field}.mesh: {w}", path.display())),
+            );
             let t = &object.transform;
             for (v, name) in [
                 (t.translation, "translation"),
@@ -294,31 +314,8 @@ impl Scene {
                     "scale components must be non-zero",
                 ));
             }
-            check_vec(object.color, &format!("{field}.color")).map_err(|(f, m)| invalid(f, m))?;
-            if !(0.0..=1.0).contains(&object.specular) || !object.shininess.is_finite() {
-                return Err(invalid(
-                    format!("{field}.specular"),
-                    "specular must be in [0, 1] and shininess finite",
-                ));
-            }
-            if !(0.0..=1.0).contains(&object.opacity) {
-                return Err(invalid(
-                    format!("{field}.opacity"),
-                    "opacity must be in [0, 1] (1 is opaque)",
-                ));
-            }
-            if !(object.transmission.cmpge(Vec3::ZERO).all()
-                && object.transmission.cmple(Vec3::ONE).all())
-            {
-                return Err(invalid(
-                    format!("{field}.transmission"),
-                    "transmission components must be in [0, 1]",
-                ));
-            }
+            check_material(object, &field).map_err(|(f, m)| invalid(f, m))?;
             let transform = t.matrix();
-            let world = local.transformed(transform);
-            let start = mesh.indices.len();
-            mesh.append(&world);
             if object.receiver {
                 let MeshDesc::Plane { size, .. } = object.mesh else {
                     return Err(invalid(
@@ -326,7 +323,7 @@ impl Scene {
                         "only Plane meshes can be receiver planes",
                     ));
                 };
-                receivers.push(receiver_plane(i, transform, size));
+                receivers.push(receiver_plane(objects.len(), transform, size));
             }
             if report.degenerate_removed > 0 {
                 log::warn!(
@@ -335,22 +332,45 @@ impl Scene {
                     report.degenerate_removed
                 );
             }
-            objects.push(SceneObject {
-                name: if object.name.is_empty() {
-                    format!("object {i}")
-                } else {
-                    object.name.clone()
-                },
-                transform,
-                indices: start..mesh.indices.len(),
-                color: object.color,
-                specular: object.specular,
-                shininess: object.shininess,
-                casts_shadows: object.casts_shadows,
-                opacity: object.opacity,
-                transmission: object.transmission,
-                report,
-            });
+            let name = if object.name.is_empty() {
+                format!("object {i}")
+            } else {
+                object.name.clone()
+            };
+            let own = ObjectMaterial::of(object, base, &mut textures);
+            let folder = mesh_folder(&object.mesh, base);
+            let several = parts.len() > 1;
+            for (local, file_material) in parts {
+                let start = mesh.indices.len();
+                mesh.append(&local.transformed(transform));
+                let material = match file_material {
+                    Some(m) if object.file_materials => {
+                        ObjectMaterial::from_mtl(&m, &own, &folder, &mut textures)
+                    }
+                    _ => own.clone(),
+                };
+                objects.push(SceneObject {
+                    name: match (several, &material.name) {
+                        (true, Some(part)) => format!("{name}/{part}"),
+                        _ => name.clone(),
+                    },
+                    transform,
+                    indices: start..mesh.indices.len(),
+                    color: material.color,
+                    specular: material.specular,
+                    shininess: material.shininess,
+                    casts_shadows: object.casts_shadows,
+                    opacity: material.opacity,
+                    transmission: object.transmission,
+                    albedo_texture: material.albedo_texture,
+                    alpha_mask: material.alpha_mask,
+                    report,
+                });
+            }
+        }
+        let textures = textures.load(&mut warnings);
+        for warning in &warnings {
+            log::warn!("{warning}");
         }
 
         validate_paths(&desc.paths, lights.len()).map_err(|(f, m)| invalid(f, &m))?;
@@ -374,6 +394,8 @@ impl Scene {
             adjacency,
             receivers,
             paths: desc.paths.clone(),
+            textures,
+            warnings,
         })
     }
 
@@ -614,12 +636,19 @@ fn build_light(desc: &LightDesc, field: &str) -> Result<Light, (String, String)>
     })
 }
 
+/// A mesh's parts (each with its file material, if any), what loading changed, and warnings.
+type BuiltMesh = (
+    Vec<(MeshData, Option<tobj::Material>)>,
+    MeshReport,
+    Vec<String>,
+);
+
 fn build_mesh(
     desc: &MeshDesc,
     field: &str,
     path: &Path,
     base: &Path,
-) -> Result<(MeshData, MeshReport), SceneError> {
+) -> Result<BuiltMesh, SceneError> {
     let invalid = |message: &str| SceneError::Invalid {
         path: path.to_path_buf(),
         field: format!("{field}.mesh"),
@@ -630,12 +659,18 @@ fn build_mesh(
     let mesh = match *desc {
         MeshDesc::Obj(ref file) => {
             let obj = base.join(file);
-            return mesh::load_obj(&obj).map_err(|e| SceneError::Obj {
+            let loaded = mesh::load_obj(&obj).map_err(|e| SceneError::Obj {
                 path: path.to_path_buf(),
                 field: format!("{field}.mesh"),
                 obj,
                 message: e.to_string(),
-            });
+            })?;
+            let parts = loaded
+                .parts
+                .into_iter()
+                .map(|p| (p.mesh, p.material))
+                .collect();
+            return Ok((parts, loaded.report, loaded.warnings));
         }
         MeshDesc::Plane { size, subdivisions } => {
             if !positive(&[size]) || !(1..=1024).contains(&subdivisions) {
@@ -699,7 +734,7 @@ fn build_mesh(
             mesh::cone(radius, height, segments)
         }
     };
-    Ok((mesh, MeshReport::default()))
+    Ok((vec![(mesh, None)], MeshReport::default(), Vec::new()))
 }
 
 fn receiver_plane(object: usize, transform: Mat4, size: f32) -> ReceiverPlane {

@@ -3,13 +3,16 @@
 use std::f32::consts::TAU;
 use std::path::Path;
 
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 
-/// An indexed triangle mesh with per-vertex normals.
+/// An indexed triangle mesh with per-vertex normals and texture coordinates.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct MeshData {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position once the mesh is in a scene (missing ones are 0);
+    /// (0, 0) is the image's top-left corner, and coordinates repeat outside [0, 1].
+    pub uvs: Vec<Vec2>,
     /// Three indices per triangle, counter-clockwise seen from the front.
     pub indices: Vec<u32>,
 }
@@ -70,6 +73,7 @@ impl MeshData {
                 .iter()
                 .map(|n| (normal_matrix * *n).normalize_or_zero())
                 .collect(),
+            uvs: self.uvs.clone(),
             indices,
         }
     }
@@ -110,11 +114,18 @@ impl MeshData {
             .collect();
     }
 
-    /// Appends `other`, offsetting its indices.
+    /// Appends `other`, offsetting its indices; texture coordinates either mesh lacks are 0.
     pub fn append(&mut self, other: &MeshData) {
         let base = self.positions.len() as u32;
+        self.uvs.resize(self.positions.len(), Vec2::ZERO);
         self.positions.extend_from_slice(&other.positions);
         self.normals.extend_from_slice(&other.normals);
+        let other_uvs = other
+            .uvs
+            .iter()
+            .copied()
+            .chain(std::iter::repeat(Vec2::ZERO));
+        self.uvs.extend(other_uvs.take(other.positions.len()));
         self.indices.extend(other.indices.iter().map(|i| i + base));
     }
 }
@@ -131,11 +142,18 @@ pub fn bounds(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
 
 /// Builds indexed rings of a surface of revolution. `profile` gives (radius, y, normal radial,
 /// normal y) for each ring; the seam reuses column 0 so the surface is closed after welding.
+/// Texture coordinates run around (u) and along the profile (v); the seam's quads interpolate
+/// u back from (segments - 1) / segments to 0.
 fn revolve(profile: &[(f32, f32, f32, f32)], segments: u32) -> MeshData {
     let segments = segments.max(3);
     let mut mesh = MeshData::default();
-    for &(r, y, nr, ny) in profile {
+    let last_ring = (profile.len().max(2) - 1) as f32;
+    for (ring, &(r, y, nr, ny)) in profile.iter().enumerate() {
         for s in 0..segments {
+            mesh.uvs.push(Vec2::new(
+                s as f32 / segments as f32,
+                ring as f32 / last_ring,
+            ));
             let angle = TAU * s as f32 / segments as f32;
             let (sin, cos) = angle.sin_cos();
             mesh.positions.push(Vec3::new(r * cos, y, -r * sin));
@@ -163,11 +181,13 @@ fn cap(radius: f32, y: f32, segments: u32, up: bool) -> MeshData {
     let mut mesh = MeshData {
         positions: vec![Vec3::new(0.0, y, 0.0)],
         normals: vec![normal],
+        uvs: vec![Vec2::splat(0.5)],
         indices: Vec::new(),
     };
     for s in 0..segments {
         let angle = TAU * s as f32 / segments as f32;
         let (sin, cos) = angle.sin_cos();
+        mesh.uvs.push(Vec2::new(0.5 + 0.5 * cos, 0.5 + 0.5 * sin));
         mesh.positions
             .push(Vec3::new(radius * cos, y, -radius * sin));
         mesh.normals.push(normal);
@@ -194,6 +214,7 @@ pub fn plane(size: f32, subdivisions: u32) -> MeshData {
             let z = (j as f32 / n as f32 - 0.5) * size;
             mesh.positions.push(Vec3::new(x, 0.0, z));
             mesh.normals.push(Vec3::Y);
+            mesh.uvs.push(Vec2::new(i as f32, j as f32) / n as f32);
         }
     }
     for j in 0..n {
@@ -226,6 +247,7 @@ pub fn cuboid(size: Vec3) -> MeshData {
         for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
             mesh.positions.push((normal + u * su + v * sv) * h);
             mesh.normals.push(normal);
+            mesh.uvs.push(Vec2::new(su + 1.0, 1.0 - sv) * 0.5);
         }
         mesh.indices
             .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
@@ -250,9 +272,11 @@ pub fn sphere(radius: f32, segments: u32, rings: u32) -> MeshData {
     let south = mesh.positions.len() as u32;
     mesh.positions.push(Vec3::new(0.0, -radius, 0.0));
     mesh.normals.push(Vec3::NEG_Y);
+    mesh.uvs.push(Vec2::new(0.5, 0.0));
     let north = south + 1;
     mesh.positions.push(Vec3::new(0.0, radius, 0.0));
     mesh.normals.push(Vec3::Y);
+    mesh.uvs.push(Vec2::new(0.5, 1.0));
     let top = (ring_count - 1) * segments;
     for s in 0..segments {
         let next = (s + 1) % segments;
@@ -287,6 +311,8 @@ pub fn cone(radius: f32, height: f32, segments: u32) -> MeshData {
         mesh.positions.push(Vec3::new(0.0, height, 0.0));
         mesh.normals
             .push(Vec3::new(slant.x * cos, slant.y, -slant.x * sin));
+        mesh.uvs
+            .push(Vec2::new((s as f32 + 0.5) / segments as f32, 1.0));
     }
     for s in 0..segments {
         let next = (s + 1) % segments;
@@ -310,23 +336,73 @@ pub fn torus(major_radius: f32, minor_radius: f32, segments: u32, rings: u32) ->
     revolve(&profile, segments)
 }
 
-/// Loads an OBJ file as one mesh: faces are triangulated and missing normals computed.
-pub fn load_obj(path: &Path) -> Result<(MeshData, MeshReport), ObjError> {
-    let text = std::fs::read_to_string(path).map_err(|e| ObjError::Io(e.to_string()))?;
-    parse_obj(&text)
+/// An OBJ file's geometry, split by material.
+#[derive(Debug, Clone)]
+pub struct ObjFile {
+    /// One part per material (or one for faces without a material), none empty.
+    pub parts: Vec<ObjPart>,
+    pub report: MeshReport,
+    /// Material libraries that could not be read or parsed, as messages naming them (their
+    /// parts render with the object's own material).
+    pub warnings: Vec<String>,
 }
 
-/// Parses OBJ text; see [`load_obj`].
-pub fn parse_obj(text: &str) -> Result<(MeshData, MeshReport), ObjError> {
+/// The faces of one material.
+#[derive(Debug, Clone)]
+pub struct ObjPart {
+    pub mesh: MeshData,
+    /// The material from the file's MTL library, if the faces name one it holds.
+    pub material: Option<tobj::Material>,
+}
+
+impl ObjFile {
+    /// Every part's geometry as one mesh.
+    pub fn merged(&self) -> MeshData {
+        let mut mesh = MeshData::default();
+        for part in &self.parts {
+            mesh.append(&part.mesh);
+        }
+        mesh
+    }
+}
+
+/// Loads an OBJ file: faces are triangulated, missing normals computed, and the `mtllib`
+/// libraries it names are read from beside it.
+pub fn load_obj(path: &Path) -> Result<ObjFile, ObjError> {
+    let text = std::fs::read_to_string(path).map_err(|e| ObjError::Io(e.to_string()))?;
+    parse_obj(&text, path.parent())
+}
+
+/// Parses OBJ text; `library_folder` resolves its `mtllib` lines (without one, materials are
+/// left out silently). See [`load_obj`].
+pub fn parse_obj(text: &str, library_folder: Option<&Path>) -> Result<ObjFile, ObjError> {
     let polygons_triangulated = prevalidate_obj(text)?;
     let mut reader = std::io::Cursor::new(text.as_bytes());
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &tobj::GPU_LOAD_OPTIONS, |_| {
-        Ok(Default::default())
+    let warnings = std::cell::RefCell::new(Vec::new());
+    let (models, materials) = tobj::load_obj_buf(&mut reader, &tobj::GPU_LOAD_OPTIONS, |library| {
+        let Some(folder) = library_folder else {
+            return Ok(Default::default());
+        };
+        let file = folder.join(library);
+        let loaded = std::fs::File::open(&file)
+            .map_err(|e| e.to_string())
+            .and_then(|f| {
+                tobj::load_mtl_buf(&mut std::io::BufReader::new(f)).map_err(|e| e.to_string())
+            });
+        loaded.map_err(|e| {
+            (warnings.borrow_mut()).push(format!("material library {}: {e}", file.display()));
+            tobj::LoadError::OpenFileFailed
+        })
     })
     .map_err(|e| ObjError::Load(e.to_string()))?;
+    let materials = materials.unwrap_or_default();
 
-    let mut mesh = MeshData::default();
-    let mut normals_computed = false;
+    let mut parts: Vec<ObjPart> = Vec::new();
+    let mut last_material = None;
+    let mut report = MeshReport {
+        polygons_triangulated,
+        ..MeshReport::default()
+    };
     for model in &models {
         let m = &model.mesh;
         let positions: Vec<Vec3> = m
@@ -334,10 +410,21 @@ pub fn parse_obj(text: &str) -> Result<(MeshData, MeshReport), ObjError> {
             .chunks_exact(3)
             .map(|p| Vec3::new(p[0], p[1], p[2]))
             .collect();
-        let mut part = MeshData {
+        // OBJ puts v = 0 at the image's bottom row.
+        let uvs = if m.texcoords.len() / 2 == positions.len() {
+            m.texcoords
+                .chunks_exact(2)
+                .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+                .map(|t| if t.is_finite() { t } else { Vec2::ZERO })
+                .collect()
+        } else {
+            vec![Vec2::ZERO; positions.len()]
+        };
+        let mut mesh = MeshData {
             normals: Vec::new(),
             indices: m.indices.clone(),
             positions,
+            uvs,
         };
         let usable_normals = m.normals.len() == m.positions.len()
             && m.normals.chunks_exact(3).all(|n| {
@@ -345,29 +432,38 @@ pub fn parse_obj(text: &str) -> Result<(MeshData, MeshReport), ObjError> {
                 n.is_finite() && n.length_squared() > 1e-12
             });
         if usable_normals {
-            part.normals = m
+            mesh.normals = m
                 .normals
                 .chunks_exact(3)
                 .map(|n| Vec3::new(n[0], n[1], n[2]).normalize())
                 .collect();
         } else {
-            part.compute_smooth_normals();
-            normals_computed = true;
+            mesh.compute_smooth_normals();
+            report.normals_computed = true;
         }
-        mesh.append(&part);
+        report.degenerate_removed += mesh.remove_degenerate();
+        if mesh.indices.is_empty() {
+            continue;
+        }
+        let id = m.material_id.filter(|&id| id < materials.len());
+        // Consecutive models of one material (objects and groups) make one part.
+        match parts.last_mut() {
+            Some(last) if last_material == Some(id) => last.mesh.append(&mesh),
+            _ => parts.push(ObjPart {
+                mesh,
+                material: id.map(|id| materials[id].clone()),
+            }),
+        }
+        last_material = Some(id);
     }
-    let degenerate_removed = mesh.remove_degenerate();
-    if mesh.indices.is_empty() {
+    if parts.is_empty() {
         return Err(ObjError::Empty);
     }
-    Ok((
-        mesh,
-        MeshReport {
-            degenerate_removed,
-            normals_computed,
-            polygons_triangulated,
-        },
-    ))
+    Ok(ObjFile {
+        parts,
+        report,
+        warnings: warnings.into_inner(),
+    })
 }
 
 /// Checks vertex coordinates and face indices line by line, so errors carry line and column.
@@ -524,7 +620,8 @@ mod tests {
 
     #[test]
     fn obj_quads_are_triangulated_and_normals_computed() {
-        let (mesh, report) = parse_obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        let obj = parse_obj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", None).unwrap();
+        let (mesh, report) = (obj.merged(), obj.report);
         assert_eq!(mesh.triangle_count(), 2);
         assert!(report.normals_computed);
         assert_eq!(report.polygons_triangulated, 1);
@@ -533,15 +630,19 @@ mod tests {
 
     #[test]
     fn obj_degenerate_triangles_are_removed() {
-        let (mesh, report) =
-            parse_obj("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n").unwrap();
+        let obj = parse_obj(
+            "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n",
+            None,
+        )
+        .unwrap();
+        let (mesh, report) = (obj.merged(), obj.report);
         assert_eq!(mesh.triangle_count(), 1);
         assert_eq!(report.degenerate_removed, 1);
     }
 
     #[test]
     fn obj_errors_name_line_and_column() {
-        let err = parse_obj("v 0 0 0\nv 1 nan 0\n").unwrap_err();
+        let err = parse_obj("v 0 0 0\nv 1 nan 0\n", None).unwrap_err();
         assert_eq!(
             err,
             ObjError::Syntax {
@@ -550,16 +651,16 @@ mod tests {
                 message: "vertex coordinate `nan` is not finite".into()
             }
         );
-        let err = parse_obj("v 0 0 0\nv 1 x 0\n").unwrap_err();
+        let err = parse_obj("v 0 0 0\nv 1 x 0\n", None).unwrap_err();
         assert!(err.to_string().starts_with("line 2, column 5"), "{err}");
-        let err = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap_err();
+        let err = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", None).unwrap_err();
         assert!(
             err.to_string().contains("vertex index 7 is out of range"),
             "{err}"
         );
-        assert_eq!(parse_obj("# nothing\n").unwrap_err(), ObjError::Empty);
+        assert_eq!(parse_obj("# nothing\n", None).unwrap_err(), ObjError::Empty);
         assert_eq!(
-            parse_obj("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap_err(),
+            parse_obj("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", None).unwrap_err(),
             ObjError::Empty
         );
     }

@@ -222,7 +222,8 @@ fn real_meshes_load() {
         ("suzanne.obj", 900, true),
         ("spot.obj", 5_000, false),
     ] {
-        let (mesh, report) = mesh::load_obj(&dir.join(file)).unwrap();
+        let obj = mesh::load_obj(&dir.join(file)).unwrap();
+        let (mesh, report) = (obj.merged(), obj.report);
         assert!(
             mesh.triangle_count() >= min_triangles,
             "{file}: {}",
@@ -325,4 +326,115 @@ fn scaling_a_scene_scales_every_length_and_keeps_angles() {
     let (lo, hi) = big.bounds();
     let (slo, shi) = scene.bounds();
     assert_eq!((lo, hi), (slo * 100.0, shi * 100.0));
+}
+
+/// Two quads with an MTL library: one material with a colour, specular, shininess, opacity
+/// and a missing texture, one with an albedo image and an alpha mask.
+const MATERIAL_OBJ: &str = "mtllib parts.mtl
+v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1
+usemtl painted
+f 1/1 2/2 3/3 4/4
+v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1
+usemtl leaves
+f 5/1 6/2 7/3 8/4
+";
+
+const MATERIAL_MTL: &str = "newmtl painted
+Kd 0.5 0.25 0.125\nKs 0.1 0.3 0.2\nNs 64\nd 0.5\nmap_Kd missing.png
+newmtl leaves
+Kd 1 1 1\nmap_Kd -bm 1 textures\\leaf.png\nmap_d leaf_mask.png
+";
+
+#[test]
+fn obj_materials_become_object_parts_with_textures_and_masks() {
+    let dir = temp_dir("materials");
+    std::fs::create_dir_all(dir.join("textures")).unwrap();
+    std::fs::write(dir.join("parts.obj"), MATERIAL_OBJ).unwrap();
+    std::fs::write(dir.join("parts.mtl"), MATERIAL_MTL).unwrap();
+    image::RgbImage::from_pixel(4, 2, image::Rgb([10, 200, 30]))
+        .save(dir.join("textures/leaf.png"))
+        .unwrap();
+    image::GrayImage::from_fn(16, 16, |x, _| image::Luma([if x < 8 { 255 } else { 0 }]))
+        .save(dir.join("leaf_mask.png"))
+        .unwrap();
+    let ron = r#"(camera: (position: (0, 0, 5), target: (0, 0, 0)),
+        lights: [Point(position: (0, 3, 3))],
+        objects: [(name: "bush", mesh: Obj("parts.obj"), alpha_cutoff: 0.25)])"#;
+    let scene = Scene::from_ron(ron, &dir.join("bush.ron"), &dir).unwrap();
+    let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["bush/painted", "bush/leaves"]);
+    let (painted, leaves) = (&scene.objects[0], &scene.objects[1]);
+    assert_eq!(painted.color, Vec3::new(0.5, 0.25, 0.125));
+    assert_eq!(
+        (painted.specular, painted.shininess, painted.opacity),
+        (0.3, 64.0, 0.5)
+    );
+    assert_eq!(painted.alpha_mask, None);
+    // The missing image is a white layer and one warning naming it.
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        scene.warnings[0].contains("missing.png"),
+        "{:?}",
+        scene.warnings
+    );
+    let mask = leaves.alpha_mask.expect("map_d masks the leaves");
+    assert_eq!(mask.cutoff, 0.25);
+    let albedo = leaves.albedo_texture.expect("map_Kd after its options");
+    assert_eq!(scene.textures.size, 16);
+    assert_eq!(
+        &scene.textures.layers[albedo as usize].rgba[..4],
+        &[10, 200, 30, 255]
+    );
+    // OBJ's v runs up the image: the quad's left half is covered, its right half a hole.
+    assert_eq!(
+        scene.textures.alpha(mask.layer, glam::Vec2::new(0.2, 0.5)),
+        1.0
+    );
+    assert_eq!(
+        scene.textures.alpha(mask.layer, glam::Vec2::new(0.8, 0.5)),
+        0.0
+    );
+    assert_eq!(
+        scene.mesh.uvs[scene.mesh.indices[leaves.indices.start] as usize].y,
+        1.0
+    );
+
+    // The object's own fields instead of the file's materials.
+    let own = ron.replace(
+        "alpha_cutoff: 0.25",
+        "file_materials: false, color: (0.1, 0.2, 0.3)",
+    );
+    let scene = Scene::from_ron(&own, &dir.join("bush.ron"), &dir).unwrap();
+    assert!(
+        scene
+            .objects
+            .iter()
+            .all(|o| o.color == Vec3::new(0.1, 0.2, 0.3))
+    );
+    assert!(scene.objects.iter().all(|o| o.alpha_mask.is_none()));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+
+    // A missing library: one warning naming it, and the object's own material.
+    std::fs::remove_file(dir.join("parts.mtl")).unwrap();
+    let scene = Scene::from_ron(ron, &dir.join("bush.ron"), &dir).unwrap();
+    assert_eq!(scene.objects.len(), 1);
+    assert_eq!(scene.objects[0].color, Vec3::splat(0.8));
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        scene.warnings[0].contains("parts.mtl"),
+        "{:?}",
+        scene.warnings
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn alpha_cutoffs_out_of_range_name_the_field() {
+    let err = parse(
+        r#"(camera: (position: (0, 0, 5), target: (0, 0, 0)),
+        lights: [Point(position: (0, 3, 3))],
+        objects: [(mesh: Box(size: (1, 1, 1)), alpha_cutoff: 1.5)])"#,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("objects[0].alpha_cutoff"), "{err}");
 }

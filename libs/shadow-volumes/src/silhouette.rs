@@ -75,6 +75,7 @@ mod tests {
             positions: p.to_vec(),
             normals: vec![Vec3::Y; 4],
             indices: vec![0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2],
+            ..MeshData::default()
         };
         // Make every face wind outward.
         for t in m.indices.chunks_exact_mut(3) {
@@ -158,6 +159,7 @@ mod tests {
             ],
             normals: vec![Vec3::Z; 5],
             indices: vec![0, 1, 2, 1, 0, 3, 0, 1, 4],
+            ..MeshData::default()
         };
         let adjacency = Adjacency::of_mesh(&fan);
         let shared = adjacency

@@ -94,6 +94,7 @@ fn gpu_silhouette_counts_match_the_cpu_mirror() {
                 positions: scene.mesh.positions.clone(),
                 normals: scene.mesh.normals.clone(),
                 indices: scene.mesh.indices[object.indices.clone()].to_vec(),
+                ..Default::default()
             };
             expected += silhouette::silhouette_edges(&mesh, light.homogeneous(), closed);
         }
