@@ -1,10 +1,12 @@
 // G-buffer pass: view depth (f32 bits), normal + shininess, albedo + specular.
 
 #import "common/frame.wgsl"
+#import "common/materials.wgsl"
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
     @builtin(instance_index) object: u32,
 }
 
@@ -13,6 +15,7 @@ struct VertexOut {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) object: u32,
+    @location(3) uv: vec2<f32>,
 }
 
 @vertex
@@ -23,6 +26,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.world = v.position;
     out.normal = v.normal;
     out.object = v.object;
+    out.uv = v.uv;
     return out;
 }
 
@@ -36,6 +40,13 @@ struct GBufferOut {
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     let object = objects[in.object];
+    let material = object_materials[in.object];
+    // Sampled unconditionally (derivatives need uniform control flow), used where the object
+    // has an albedo texture.
+    let texel = textureSample(material_textures, material_sampler, in.uv, max(material.albedo_layer, 0));
+    if !covered(in.object, in.uv) {
+        discard;
+    }
     var n = normalize(in.normal);
     // Back faces (open meshes seen from inside) are shaded from their visible side.
     if !front {
@@ -45,5 +56,8 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     out.view_depth = bitcast<u32>(-(camera.view * vec4<f32>(in.world, 1.0)).z);
     out.normal = vec4<f32>(n, object.material.x / 256.0);
     out.albedo = object.color;
+    if material.albedo_layer >= 0 {
+        out.albedo = vec4<f32>(object.color.rgb * texel.rgb, object.color.a);
+    }
     return out;
 }

@@ -8,7 +8,7 @@
 //       2006). The moments of the far plane (z = 1, no spread) are 1 in every channel: maps
 //       clear to white.
 
-#import "shadow-maps/depth.wgsl"
+#import "shadow-maps/depth_masked.wgsl"
 
 // The moments of the fragment at `in`. No entry point here: the library composes the method
 // and this file and adds `fs_moments`, which returns this.

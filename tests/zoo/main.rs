@@ -8,6 +8,7 @@ mod bench;
 mod cli;
 mod contact_sheet;
 mod filtered_shadow_maps;
+mod foliage;
 mod gl_backend;
 mod indirect_light;
 mod judge;

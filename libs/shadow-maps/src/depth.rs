@@ -59,6 +59,9 @@ pub struct ColorOutput<'a> {
     /// method and the pass that calls it, for example).
     pub source: Option<&'a str>,
     pub entry: &'a str,
+    /// The entry for alpha-tested casters, which takes `MaskedVertex` from
+    /// `shadow-maps/depth_masked.wgsl` (which the shader must import) and discards holes.
+    pub masked_entry: &'a str,
     pub format: wgpu::TextureFormat,
     /// What texels no caster covers hold.
     pub clear: wgpu::Color,
@@ -83,6 +86,8 @@ pub struct DepthPass {
     label: String,
     opaque_only: bool,
     pipeline: wgpu::RenderPipeline,
+    /// For alpha-tested casters (`shadow-maps/depth_masked.wgsl`), where the scene has any.
+    masked_pipeline: Option<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
     clear: Option<wgpu::Color>,
     cameras: Option<(wgpu::Buffer, wgpu::BindGroup)>,
@@ -98,22 +103,13 @@ impl DepthPass {
         color: Option<ColorOutput<'_>>,
     ) -> Result<DepthPass, TechniqueError> {
         let device = &ctx.gpu.device;
+        let create = |shader: &str, source: Option<&str>| match source {
+            None => ctx.shaders.create_module(device, shader),
+            Some(text) => ctx.shaders.create_module_from_source(device, shader, text),
+        };
         let module = match color {
-            None => ctx
-                .shaders
-                .create_module(device, "shadow-maps/depth.wgsl")?,
-            Some(ColorOutput {
-                shader,
-                source: None,
-                ..
-            }) => ctx.shaders.create_module(device, shader)?,
-            Some(ColorOutput {
-                shader,
-                source: Some(text),
-                ..
-            }) => ctx
-                .shaders
-                .create_module_from_source(device, shader, text)?,
+            None => create("shadow-maps/depth.wgsl", None)?,
+            Some(c) => create(c.shader, c.source)?,
         };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some(&format!("{label} layer camera layout")),
@@ -128,62 +124,63 @@ impl DepthPass {
                 count: None,
             }],
         });
-        let targets = color.map(|c| {
-            [Some(wgpu::ColorTargetState {
-                format: c.format,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })]
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&format!("{label} pipeline layout")),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(&format!("{label} pipeline")),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some(if color.is_some() {
-                    "vs_depth_world"
-                } else {
-                    "vs_depth"
-                }),
-                compilation_options: Default::default(),
-                buffers: &[Some(Vertex::LAYOUT)],
+        let targets: Vec<_> = color
+            .map(|c| {
+                Some(wgpu::ColorTargetState {
+                    format: c.format,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })
+            })
+            .into_iter()
+            .collect();
+        let stages = |vertex, fragment| DepthStages {
+            vertex,
+            fragment,
+            targets: &targets,
+        };
+        let pipeline = depth_pipeline(
+            device,
+            label,
+            &[Some(&layout)],
+            &module,
+            match color {
+                None => stages("vs_depth", None),
+                Some(c) => stages("vs_depth_world", Some(c.entry)),
             },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: state.cull_front.then_some(wgpu::Face::Front),
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: MAP_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: wgpu::DepthBiasState {
-                    constant: state.constant_bias,
-                    slope_scale: state.slope_bias,
-                    clamp: 0.0,
-                },
-            }),
-            multisample: Default::default(),
-            fragment: color
-                .zip(targets.as_ref())
-                .map(|(c, targets)| wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(c.entry),
-                    compilation_options: Default::default(),
-                    targets,
-                }),
-            multiview_mask: None,
-            cache: None,
+            state,
+        );
+        // Alpha-tested casters get a pipeline of their own, only where the scene has them.
+        let casts_masked =
+            (ctx.scene.objects.iter()).any(|o| o.casts_shadows && o.alpha_mask.is_some());
+        let masked_pipeline = match (casts_masked, color) {
+            (false, _) => None,
+            (true, None) => {
+                let module = create("shadow-maps/depth_masked.wgsl", None)?;
+                Some((module, stages("vs_depth_masked", Some("fs_depth_masked"))))
+            }
+            (true, Some(c)) => Some((
+                module.clone(),
+                stages("vs_depth_masked", Some(c.masked_entry)),
+            )),
+        }
+        .map(|(module, stages)| {
+            let materials = &ctx.scene_buffers.materials.layout;
+            let groups = [Some(&layout), Some(materials)];
+            depth_pipeline(
+                device,
+                &format!("{label} masked"),
+                &groups,
+                &module,
+                stages,
+                state,
+            )
         });
         Ok(DepthPass {
             label: label.to_string(),
             opaque_only: state.opaque_only,
             pipeline,
+            masked_pipeline,
             layout,
             clear: color.map(|c| c.clear),
             cameras: None,
@@ -281,15 +278,77 @@ impl DepthPass {
             let offset = tile_pass.layer as u64 * CAMERA_STRIDE;
             pass.set_bind_group(0, bind_group, &[offset as u32]);
             let (opaque_only, light) = (self.opaque_only, tile_pass.maps.light);
-            ctx.scene_buffers
-                .draw_objects_where(&mut pass, ctx.scene, |i, o| {
-                    o.casts_shadows
-                        && !(opaque_only && o.transmittance().is_some())
-                        && reaches(light, i)
-                });
+            let casts = |i: usize, o: &zoo_host::scene::SceneObject| {
+                o.casts_shadows
+                    && !(opaque_only && o.transmittance().is_some())
+                    && reaches(light, i)
+            };
+            let buffers = ctx.scene_buffers;
+            buffers.draw_objects_masked(&mut pass, ctx.scene, false, casts);
+            if let Some(masked) = &self.masked_pipeline {
+                pass.set_pipeline(masked);
+                pass.set_bind_group(1, &buffers.materials.bind_group, &[]);
+                buffers.draw_objects_masked(&mut pass, ctx.scene, true, casts);
+            }
         }
         Ok(())
     }
+}
+
+/// The entry points and colour targets of a depth pipeline.
+struct DepthStages<'a> {
+    vertex: &'a str,
+    fragment: Option<&'a str>,
+    targets: &'a [Option<wgpu::ColorTargetState>],
+}
+
+fn depth_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    groups: &[Option<&wgpu::BindGroupLayout>],
+    module: &wgpu::ShaderModule,
+    stages: DepthStages<'_>,
+    state: DepthState,
+) -> wgpu::RenderPipeline {
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(&format!("{label} pipeline layout")),
+        bind_group_layouts: groups,
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(&format!("{label} pipeline")),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(stages.vertex),
+            compilation_options: Default::default(),
+            buffers: &[Some(Vertex::LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: state.cull_front.then_some(wgpu::Face::Front),
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: MAP_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::LessEqual),
+            stencil: Default::default(),
+            bias: wgpu::DepthBiasState {
+                constant: state.constant_bias,
+                slope_scale: state.slope_bias,
+                clamp: 0.0,
+            },
+        }),
+        multisample: Default::default(),
+        fragment: stages.fragment.map(|entry| wgpu::FragmentState {
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: stages.targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 #[cfg(test)]

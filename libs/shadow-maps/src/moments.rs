@@ -21,7 +21,8 @@ use crate::{ColorOutput, DepthState, LayerBlur, MapHeader, ShadowMapSet};
 
 const STORE_SHADER: &str = "shadow-maps/moments_store.wgsl";
 const LOOKUP_SHADER: &str = "shadow-maps/moments_lookup.wgsl";
-const STORE_ENTRY: &str = "@fragment fn fs_moments(in: DepthVertex) -> @location(0) vec4<f32> { return store_moments(in); }";
+const STORE_ENTRY: &str = "@fragment fn fs_moments(in: DepthVertex) -> @location(0) vec4<f32> { return store_moments(in); }
+@fragment fn fs_moments_masked(in: MaskedVertex) -> @location(0) vec4<f32> { let m = store_moments(to_depth_vertex(in)); if !covered(in.object, in.uv) { discard; } return m; }";
 const LOOKUP_ENTRY: &str = "@fragment fn fs_moment_lookup(in: FullscreenOut) -> @location(0) vec4<f32> { return moment_lookup(in); }";
 
 /// `MomentLight` in `shadow-maps/moments_lookup.wgsl`: one light's lookup.
@@ -88,6 +89,7 @@ impl MomentMaps {
             shader: &store_label,
             source: Some(&store),
             entry: "fs_moments",
+            masked_entry: "fs_moments_masked",
             format: method.format,
             clear: wgpu::Color::WHITE,
         };

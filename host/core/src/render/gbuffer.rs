@@ -10,6 +10,7 @@
 use glam::{UVec2, Vec3};
 
 use super::frame::{CameraMatrices, FrameBindings};
+use super::materials::MaterialBindings;
 use super::scene_buffers::{SceneBuffers, Vertex};
 use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
 use crate::scene::Scene;
@@ -158,12 +159,13 @@ impl GBufferPass {
         gpu: &GpuContext,
         shaders: &ShaderLibrary,
         frame: &FrameBindings,
+        materials: &MaterialBindings,
     ) -> Result<GBufferPass, ShaderError> {
         let device = &gpu.device;
         let module = shaders.create_module(device, "host/gbuffer.wgsl")?;
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer pipeline layout"),
-            bind_group_layouts: &[Some(&frame.layout)],
+            bind_group_layouts: &[Some(&frame.layout), Some(&materials.layout)],
             immediate_size: 0,
         });
         let color = |format| {
@@ -256,6 +258,7 @@ impl GBufferPass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &frame.bind_group, &[]);
+        pass.set_bind_group(1, &buffers.materials.bind_group, &[]);
         buffers.draw_objects(&mut pass, scene, false);
     }
 }

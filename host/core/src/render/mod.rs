@@ -5,6 +5,7 @@ pub mod difference;
 pub mod frame;
 pub mod gbuffer;
 pub mod lighting;
+pub mod materials;
 mod renderer;
 pub mod scene_buffers;
 pub mod visibility;
@@ -12,6 +13,7 @@ pub mod visibility;
 pub use difference::ImageDifference;
 pub use frame::{CameraMatrices, FrameBindings};
 pub use gbuffer::GBuffer;
+pub use materials::MaterialBindings;
 pub use renderer::{GBufferData, MAX_OUTPUT_SIDE, Overlay, RenderError, Renderer, View};
 pub use scene_buffers::{SceneBuffers, Vertex};
 pub use visibility::{

@@ -1,25 +1,29 @@
-//! The scene's geometry on the GPU: shared vertex and index buffers and edge adjacency.
+//! The scene's geometry on the GPU: shared vertex and index buffers, edge adjacency and the
+//! materials.
 
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
+use super::materials::MaterialBindings;
 use crate::gpu::GpuContext;
 use crate::scene::{Scene, SceneObject};
 
-/// One vertex: world-space position and normal (24 bytes).
+/// One vertex: world-space position, normal and texture coordinates (32 bytes).
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 #[repr(C)]
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
+    pub uv: [f32; 2],
 }
 
 impl Vertex {
-    /// Vertex buffer layout: location 0 position, location 1 normal.
+    /// Vertex buffer layout: location 0 position, location 1 normal, location 2 texture
+    /// coordinates.
     pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
         array_stride: size_of::<Vertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
     };
 }
 
@@ -35,6 +39,8 @@ pub struct SceneBuffers {
     pub edge_faces: wgpu::Buffer,
     /// Object index of each triangle (`STORAGE`).
     pub triangle_objects: wgpu::Buffer,
+    /// Textures and alpha tests (`common/materials.wgsl`).
+    pub materials: MaterialBindings,
     pub vertex_count: u32,
     pub index_count: u32,
     pub edge_count: u32,
@@ -48,9 +54,17 @@ impl SceneBuffers {
             .positions
             .iter()
             .zip(&scene.mesh.normals)
-            .map(|(p, n)| Vertex {
+            .enumerate()
+            .map(|(i, (p, n))| Vertex {
                 position: p.to_array(),
                 normal: n.to_array(),
+                uv: scene
+                    .mesh
+                    .uvs
+                    .get(i)
+                    .copied()
+                    .unwrap_or_default()
+                    .to_array(),
             })
             .collect();
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -96,10 +110,25 @@ impl SceneBuffers {
                 bytemuck::cast_slice(&scene.triangle_objects()),
                 storage,
             ),
+            materials: MaterialBindings::new(gpu, scene),
             vertex_count: vertices.len() as u32,
             index_count: scene.mesh.indices.len() as u32,
             edge_count: scene.adjacency.edges.len() as u32,
         }
+    }
+
+    /// Draws the objects `keep(index, object)` accepts whose alpha test is `masked` (for
+    /// passes that draw alpha-tested objects with a pipeline of their own).
+    pub fn draw_objects_masked(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        scene: &Scene,
+        masked: bool,
+        keep: impl Fn(usize, &SceneObject) -> bool,
+    ) {
+        self.draw_objects_where(pass, scene, |i, o| {
+            o.alpha_mask.is_some() == masked && keep(i, o)
+        });
     }
 
     /// Draws every object (or only shadow casters) with `first_instance` = object index, so

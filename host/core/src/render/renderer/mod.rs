@@ -147,7 +147,7 @@ impl Renderer {
         let visibility = VisibilityTargets::new(&gpu, size, slots);
         let indirect = IndirectTarget::new(&gpu, size);
         let (output, output_view) = create_output(&gpu, size);
-        let gbuffer_pass = GBufferPass::new(&gpu, &shaders, &frame)?;
+        let gbuffer_pass = GBufferPass::new(&gpu, &shaders, &frame, &scene_buffers.materials)?;
         let lighting = LightingPass::new(&gpu, &shaders, &frame, &gbuffer)?;
         let lighting_inputs = lighting.inputs(&gpu, &visibility, &indirect, &transmittance);
         let debug = DebugViewPass::new(&gpu, &shaders)?;
@@ -595,7 +595,12 @@ impl Renderer {
                 self.shaders.validate(&name)?;
             }
         }
-        let gbuffer_pass = GBufferPass::new(&self.gpu, &self.shaders, &self.frame)?;
+        let gbuffer_pass = GBufferPass::new(
+            &self.gpu,
+            &self.shaders,
+            &self.frame,
+            &self.scene_buffers.materials,
+        )?;
         let lighting = LightingPass::new(&self.gpu, &self.shaders, &self.frame, &self.gbuffer)?;
         let debug = DebugViewPass::new(&self.gpu, &self.shaders)?;
         let registration = self.technique.registration;

@@ -1,0 +1,26 @@
+// The scene's materials: bind group 1 of the passes that draw the scene's geometry (the
+// G-buffer and the shadow-map depth passes). Layout mirrors `zoo_host::render::materials`.
+//
+// Alpha tests read the mask at full resolution (level 0), bilinearly, with repeating
+// coordinates: the rule the judge's `Textures::alpha` follows, so that a technique's holes
+// are the reference's.
+
+struct ObjectMaterial {
+    // Texture layers, -1 for none.
+    albedo_layer: i32,
+    mask_layer: i32,
+    // Coverage below which a masked texel is a hole.
+    alpha_cutoff: f32,
+    _pad: f32,
+}
+
+@group(1) @binding(0) var<storage, read> object_materials: array<ObjectMaterial>;
+@group(1) @binding(1) var material_textures: texture_2d_array<f32>;
+@group(1) @binding(2) var material_sampler: sampler;
+
+// Whether the surface of `object` at `uv` is there (not a hole of its alpha mask).
+fn covered(object: u32, uv: vec2<f32>) -> bool {
+    let m = object_materials[object];
+    let alpha = textureSampleLevel(material_textures, material_sampler, uv, max(m.mask_layer, 0), 0.0).a;
+    return m.mask_layer < 0 || alpha >= m.alpha_cutoff;
+}
