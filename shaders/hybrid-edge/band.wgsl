@@ -14,6 +14,7 @@
 //   triangles the shadow map saw nearest the light in the pixel's neighbourhood (seed 003's
 //   future-work idea): no volumes at all.
 
+#import "common/vertices.wgsl"
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
 #import "common/fullscreen.wgsl"
@@ -39,8 +40,8 @@ const RESTRICTION_TILES: u32 = 3u;
 
 @group(2) @binding(0) var<uniform> edge: EdgeLight;
 // The coverage maps (laid out like the depth maps): the id of the triangle nearest the light
-// among those touching each texel (NO_TRIANGLE where none); the scene's vertices (six floats
-// each) and indices.
+// among those touching each texel (NO_TRIANGLE where none); the scene's vertices
+// (`VERTEX_FLOATS` floats each) and indices.
 @group(4) @binding(0) var coverage_ids: texture_2d_array<u32>;
 @group(4) @binding(1) var<storage, read> scene_vertices: array<f32>;
 @group(4) @binding(2) var<storage, read> scene_indices: array<u32>;
@@ -92,7 +93,7 @@ const EDGE: u32 = 3u;
 const NO_TRIANGLE: u32 = 0xffffffffu;
 
 fn vertex_position(index: u32) -> vec3<f32> {
-    let base = index * 6u;
+    let base = index * VERTEX_FLOATS;
     return vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
 }
 

@@ -1,11 +1,12 @@
 // Caster triangles pulled from the scene's storage buffers, for passes that render every
 // caster from one shadow-map layer and need a triangle whole (its index, all three corners).
 
+#import "common/vertices.wgsl"
 #import "common/frame.wgsl"
 #import "shadow-maps/layers.wgsl"
 
 @group(1) @binding(0) var<uniform> layer_camera: LayerCamera;
-// The scene's vertices (position, normal: six floats each) and triangle indices.
+// The scene's vertices (`VERTEX_FLOATS` floats each) and triangle indices.
 @group(1) @binding(1) var<storage, read> scene_vertices: array<f32>;
 @group(1) @binding(2) var<storage, read> scene_indices: array<u32>;
 // The object of each triangle.
@@ -15,7 +16,7 @@
 const OUTSIDE_CLIP: vec4<f32> = vec4<f32>(2.0, 2.0, 2.0, 1.0);
 
 fn scene_position(index: u32) -> vec3<f32> {
-    let base = index * 6u;
+    let base = index * VERTEX_FLOATS;
     return vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
 }
 

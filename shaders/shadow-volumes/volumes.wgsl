@@ -8,6 +8,7 @@
 // so sides shared by two emitting triangles cancel and boundary or non-manifold edges close
 // the volume exactly as per-triangle volumes would.
 
+#import "common/vertices.wgsl"
 #import "common/frame.wgsl"
 
 const FLAG_CASTS: u32 = 1u;
@@ -48,7 +49,7 @@ struct DrawArgs {
 @group(1) @binding(8) var<uniform> params: Params;
 
 fn position(index: u32) -> vec3<f32> {
-    let base = index * 6u;
+    let base = index * VERTEX_FLOATS;
     return vec3<f32>(vertices[base], vertices[base + 1u], vertices[base + 2u]);
 }
 

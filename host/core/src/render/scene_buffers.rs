@@ -154,3 +154,17 @@ impl SceneBuffers {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shaders_read_vertices_with_their_size() {
+        let composed = crate::ShaderLibrary::embedded()
+            .compose("common/vertices.wgsl")
+            .unwrap();
+        let floats = crate::gpu::layout::wgsl_integer_constant(&composed.source, "VERTEX_FLOATS");
+        assert_eq!(floats, Ok((size_of::<Vertex>() / 4) as i64));
+    }
+}
