@@ -368,6 +368,16 @@ impl Scene {
                 });
             }
         }
+        if textures.len() > material::MAX_TEXTURE_LAYERS {
+            return Err(invalid(
+                "objects".into(),
+                &format!(
+                    "{} distinct textures and masks, at most {} are supported",
+                    textures.len(),
+                    material::MAX_TEXTURE_LAYERS
+                ),
+            ));
+        }
         let textures = textures.load(&mut warnings);
         for warning in &warnings {
             log::warn!("{warning}");

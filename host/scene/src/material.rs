@@ -12,6 +12,10 @@ use crate::description::{MeshDesc, ObjectDesc};
 /// Largest side of the scene's texture layers; bigger images are scaled down to it.
 pub const MAX_TEXTURE_SIZE: u32 = 1024;
 
+/// Most texture layers a scene may use (distinct images, each as albedo or as mask): the array
+/// layers every WebGPU device offers.
+pub const MAX_TEXTURE_LAYERS: usize = 256;
+
 /// Which channel of an image a layer serves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum TextureUse {
@@ -57,6 +61,11 @@ impl Textures {
         let Some(texels) = self.layers.get(layer as usize).map(|l| &l.rgba) else {
             return 1.0;
         };
+        // Coordinates repeat; wrapped first, so that huge ones cannot overflow the texel index.
+        let uv = uv - uv.floor();
+        if !uv.is_finite() {
+            return 1.0;
+        }
         let n = self.size as i64;
         let x = uv * self.size as f32 - 0.5;
         let base = x.floor();
@@ -88,6 +97,11 @@ impl TextureRequests {
             self.requests.push(key);
             next
         })
+    }
+
+    /// Number of layers requested.
+    pub(crate) fn len(&self) -> usize {
+        self.requests.len()
     }
 
     /// Reads every requested image and resamples it to the common size: the largest image's
@@ -219,7 +233,12 @@ impl ObjectMaterial {
             specular: (m.specular.and_then(colour)).map_or(own.specular, |s| s.max_element()),
             shininess: (m.shininess.and_then(finite))
                 .map_or(own.shininess, |n| n.clamp(1.0, 4096.0)),
-            opacity: (m.dissolve.and_then(finite)).map_or(own.opacity, |d| d.clamp(0.0, 1.0)),
+            // A masked material is an alpha-tested opaque one: `d` counts only without `map_d`.
+            opacity: match (mask, m.dissolve.and_then(finite)) {
+                (Some(_), _) => 1.0,
+                (None, Some(d)) => d.clamp(0.0, 1.0),
+                (None, None) => own.opacity,
+            },
             albedo_texture: albedo_texture.or(own.albedo_texture),
             alpha_mask: mask
                 .map(|layer| AlphaMask {
@@ -286,6 +305,12 @@ pub(crate) fn check_material(
     if !(0.0..=1.0).contains(&object.alpha_cutoff) {
         return Err((format!("{field}.alpha_cutoff"), "must be in [0, 1]"));
     }
+    if object.alpha_mask.is_some() && object.opacity < 1.0 {
+        return Err((
+            format!("{field}.opacity"),
+            "an alpha-masked object is opaque where its mask covers it: opacity must be 1",
+        ));
+    }
     Ok(())
 }
 
@@ -318,6 +343,10 @@ mod tests {
         assert!((t.alpha(0, Vec2::new(0.25, 0.5)) - 0.5).abs() < 1e-6);
         // Repeats: u = 1.125 is u = 0.125; u = 0 lies between the last and the first column.
         assert_eq!(t.alpha(0, Vec2::new(1.125, -0.875)), 1.0);
+        // Huge and non-finite coordinates neither overflow nor make holes.
+        assert!((0.0..=1.0).contains(&t.alpha(0, Vec2::new(1e16, -3e18))));
+        assert_eq!(t.alpha(0, Vec2::new(f32::INFINITY, 0.5)), 1.0);
+        assert_eq!(t.alpha(0, Vec2::new(f32::NAN, 0.5)), 1.0);
         assert!((t.alpha(0, Vec2::new(0.0, 0.3)) - 0.5).abs() < 1e-6);
         // A missing layer is opaque.
         assert_eq!(t.alpha(3, Vec2::ZERO), 1.0);

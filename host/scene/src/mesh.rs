@@ -142,8 +142,9 @@ pub fn bounds(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
 
 /// Builds indexed rings of a surface of revolution. `profile` gives (radius, y, normal radial,
 /// normal y) for each ring; the seam reuses column 0 so the surface is closed after welding.
-/// Texture coordinates run around (u) and along the profile (v); the seam's quads interpolate
-/// u back from (segments - 1) / segments to 0.
+/// Texture coordinates run around (u) and up the profile (v from 1 at the first ring to 0 at
+/// the last, so images stand upright); the seam's quads interpolate u back from
+/// (segments - 1) / segments to 0.
 fn revolve(profile: &[(f32, f32, f32, f32)], segments: u32) -> MeshData {
     let segments = segments.max(3);
     let mut mesh = MeshData::default();
@@ -152,7 +153,7 @@ fn revolve(profile: &[(f32, f32, f32, f32)], segments: u32) -> MeshData {
         for s in 0..segments {
             mesh.uvs.push(Vec2::new(
                 s as f32 / segments as f32,
-                ring as f32 / last_ring,
+                1.0 - ring as f32 / last_ring,
             ));
             let angle = TAU * s as f32 / segments as f32;
             let (sin, cos) = angle.sin_cos();
@@ -272,11 +273,11 @@ pub fn sphere(radius: f32, segments: u32, rings: u32) -> MeshData {
     let south = mesh.positions.len() as u32;
     mesh.positions.push(Vec3::new(0.0, -radius, 0.0));
     mesh.normals.push(Vec3::NEG_Y);
-    mesh.uvs.push(Vec2::new(0.5, 0.0));
+    mesh.uvs.push(Vec2::new(0.5, 1.0));
     let north = south + 1;
     mesh.positions.push(Vec3::new(0.0, radius, 0.0));
     mesh.normals.push(Vec3::Y);
-    mesh.uvs.push(Vec2::new(0.5, 1.0));
+    mesh.uvs.push(Vec2::new(0.5, 0.0));
     let top = (ring_count - 1) * segments;
     for s in 0..segments {
         let next = (s + 1) % segments;
@@ -312,7 +313,7 @@ pub fn cone(radius: f32, height: f32, segments: u32) -> MeshData {
         mesh.normals
             .push(Vec3::new(slant.x * cos, slant.y, -slant.x * sin));
         mesh.uvs
-            .push(Vec2::new((s as f32 + 0.5) / segments as f32, 1.0));
+            .push(Vec2::new((s as f32 + 0.5) / segments as f32, 0.0));
     }
     for s in 0..segments {
         let next = (s + 1) % segments;

@@ -429,7 +429,7 @@ fn obj_materials_become_object_parts_with_textures_and_masks() {
 }
 
 #[test]
-fn alpha_cutoffs_out_of_range_name_the_field() {
+fn bad_alpha_cutoffs_and_translucent_masks_name_the_field() {
     let err = parse(
         r#"(camera: (position: (0, 0, 5), target: (0, 0, 0)),
         lights: [Point(position: (0, 3, 3))],
@@ -437,4 +437,25 @@ fn alpha_cutoffs_out_of_range_name_the_field() {
     )
     .unwrap_err();
     assert!(err.to_string().contains("objects[0].alpha_cutoff"), "{err}");
+    let err = parse(
+        r#"(camera: (position: (0, 0, 5), target: (0, 0, 0)),
+        lights: [Point(position: (0, 3, 3))],
+        objects: [(mesh: Box(size: (1, 1, 1)), alpha_mask: Some("leaf.png"), opacity: 0.5)])"#,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("objects[0].opacity"), "{err}");
+}
+
+#[test]
+fn more_textures_than_array_layers_is_an_error() {
+    let objects: Vec<String> = (0..257)
+        .map(|i| format!(r#"(mesh: Box(size: (1, 1, 1)), texture: Some("t{i}.png"))"#))
+        .collect();
+    let text = format!(
+        r#"(camera: (position: (0, 0, 5), target: (0, 0, 0)),
+        lights: [Point(position: (0, 3, 3))], objects: [{}])"#,
+        objects.join(", ")
+    );
+    let err = parse(&text).unwrap_err();
+    assert!(err.to_string().contains("257 distinct textures"), "{err}");
 }
