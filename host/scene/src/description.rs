@@ -199,6 +199,9 @@ fn yes() -> bool {
 pub enum MeshDesc {
     /// A Wavefront OBJ file, relative to the scene file.
     Obj(String),
+    /// A glTF 2.0 file (`.gltf` or binary `.glb`), relative to the scene file: its default
+    /// scene with the node transforms applied.
+    Gltf(String),
     /// A square in the XZ plane facing +Y, `size` on a side, split into `subdivisions`².
     Plane {
         size: f32,
@@ -321,7 +324,7 @@ pub struct LightKey {
 
 impl SceneDescription {
     /// The same scene with every procedural mesh's segment, ring and subdivision counts scaled
-    /// by `factor` (for triangle-count sweeps). OBJ meshes are unchanged.
+    /// by `factor` (for triangle-count sweeps). Mesh files are unchanged.
     pub fn with_tessellation(&self, factor: f32) -> SceneDescription {
         let scale = |n: u32, min: u32| ((n as f32 * factor).round() as u32).clamp(min, 4096);
         let mut out = self.clone();
@@ -342,7 +345,7 @@ impl SceneDescription {
                 MeshDesc::Cylinder { segments, .. } | MeshDesc::Cone { segments, .. } => {
                     *segments = scale(*segments, 3)
                 }
-                MeshDesc::Box { .. } | MeshDesc::Obj(_) => {}
+                MeshDesc::Box { .. } | MeshDesc::Obj(_) | MeshDesc::Gltf(_) => {}
             }
         }
         out

@@ -3,6 +3,9 @@
 
 pub mod adjacency;
 pub mod description;
+pub mod gltf_file;
+#[cfg(any(test, feature = "test-support"))]
+pub mod gltf_writer;
 pub mod material;
 pub mod mesh;
 pub mod paths;
@@ -15,10 +18,11 @@ use glam::{Mat4, Vec3, Vec4};
 
 pub use adjacency::{Adjacency, EdgeKind, EdgeRecord};
 pub use description::*;
-pub use material::{AlphaMask, TextureLayer, TextureUse, Textures};
+pub use gltf_file::{GltfError, GltfFile};
+pub use material::{AlphaMask, ImageSource, TextureLayer, TextureUse, Textures};
 pub use mesh::{MeshData, MeshReport};
 
-use material::{ObjectMaterial, TextureRequests, check_material, mesh_folder};
+use material::{FileMaterial, ObjectMaterial, TextureRequests, check_material, mesh_folder};
 
 /// Most lights a scene may hold.
 pub const MAX_LIGHTS: usize = 1024;
@@ -50,6 +54,14 @@ pub enum SceneError {
         path: PathBuf,
         field: String,
         obj: PathBuf,
+        message: String,
+    },
+    /// A referenced glTF file is missing or malformed.
+    #[error("{path}: {field}: {file}: {message}")]
+    Gltf {
+        path: PathBuf,
+        field: String,
+        file: PathBuf,
         message: String,
     },
 }
@@ -179,6 +191,9 @@ pub struct SceneObject {
     pub albedo_texture: Option<u32>,
     /// The alpha test of a masked material.
     pub alpha_mask: Option<AlphaMask>,
+    /// Whether the camera sees its back faces (false only for single-sided glTF materials;
+    /// both sides cast shadows either way).
+    pub double_sided: bool,
     /// What loading changed.
     pub report: MeshReport,
 }
@@ -345,7 +360,7 @@ impl Scene {
                 mesh.append(&local.transformed(transform));
                 let material = match file_material {
                     Some(m) if object.file_materials => {
-                        ObjectMaterial::from_mtl(&m, &own, &folder, &mut textures)
+                        ObjectMaterial::from_file(&m, &own, &folder, &mut textures)
                     }
                     _ => own.clone(),
                 };
@@ -364,6 +379,7 @@ impl Scene {
                     transmission: object.transmission,
                     albedo_texture: material.albedo_texture,
                     alpha_mask: material.alpha_mask,
+                    double_sided: material.double_sided,
                     report,
                 });
             }
@@ -648,7 +664,7 @@ fn build_light(desc: &LightDesc, field: &str) -> Result<Light, (String, String)>
 
 /// A mesh's parts (each with its file material, if any), what loading changed, and warnings.
 type BuiltMesh = (
-    Vec<(MeshData, Option<tobj::Material>)>,
+    Vec<(MeshData, Option<FileMaterial>)>,
     MeshReport,
     Vec<String>,
 );
@@ -678,7 +694,22 @@ fn build_mesh(
             let parts = loaded
                 .parts
                 .into_iter()
-                .map(|p| (p.mesh, p.material))
+                .map(|p| (p.mesh, p.material.map(FileMaterial::Mtl)))
+                .collect();
+            return Ok((parts, loaded.report, loaded.warnings));
+        }
+        MeshDesc::Gltf(ref file) => {
+            let gltf = base.join(file);
+            let loaded = gltf_file::load_gltf(&gltf).map_err(|e| SceneError::Gltf {
+                path: path.to_path_buf(),
+                field: format!("{field}.mesh"),
+                file: gltf,
+                message: e.to_string(),
+            })?;
+            let parts = loaded
+                .parts
+                .into_iter()
+                .map(|p| (p.mesh, Some(FileMaterial::Gltf(p.material))))
                 .collect();
             return Ok((parts, loaded.report, loaded.warnings));
         }

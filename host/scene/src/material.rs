@@ -4,10 +4,12 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
 use crate::description::{MeshDesc, ObjectDesc};
+use crate::gltf_file::{GltfAlpha, GltfMaterial};
 
 /// Largest side of the scene's texture layers; bigger images are scaled down to it.
 pub const MAX_TEXTURE_SIZE: u32 = 1024;
@@ -24,6 +26,34 @@ pub enum TextureUse {
     /// Coverage in the layer's alpha: the image's alpha channel, or its red channel when it has
     /// none (greyscale masks, as `map_d` files usually are).
     Mask,
+    /// Coverage in the image's alpha channel alone, opaque when it has none (glTF's base
+    /// colour alpha).
+    Alpha,
+}
+
+/// Where an image's encoded bytes are.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ImageSource {
+    /// A file of its own.
+    File(PathBuf),
+    /// Bytes inside another file (a GLB's binary chunk, a data URI); `name` says where.
+    Encoded { name: PathBuf, bytes: Arc<[u8]> },
+}
+
+impl ImageSource {
+    /// The file, or the place in a file, that names the image in warnings and layers.
+    pub fn name(&self) -> &Path {
+        match self {
+            ImageSource::File(path) | ImageSource::Encoded { name: path, .. } => path,
+        }
+    }
+
+    fn decode(&self) -> image::ImageResult<image::DynamicImage> {
+        match self {
+            ImageSource::File(path) => image::open(path),
+            ImageSource::Encoded { bytes, .. } => image::load_from_memory(bytes),
+        }
+    }
 }
 
 /// An alpha-tested material: where its mask's alpha (bilinear at full resolution, see
@@ -84,17 +114,22 @@ impl Textures {
 /// Collects the images a scene's materials name, then loads them as [`Textures`].
 #[derive(Debug, Default)]
 pub(crate) struct TextureRequests {
-    requests: Vec<(PathBuf, TextureUse)>,
+    requests: Vec<(ImageSource, TextureUse)>,
     index: HashMap<(PathBuf, TextureUse), u32>,
 }
 
 impl TextureRequests {
     /// The layer `file` will have, used as `usage`.
     pub(crate) fn request(&mut self, file: &Path, usage: TextureUse) -> u32 {
-        let key = (file.to_path_buf(), usage);
+        self.request_source(&ImageSource::File(file.to_path_buf()), usage)
+    }
+
+    /// The layer the image `source` will have, used as `usage`.
+    pub(crate) fn request_source(&mut self, source: &ImageSource, usage: TextureUse) -> u32 {
+        let key = (source.name().to_path_buf(), usage);
         let next = self.requests.len() as u32;
-        *self.index.entry(key.clone()).or_insert_with(|| {
-            self.requests.push(key);
+        *self.index.entry(key).or_insert_with(|| {
+            self.requests.push((source.clone(), usage));
             next
         })
     }
@@ -108,20 +143,30 @@ impl TextureRequests {
     /// side rounded up to a power of two, at most [`MAX_TEXTURE_SIZE`]. An image that cannot
     /// be read becomes a white, opaque layer and a warning naming the file.
     pub(crate) fn load(self, warnings: &mut Vec<String>) -> Textures {
+        // Each image is decoded (and an unreadable one reported) once, whatever its uses.
+        let mut decoded: HashMap<&Path, Option<image::DynamicImage>> = HashMap::new();
+        for (source, _) in &self.requests {
+            decoded.entry(source.name()).or_insert_with(|| {
+                source
+                    .decode()
+                    .map_err(|e| {
+                        warnings.push(format!(
+                            "texture {}: {e}; the material is drawn without it",
+                            source.name().display()
+                        ))
+                    })
+                    .ok()
+            });
+        }
         let images: Vec<Option<image::RgbaImage>> = self
             .requests
             .iter()
-            .map(|(path, usage)| match image::open(path) {
-                Ok(image) => Some(as_layer(image, *usage)),
-                Err(e) => {
-                    warnings.push(format!(
-                        "texture {}: {e}; the material is drawn without it",
-                        path.display()
-                    ));
-                    None
-                }
+            .map(|(source, usage)| {
+                let image = decoded.get(source.name())?.as_ref()?;
+                Some(as_layer(image, *usage))
             })
             .collect();
+        drop(decoded);
         let largest = images
             .iter()
             .flatten()
@@ -143,7 +188,7 @@ impl TextureRequests {
                     None => vec![255; (size * size * 4) as usize],
                 };
                 TextureLayer {
-                    source,
+                    source: source.name().to_path_buf(),
                     usage,
                     rgba,
                 }
@@ -157,7 +202,7 @@ impl TextureRequests {
 }
 
 /// The image as RGBA8; for masks, coverage moves into alpha.
-fn as_layer(image: image::DynamicImage, usage: TextureUse) -> image::RgbaImage {
+fn as_layer(image: &image::DynamicImage, usage: TextureUse) -> image::RgbaImage {
     let has_alpha = image.color().has_alpha();
     let mut rgba = image.to_rgba8();
     if usage == TextureUse::Mask && !has_alpha {
@@ -181,6 +226,8 @@ pub(crate) struct ObjectMaterial {
     pub(crate) alpha_mask: Option<AlphaMask>,
     /// The object's cutoff, for masks its file's materials bring.
     pub(crate) alpha_cutoff: f32,
+    /// Whether back faces are drawn.
+    pub(crate) double_sided: bool,
 }
 
 impl ObjectMaterial {
@@ -203,6 +250,7 @@ impl ObjectMaterial {
                 cutoff: object.alpha_cutoff,
             }),
             alpha_cutoff: object.alpha_cutoff,
+            double_sided: true,
         }
     }
 
@@ -247,8 +295,64 @@ impl ObjectMaterial {
                 })
                 .or(own.alpha_mask),
             alpha_cutoff: own.alpha_cutoff,
+            double_sided: own.double_sided,
         }
     }
+
+    /// A glTF material: the base colour factor the colour, its texture the albedo; metallic
+    /// and roughness turned into Blinn-Phong terms (specular 0.04 for dielectrics up to 1 for
+    /// metals; exponent 2 / α² - 2 with α = roughness²); `MASK` an alpha test of the base
+    /// colour texture's alpha, `BLEND` a translucent caster.
+    pub(crate) fn from_gltf(
+        m: &GltfMaterial,
+        own: &ObjectMaterial,
+        textures: &mut TextureRequests,
+    ) -> ObjectMaterial {
+        let alpha = (m.roughness * m.roughness).max(1e-3);
+        let mut request =
+            |usage| (m.texture.as_ref()).map(|source| textures.request_source(source, usage));
+        let albedo_texture = request(TextureUse::Albedo);
+        let alpha_mask = match m.alpha {
+            GltfAlpha::Mask { cutoff } => {
+                request(TextureUse::Alpha).map(|layer| AlphaMask { layer, cutoff })
+            }
+            _ => None,
+        };
+        ObjectMaterial {
+            name: Some(m.name.clone()),
+            color: m.color,
+            specular: 0.04 + 0.96 * m.metallic,
+            shininess: (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 4096.0),
+            opacity: match m.alpha {
+                GltfAlpha::Blend { opacity } => opacity,
+                _ => 1.0,
+            },
+            albedo_texture: albedo_texture.or(own.albedo_texture),
+            alpha_mask: alpha_mask.or(own.alpha_mask),
+            alpha_cutoff: own.alpha_cutoff,
+            double_sided: m.double_sided,
+        }
+    }
+
+    /// A mesh file's material (see [`Self::from_mtl`] and [`Self::from_gltf`]).
+    pub(crate) fn from_file(
+        m: &FileMaterial,
+        own: &ObjectMaterial,
+        folder: &Path,
+        textures: &mut TextureRequests,
+    ) -> ObjectMaterial {
+        match m {
+            FileMaterial::Mtl(m) => Self::from_mtl(m, own, folder, textures),
+            FileMaterial::Gltf(m) => Self::from_gltf(m, own, textures),
+        }
+    }
+}
+
+/// The material a mesh file gives some of its faces.
+#[derive(Debug, Clone)]
+pub(crate) enum FileMaterial {
+    Mtl(tobj::Material),
+    Gltf(GltfMaterial),
 }
 
 /// The file of an MTL texture statement: its last word (options such as `-bm 1` come
@@ -264,7 +368,7 @@ fn image_file(statement: &str) -> String {
 /// The folder a mesh's own files (MTL libraries, textures) are relative to.
 pub(crate) fn mesh_folder(mesh: &MeshDesc, base: &Path) -> PathBuf {
     match mesh {
-        MeshDesc::Obj(file) => base
+        MeshDesc::Obj(file) | MeshDesc::Gltf(file) => base
             .join(file)
             .parent()
             .map_or_else(|| base.to_path_buf(), Path::to_path_buf),

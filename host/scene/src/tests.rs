@@ -459,3 +459,65 @@ fn more_textures_than_array_layers_is_an_error() {
     let err = parse(&text).unwrap_err();
     assert!(err.to_string().contains("257 distinct textures"), "{err}");
 }
+
+#[test]
+fn gltf_objects_take_their_materials_textures_and_sides() {
+    let dir = temp_dir("gltf");
+    let spec = crate::gltf_file::tests::document();
+    std::fs::write(dir.join("garden.glb"), spec.to_glb()).unwrap();
+    // The same document as JSON, its image in a file that is missing.
+    let json = spec.to_gltf();
+    let start = json.find("data:image/png").unwrap();
+    let end = start + json[start..].find('"').unwrap();
+    let json = json.replace(&json[start..end], "leaf%20missing.png");
+    std::fs::write(dir.join("garden.gltf"), json).unwrap();
+    let ron = r#"(camera: (position: (0, 0, 5), target: (0, 0, 0)),
+        lights: [Point(position: (0, 3, 3))],
+        objects: [(name: "garden", mesh: Gltf("garden.glb"), transmission: (1, 0.5, 0.5))])"#;
+    let scene = Scene::from_ron(ron, &dir.join("g.ron"), &dir).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["garden/leaves", "garden/glass", "garden/default"]);
+    let [leaves, glass, default] = &scene.objects[..] else {
+        unreachable!()
+    };
+    let mask = leaves.alpha_mask.expect("MASK is an alpha test");
+    assert_eq!(mask.cutoff, 0.5 / 0.8);
+    assert_eq!(leaves.albedo_texture.map(|l| l != mask.layer), Some(true));
+    assert!(leaves.double_sided && !glass.double_sided && !default.double_sided);
+    // The image's alpha ramps 0, 80, 160, 240 across its columns; u = 0.875 is the last.
+    let alpha = scene
+        .textures
+        .alpha(mask.layer, glam::Vec2::new(0.875, 0.5));
+    assert!((alpha - 240.0 / 255.0).abs() < 1e-6, "{alpha}");
+    assert_eq!(leaves.color, Vec3::new(0.5, 1.0, 0.5));
+    assert_eq!((glass.opacity, glass.alpha_mask), (0.25, None));
+    assert_eq!(glass.transmittance(), Some(Vec3::new(0.75, 0.375, 0.375)));
+    assert_eq!((glass.specular, default.opacity), (1.0, 1.0));
+
+    // An image file that is missing: one warning naming it, and the leaves drawn unmasked.
+    let scene = Scene::from_ron(&ron.replace(".glb", ".gltf"), &dir.join("g.ron"), &dir).unwrap();
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        scene.warnings[0].contains("leaf missing.png"),
+        "{:?}",
+        scene.warnings
+    );
+    let mask = scene.objects[0].alpha_mask.unwrap();
+    assert_eq!(
+        scene.textures.alpha(mask.layer, glam::Vec2::splat(0.5)),
+        1.0
+    );
+
+    // A malformed file: one error naming the scene, the field and the file.
+    std::fs::write(dir.join("garden.glb"), b"glTF\x02\0\0\0").unwrap();
+    let err = Scene::from_ron(ron, &dir.join("g.ron"), &dir).unwrap_err();
+    let SceneError::Gltf { field, file, .. } = &err else {
+        panic!("expected a glTF error, got {err}");
+    };
+    assert_eq!(
+        (field.as_str(), file),
+        ("objects[0].mesh", &dir.join("garden.glb"))
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -150,7 +150,10 @@ impl GBuffer {
 
 /// The pipeline that fills the G-buffer.
 pub struct GBufferPass {
+    /// For double-sided objects (every procedural and OBJ mesh).
     pipeline: wgpu::RenderPipeline,
+    /// For single-sided (glTF) materials: back faces culled.
+    single_sided: wgpu::RenderPipeline,
 }
 
 impl GBufferPass {
@@ -175,42 +178,47 @@ impl GBufferPass {
                 write_mask: wgpu::ColorWrites::ALL,
             })
         };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer pipeline"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(Vertex::LAYOUT)],
-            },
-            primitive: wgpu::PrimitiveState {
-                // Open meshes (planes, scanned models) must be visible from both sides.
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[
-                    color(VIEW_DEPTH_FORMAT),
-                    color(NORMAL_FORMAT),
-                    color(ALBEDO_FORMAT),
-                ],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        Ok(GBufferPass { pipeline })
+        let pipeline = |label, cull_mode| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(Vertex::LAYOUT)],
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[
+                        color(VIEW_DEPTH_FORMAT),
+                        color(NORMAL_FORMAT),
+                        color(ALBEDO_FORMAT),
+                    ],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        Ok(GBufferPass {
+            // Open meshes (planes, scanned models) must be visible from both sides.
+            pipeline: pipeline("gbuffer pipeline", None),
+            single_sided: pipeline("gbuffer single-sided pipeline", Some(wgpu::Face::Back)),
+        })
     }
 
     /// Records the G-buffer pass.
@@ -259,7 +267,11 @@ impl GBufferPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &frame.bind_group, &[]);
         pass.set_bind_group(1, &buffers.materials.bind_group, &[]);
-        buffers.draw_objects(&mut pass, scene, false);
+        buffers.draw_objects_where(&mut pass, scene, |_, o| o.double_sided);
+        if scene.objects.iter().any(|o| !o.double_sided) {
+            pass.set_pipeline(&self.single_sided);
+            buffers.draw_objects_where(&mut pass, scene, |_, o| !o.double_sided);
+        }
     }
 }
 
