@@ -83,10 +83,10 @@ impl DocumentSpec {
     pub fn to_glb(&self) -> Vec<u8> {
         let (json, mut bin) = self.json_and_binary(false);
         let mut json = json.into_bytes();
-        while json.len() % 4 != 0 {
+        while !json.len().is_multiple_of(4) {
             json.push(b' ');
         }
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let total = 12 + 8 + json.len() + 8 + bin.len();
@@ -114,7 +114,7 @@ impl DocumentSpec {
         let mut views = Vec::new();
         let mut accessors = Vec::new();
         let mut add_view = |bin: &mut Vec<u8>, bytes: &[u8]| {
-            while bin.len() % 4 != 0 {
+            while !bin.len().is_multiple_of(4) {
                 bin.push(0);
             }
             views.push(format!(

@@ -694,7 +694,7 @@ fn build_mesh(
             let parts = loaded
                 .parts
                 .into_iter()
-                .map(|p| (p.mesh, p.material.map(FileMaterial::Mtl)))
+                .map(|p| (p.mesh, p.material.map(|m| FileMaterial::Mtl(Box::new(m)))))
                 .collect();
             return Ok((parts, loaded.report, loaded.warnings));
         }

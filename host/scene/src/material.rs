@@ -351,7 +351,7 @@ impl ObjectMaterial {
 /// The material a mesh file gives some of its faces.
 #[derive(Debug, Clone)]
 pub(crate) enum FileMaterial {
-    Mtl(tobj::Material),
+    Mtl(Box<tobj::Material>),
     Gltf(GltfMaterial),
 }
 
