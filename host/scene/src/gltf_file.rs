@@ -91,8 +91,22 @@ pub fn load_gltf(path: &Path) -> Result<GltfFile, GltfError> {
 /// Parses glTF or GLB `bytes`; `path` names the file in image keys and resolves its external
 /// buffers and images. See [`load_gltf`].
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<GltfFile, GltfError> {
-    let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice(bytes).map_err(|e| GltfError::Format(e.to_string()))?;
+    if let Some(header) = bytes.strip_prefix(b"glTF") {
+        // The container's parser takes the header's length for granted.
+        let length = header
+            .get(4..8)
+            .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]));
+        if !length.is_some_and(|l| l >= 12) {
+            return Err(GltfError::Format(
+                "GLB header is shorter than 12 bytes".into(),
+            ));
+        }
+    }
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| GltfError::Format(e.to_string()))?;
+    let root = document.into_json();
+    check_position_indices(&root)?;
+    let document = gltf::Document::from_json(root).map_err(|e| GltfError::Format(e.to_string()))?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let buffers = read_buffers(&document, folder, blob)?;
     let buffers: Vec<&[u8]> = buffers.iter().map(Vec::as_slice).collect();
@@ -106,7 +120,7 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<GltfFile, GltfError> {
         warnings.push(format!("extensions ignored: {}", ignored.join(", ")));
     }
 
-    let mut images = ImageSources::new(path, folder, &buffers);
+    let mut images = ImageSources::new(&document, path, folder, &buffers);
     let mut loader = Loader {
         buffers: &buffers,
         parts: Vec::new(),
@@ -148,6 +162,29 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<GltfFile, GltfError> {
         report: loader.report,
         warnings,
     })
+}
+
+/// Checks that every primitive's POSITION names an accessor, which the schema's own checks
+/// take for granted.
+fn check_position_indices(root: &gltf::json::Root) -> Result<(), GltfError> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(index) = primitive.attributes.get(&position)
+                && index.value() >= root.accessors.len()
+            {
+                return Err(GltfError::Invalid {
+                    what: format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
+                    message: format!(
+                        "accessor {} does not exist ({} accessors)",
+                        index.value(),
+                        root.accessors.len()
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Every buffer's bytes: the GLB's binary chunk, a data URI's, or a file's beside the
@@ -514,6 +551,7 @@ fn gltf_material(
 
 /// Where each image of the file comes from: its own file, or bytes inside the file.
 struct ImageSources<'a> {
+    document: &'a gltf::Document,
     path: &'a Path,
     folder: &'a Path,
     buffers: &'a [&'a [u8]],
@@ -522,8 +560,14 @@ struct ImageSources<'a> {
 }
 
 impl<'a> ImageSources<'a> {
-    fn new(path: &'a Path, folder: &'a Path, buffers: &'a [&'a [u8]]) -> Self {
+    fn new(
+        document: &'a gltf::Document,
+        path: &'a Path,
+        folder: &'a Path,
+        buffers: &'a [&'a [u8]],
+    ) -> Self {
         Self {
+            document,
             path,
             folder,
             buffers,
@@ -537,32 +581,43 @@ impl<'a> ImageSources<'a> {
             return known.clone();
         }
         let name = PathBuf::from(format!("{}#images[{}]", self.path.display(), image.index()));
-        let source = match image.source() {
-            gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
-                let file = percent_decoded(uri);
-                Ok(ImageSource::File(self.folder.join(file)))
-            }
-            gltf::image::Source::Uri { uri, .. } => {
-                let source = gltf::buffer::Source::Uri(uri);
-                gltf::buffer::Data::from_source(source, None)
-                    .map(|data| ImageSource::Encoded {
-                        name: name.clone(),
-                        bytes: Arc::from(data.0),
-                    })
-                    .map_err(|e| e.to_string())
-            }
-            gltf::image::Source::View { view, .. } => {
-                let start = view.offset();
-                let bytes = self
-                    .buffers
-                    .get(view.buffer().index())
-                    .and_then(|b| b.get(start..start.checked_add(view.length())?));
-                match bytes {
-                    Some(bytes) => Ok(ImageSource::Encoded {
-                        name: name.clone(),
-                        bytes: Arc::from(bytes),
-                    }),
-                    None => Err("its buffer view reaches past the buffer".into()),
+        // The schema allows an image with neither a URI nor a view with its MIME type, which
+        // the reader cannot represent.
+        let json = &self.document.as_json().images[image.index()];
+        let readable = match json.buffer_view {
+            Some(_) => json.mime_type.is_some(),
+            None => json.uri.is_some(),
+        };
+        let source = if !readable {
+            Err("has neither a URI nor a buffer view with a MIME type".to_string())
+        } else {
+            match image.source() {
+                gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
+                    let file = percent_decoded(uri);
+                    Ok(ImageSource::File(self.folder.join(file)))
+                }
+                gltf::image::Source::Uri { uri, .. } => {
+                    let source = gltf::buffer::Source::Uri(uri);
+                    gltf::buffer::Data::from_source(source, None)
+                        .map(|data| ImageSource::Encoded {
+                            name: name.clone(),
+                            bytes: Arc::from(data.0),
+                        })
+                        .map_err(|e| e.to_string())
+                }
+                gltf::image::Source::View { view, .. } => {
+                    let start = view.offset();
+                    let bytes = self
+                        .buffers
+                        .get(view.buffer().index())
+                        .and_then(|b| b.get(start..start.checked_add(view.length())?));
+                    match bytes {
+                        Some(bytes) => Ok(ImageSource::Encoded {
+                            name: name.clone(),
+                            bytes: Arc::from(bytes),
+                        }),
+                        None => Err("its buffer view reaches past the buffer".into()),
+                    }
                 }
             }
         };

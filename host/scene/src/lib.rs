@@ -833,3 +833,6 @@ fn validate_paths(paths: &PathsDesc, light_count: usize) -> Result<(), (String, 
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod fuzz_tests;

@@ -385,10 +385,11 @@ pub fn parse_obj(text: &str, library_folder: Option<&Path>) -> Result<ObjFile, O
             return Ok(Default::default());
         };
         let file = folder.join(library);
-        let loaded = std::fs::File::open(&file)
+        let loaded = std::fs::read_to_string(&file)
             .map_err(|e| e.to_string())
-            .and_then(|f| {
-                tobj::load_mtl_buf(&mut std::io::BufReader::new(f)).map_err(|e| e.to_string())
+            .and_then(|text| {
+                prevalidate_mtl(&text)?;
+                tobj::load_mtl_buf(&mut text.as_bytes()).map_err(|e| e.to_string())
             });
         loaded.map_err(|e| {
             (warnings.borrow_mut()).push(format!("material library {}: {e}", file.display()));
@@ -467,10 +468,30 @@ pub fn parse_obj(text: &str, library_folder: Option<&Path>) -> Result<ObjFile, O
     })
 }
 
+/// Checks the colour statements of an MTL library, which its parser requires to hold three
+/// numbers; the error names the line.
+fn prevalidate_mtl(text: &str) -> Result<(), String> {
+    for (line_index, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(keyword @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
+            continue;
+        };
+        if words.take(3).filter(|w| w.parse::<f32>().is_ok()).count() < 3 {
+            return Err(format!(
+                "line {}: {keyword} needs three numbers",
+                line_index + 1
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Checks vertex coordinates and face indices line by line, so errors carry line and column.
 /// Returns the number of faces with more than three vertices.
 fn prevalidate_obj(text: &str) -> Result<usize, ObjError> {
     let mut vertex_count = 0i64;
+    let mut texcoord_count = 0i64;
+    let mut normal_count = 0i64;
     let mut polygons = 0;
     for (line_index, line) in text.lines().enumerate() {
         let line_no = line_index + 1;
@@ -523,28 +544,42 @@ fn prevalidate_obj(text: &str) -> Result<usize, ObjError> {
                     polygons += 1;
                 }
                 for corner in corners {
-                    let index_text = corner.split('/').next().unwrap_or("");
-                    let index: i64 = index_text.parse().map_err(|_| ObjError::Syntax {
-                        line: line_no,
-                        col: column_of(corner),
-                        message: format!("`{corner}` is not a vertex index"),
-                    })?;
-                    let resolved = if index < 0 {
-                        vertex_count + index + 1
-                    } else {
-                        index
-                    };
-                    if resolved < 1 || resolved > vertex_count {
-                        return Err(ObjError::Syntax {
+                    // `v`, `v/vt`, `v//vn` or `v/vt/vn`; each index counts from 1, or back
+                    // from the last one defined when negative.
+                    let mut fields = corner.split('/');
+                    for (kind, defined) in [
+                        ("vertex", vertex_count),
+                        ("texture coordinate", texcoord_count),
+                        ("normal", normal_count),
+                    ] {
+                        let text = fields.next().unwrap_or("");
+                        if text.is_empty() && kind != "vertex" {
+                            continue;
+                        }
+                        let index: i64 = text.parse().map_err(|_| ObjError::Syntax {
                             line: line_no,
                             col: column_of(corner),
-                            message: format!(
-                                "vertex index {index} is out of range (1..={vertex_count} defined so far)"
-                            ),
-                        });
+                            message: format!("`{corner}` is not a {kind} index"),
+                        })?;
+                        let resolved = if index < 0 {
+                            defined.saturating_add(index).saturating_add(1)
+                        } else {
+                            index
+                        };
+                        if resolved < 1 || resolved > defined {
+                            return Err(ObjError::Syntax {
+                                line: line_no,
+                                col: column_of(corner),
+                                message: format!(
+                                    "{kind} index {index} is out of range (1..={defined} defined so far)"
+                                ),
+                            });
+                        }
                     }
                 }
             }
+            "vt" => texcoord_count += 1,
+            "vn" => normal_count += 1,
             _ => {}
         }
     }
