@@ -96,7 +96,7 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<GltfFile, GltfError> {
         let length = header
             .get(4..8)
             .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]));
-        if !length.is_some_and(|l| l >= 12) {
+        if length.is_none_or(|l| l < 12) {
             return Err(GltfError::Format(
                 "GLB header is shorter than 12 bytes".into(),
             ));
