@@ -24,8 +24,9 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
-/// One line per registered technique: id, description, supported light kinds, and, when
-/// `gpu` is given, why a technique cannot run on it.
+/// One line per registered technique: id, description, supported light kinds, how it treats
+/// masked casters when not alpha-tested, and, when `gpu` is given, why a technique cannot
+/// run on it.
 pub fn list_techniques(gpu: Option<&GpuContext>) -> String {
     let all = zoo_host::registry();
     let width = all.iter().map(|r| r.id.len()).max().unwrap_or(0);
@@ -35,8 +36,12 @@ pub fn list_techniques(gpu: Option<&GpuContext>) -> String {
                 .and_then(|gpu| r.unavailable_reason(gpu))
                 .map(|reason| format!("  unavailable here: {reason}"))
                 .unwrap_or_default();
+            let masks = match r.masked_casters {
+                zoo_host::MaskedCasters::AlphaTested => String::new(),
+                other => format!("  ({})", other.describe()),
+            };
             format!(
-                "{:width$}  {}  [{}]{unavailable}\n",
+                "{:width$}  {}  [{}]{masks}{unavailable}\n",
                 r.id,
                 r.description,
                 r.light_kind_names()

@@ -555,6 +555,15 @@ fn summary_table(view: &JudgedView) -> String {
             )
             .expect("write to string");
         }
+        if j.masks_opaque {
+            let note = zoo_host::MaskedCasters::Opaque.describe();
+            writeln!(
+                out,
+                "  {:16} {note}: the mask's holes cast shadows",
+                j.technique
+            )
+            .expect("write to string");
+        }
     }
     out
 }

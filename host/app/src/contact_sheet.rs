@@ -64,6 +64,8 @@ pub struct Row {
     pub summary: Option<Summary>,
     /// Lights the technique does not support (rendered unshadowed, not scored).
     pub unsupported: Vec<usize>,
+    /// Whether it treated the scene's masked casters as opaque.
+    pub masks_opaque: bool,
     /// Why the technique failed, if it did.
     pub failure: Option<String>,
     /// Extra note (for the reference tiles).
@@ -120,6 +122,10 @@ impl Row {
             let last = lines.last_mut().expect("three lines");
             let _ = write!(last, "  (lights {} unshadowed)", lights.join(","));
         }
+        if self.masks_opaque {
+            let last = lines.last_mut().expect("three lines");
+            let _ = write!(last, "  ({})", zoo_host::MaskedCasters::Opaque.describe());
+        }
         lines
     }
 }
@@ -174,6 +180,7 @@ pub fn build(
         timings: None,
         summary: None,
         unsupported: Vec::new(),
+        masks_opaque: false,
         failure: None,
         note: Some(traced.clone()),
     };
@@ -216,6 +223,7 @@ pub fn build(
                         .filter(|s| s.metrics.is_none())
                         .map(|s| s.light)
                         .collect(),
+                    masks_opaque: judged.masks_opaque,
                     failure: None,
                     note: None,
                 });
@@ -230,6 +238,7 @@ pub fn build(
                     timings: None,
                     summary: None,
                     unsupported: Vec::new(),
+                    masks_opaque: false,
                     failure: Some(e.to_string()),
                     note: None,
                 });
@@ -423,6 +432,9 @@ pub fn table(sheet: &Sheet) -> String {
         } else if !row.unsupported.is_empty() {
             let lights: Vec<String> = row.unsupported.iter().map(usize::to_string).collect();
             let _ = write!(out, "  lights {} not supported", lights.join(","));
+        }
+        if row.masks_opaque {
+            let _ = write!(out, "  {}", zoo_host::MaskedCasters::Opaque.describe());
         }
         out.push('\n');
     }

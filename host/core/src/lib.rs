@@ -24,9 +24,9 @@ pub use params::{ParamSpec, ParamValue, ParamValues, TechniqueParams};
 pub use render::{Renderer, View};
 pub use scene::{Camera, Light, LightKind, MAX_LIGHTS, Scene};
 pub use technique::{
-    Changes, DebugImage, DebugVolume, ParamUpdate, RenderContext, ResourceInfo, ShadowTechnique,
-    TechniqueError, TechniqueRegistration, TechniqueResult, ViewMapping, VolumeAxis, VolumeSlice,
-    find_technique, registry,
+    Changes, DebugImage, DebugVolume, MaskedCasters, ParamUpdate, RenderContext, ResourceInfo,
+    ShadowTechnique, TechniqueError, TechniqueRegistration, TechniqueResult, ViewMapping,
+    VolumeAxis, VolumeSlice, find_technique, registry,
 };
 
 /// What a technique's crate usually needs: `use zoo_host::prelude::*;`.

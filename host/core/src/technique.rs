@@ -41,6 +41,9 @@ pub struct TechniqueRegistration {
     /// than `unshadowed`, and the judge scores its indirect light against a one-bounce
     /// reference.
     pub adds_light: bool,
+    /// How its shadows treat alpha-masked casters (foliage, fences): alpha-tested like the
+    /// reference (the default), or whole, where the method cannot follow a texture.
+    pub masked_casters: MaskedCasters,
     /// Device features it cannot run without.
     pub required_features: fn() -> wgpu::Features,
     /// Device features it uses when present.
@@ -57,6 +60,26 @@ pub struct TechniqueRegistration {
 }
 
 inventory::collect!(TechniqueRegistration);
+
+/// How a technique's shadows treat casters with an alpha mask.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MaskedCasters {
+    /// Light passes through the mask's holes, as in the reference.
+    AlphaTested,
+    /// The whole surface casts a shadow, holes included: shadow volumes extrude silhouette
+    /// edges of triangles, which cannot follow a texture.
+    Opaque,
+}
+
+impl MaskedCasters {
+    /// How `list`, the contact sheet and the judge's report name it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            MaskedCasters::AlphaTested => "masked casters alpha-tested",
+            MaskedCasters::Opaque => "masked casters opaque",
+        }
+    }
+}
 
 impl std::fmt::Debug for TechniqueRegistration {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -79,6 +102,7 @@ impl TechniqueRegistration {
         readme: "",
         light_kinds: &[],
         adds_light: false,
+        masked_casters: MaskedCasters::AlphaTested,
         required_features: wgpu::Features::empty,
         optional_features: wgpu::Features::empty,
         required_limits: wgpu::Limits::downlevel_defaults,
@@ -119,6 +143,12 @@ impl TechniqueRegistration {
             |name, wanted, allowed| failed.push(format!("{name} {wanted} (device: {allowed})")),
         );
         (!failed.is_empty()).then(|| format!("needs limits {}", failed.join(", ")))
+    }
+
+    /// Whether it treats the masked casters of `scene` as opaque (the scene has some and the
+    /// technique declares [`MaskedCasters::Opaque`]).
+    pub fn masks_opaque_in(&self, scene: &Scene) -> bool {
+        self.masked_casters == MaskedCasters::Opaque && scene.has_masked_casters()
     }
 
     /// Comma-separated supported light kinds.

@@ -430,6 +430,13 @@ impl Scene {
         self.mesh.triangle_count()
     }
 
+    /// Whether any shadow caster has an alpha mask.
+    pub fn has_masked_casters(&self) -> bool {
+        self.objects
+            .iter()
+            .any(|o| o.casts_shadows && o.alpha_mask.is_some())
+    }
+
     /// Whether any shadow caster is translucent (opacity below 1).
     pub fn has_translucent_casters(&self) -> bool {
         self.objects.iter().any(|o| o.transmittance().is_some())

@@ -38,7 +38,7 @@ zoo_host::technique_params! {
     }
 }
 
-/// Uniform data of one (light, plane) pair; `Projection` in `planar/planar.wgsl`.
+/// Uniform data of one (light, plane) pair; `Projection` in `planar/projection.wgsl`.
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 #[repr(C)]
 struct Projection {
@@ -85,7 +85,8 @@ pub struct Planar {
 impl Planar {
     fn create_pipelines(&self, ctx: &RenderContext<'_>) -> Result<Gpu, TechniqueError> {
         let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, "planar/planar.wgsl")?;
+        let mark_module = ctx.shaders.create_module(device, "planar/mark.wgsl")?;
+        let shadow_module = ctx.shaders.create_module(device, "planar/shadow.wgsl")?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("planar projection layout"),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -99,15 +100,19 @@ impl Planar {
                 count: None,
             }],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("planar pipeline layout"),
-            bind_group_layouts: &[
-                Some(&ctx.frame.layout),
-                Some(&ctx.gbuffer.layout),
-                Some(&layout),
-            ],
-            immediate_size: 0,
-        });
+        // Marking reads the G-buffer; the shadow pass reads the casters' materials instead.
+        let pipeline_layout = |label, group_1| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &[Some(&ctx.frame.layout), Some(group_1), Some(&layout)],
+                immediate_size: 0,
+            })
+        };
+        let mark_layout = pipeline_layout("planar mark pipeline layout", &ctx.gbuffer.layout);
+        let shadow_layout = pipeline_layout(
+            "planar shadow pipeline layout",
+            &ctx.scene_buffers.materials.layout,
+        );
         let stencil_face = |compare, pass_op| wgpu::StencilFaceState {
             compare,
             fail_op: wgpu::StencilOperation::Keep,
@@ -115,6 +120,7 @@ impl Planar {
             pass_op,
         };
         let pipeline = |label: &str,
+                        (module, pipeline_layout): (&wgpu::ShaderModule, &wgpu::PipelineLayout),
                         vertex: &str,
                         fragment: &str,
                         visibility: wgpu::ColorTargetState,
@@ -124,9 +130,9 @@ impl Planar {
                         bias: wgpu::DepthBiasState| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
-                layout: Some(&pipeline_layout),
+                layout: Some(pipeline_layout),
                 vertex: wgpu::VertexState {
-                    module: &module,
+                    module,
                     entry_point: Some(vertex),
                     compilation_options: Default::default(),
                     buffers: &[Some(Vertex::LAYOUT)],
@@ -149,7 +155,7 @@ impl Planar {
                 }),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
-                    module: &module,
+                    module,
                     entry_point: Some(fragment),
                     compilation_options: Default::default(),
                     targets: &[
@@ -167,6 +173,7 @@ impl Planar {
         };
         let mark = pipeline(
             "planar mark plane pipeline",
+            (&mark_module, &mark_layout),
             "vs_mark",
             "fs_mark",
             wgpu::ColorTargetState {
@@ -192,6 +199,7 @@ impl Planar {
         );
         let shadow = pipeline(
             "planar shadow pipeline",
+            (&shadow_module, &shadow_layout),
             "vs_shadow",
             "fs_shadow",
             zoo_host::kit::slot_target(),
@@ -355,8 +363,10 @@ impl ShadowTechnique for Planar {
                 let receiver = &scene.receivers[plane.receiver];
                 pass.set_bind_group(2, uniforms, &[plane.offset]);
                 pass.set_stencil_reference(plane.receiver as u32 + 1);
+                pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
                 pass.set_pipeline(&gpu.mark);
                 draw_object(&mut pass, scene, receiver.object);
+                pass.set_bind_group(1, &ctx.scene_buffers.materials.bind_group, &[]);
                 pass.set_pipeline(&gpu.shadow);
                 for (object, o) in scene.objects.iter().enumerate() {
                     if o.casts_shadows && object != receiver.object {
@@ -430,6 +440,12 @@ mod tests {
             light,
             params
         });
-        check_embedded_mirror("planar/planar.wgsl", "Projection", mirror, SizeRule::Equal).unwrap();
+        check_embedded_mirror(
+            "planar/projection.wgsl",
+            "Projection",
+            mirror,
+            SizeRule::Equal,
+        )
+        .unwrap();
     }
 }

@@ -186,3 +186,43 @@ fn disabled_receivers_get_no_shadow() {
         }
     }
 }
+
+/// A fence of masked planks and a chain-link panel over the floor: their holes cast no shadow,
+/// so the flattened casters agree with the judge's exact alpha test on the floor.
+#[test]
+fn masked_casters_shadow_only_where_their_masks_cover() {
+    let scene = floor_scene(
+        "masked",
+        "Directional(direction: (-0.3, -1, -0.2))",
+        r#"(mesh: Plane(size: 3), alpha_mask: Some("textures/fence.png"),
+            transform: (translation: (-1, 1.5, 0), rotation_degrees: (0, 0, 15))),
+           (mesh: Plane(size: 2.5), alpha_mask: Some("textures/chain-link.png"),
+            transform: (translation: (1.5, 1, 1), rotation_degrees: (20, 30, 0)))"#,
+    );
+    let run = judge_scene(scene, "planar", &[], SIZE);
+    let mask = run.receiver_mask();
+    let on_floor = run.metrics_masked(0, &mask);
+    eprintln!("masked casters on the floor: {on_floor:?}");
+    assert!(
+        on_floor.false_shadow_core + on_floor.false_lit_core <= 0.005,
+        "{on_floor:?}"
+    );
+    // The holes matter: a good share of the floor under the casters is lit through them.
+    let values = receiver_values(&run, 0);
+    let shadowed = values.iter().filter(|v| **v < 0.5).count();
+    assert!(shadowed > 1000, "{shadowed} shadowed floor pixels");
+    let mut opaque = run.loaded.clone();
+    for object in &mut opaque.objects {
+        object.alpha_mask = None;
+    }
+    let whole = judge_scene(opaque, "planar", &[], SIZE);
+    let whole_shadowed = receiver_values(&whole, 0)
+        .iter()
+        .filter(|v| **v < 0.5)
+        .count();
+    eprintln!("shadowed floor pixels: {shadowed} masked, {whole_shadowed} with the masks ignored");
+    assert!(
+        (shadowed as f64) < 0.8 * whole_shadowed as f64,
+        "masked {shadowed} against whole {whole_shadowed} shadowed pixels"
+    );
+}

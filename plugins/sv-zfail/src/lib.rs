@@ -268,6 +268,8 @@ zoo_host::register_technique! {
     source: "seed 000 section 8; seed 004 sections 2.4-3.5 and 9.2 (Crow 1977; Carmack, Everitt & Kilgard 2002)",
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
+    // A volume extrudes triangle edges; a mask's holes cannot open it.
+    masked_casters: zoo_host::MaskedCasters::Opaque,
     required_features: || wgpu::Features::DEPTH_CLIP_CONTROL,
     optional_features: wgpu::Features::empty,
     required_limits: || wgpu::Limits {

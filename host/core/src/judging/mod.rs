@@ -197,6 +197,9 @@ pub struct Judged {
     pub slot_count: u32,
     /// The indirect light it added per pixel, for techniques that add light.
     pub indirect: Option<Vec<glam::Vec3>>,
+    /// Whether it treated the scene's alpha-masked casters as opaque (see
+    /// [`crate::MaskedCasters`]).
+    pub masks_opaque: bool,
 }
 
 impl Judged {
@@ -289,6 +292,7 @@ pub fn judge_technique(
         transmittance,
         slot_count: renderer.slots().slot_count(),
         indirect: registration.adds_light.then(|| renderer.read_indirect()),
+        masks_opaque: registration.masks_opaque_in(renderer.scene()),
     })
 }
 

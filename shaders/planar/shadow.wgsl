@@ -1,0 +1,46 @@
+// Planar projected shadows, second pass: the casters flattened onto the marked receiver plane
+// with Blinn's matrix M = (P.L) I - L P^T. Alpha-masked casters are tested at their own
+// texture coordinates (`covered`, the judge's rule), so a mask's holes cast no shadow.
+
+#import "common/frame.wgsl"
+#import "common/materials.wgsl"
+#import "planar/projection.wgsl"
+
+struct ShadowOut {
+    @builtin(position) clip: vec4<f32>,
+    // The unprojected caster point: exact per fragment, since the whole transform is one
+    // projective map and interpolation is perspective-correct.
+    @location(0) world: vec3<f32>,
+    @location(1) uv: vec2<f32>,
+    @location(2) @interpolate(flat) object: u32,
+}
+
+@vertex
+fn vs_shadow(
+    @location(0) position: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @builtin(instance_index) object: u32,
+) -> ShadowOut {
+    var out: ShadowOut;
+    out.clip = camera.view_proj * (projection.shadow_matrix * vec4<f32>(position, 1.0));
+    out.world = position;
+    out.uv = uv;
+    out.object = object;
+    return out;
+}
+
+@fragment
+fn fs_shadow(in: ShadowOut) -> Targets {
+    let height = dot(projection.plane, vec4<f32>(in.world, 1.0));
+    let light_height = dot(projection.plane, projection.light);
+    // Below the plane: a false shadow. At or beyond the light: an anti-shadow. A hole of the
+    // caster's mask: no shadow.
+    if height < 0.0 || (projection.light.w > 0.0 && height >= light_height)
+        || !covered(in.object, in.uv) {
+        discard;
+    }
+    var out: Targets;
+    out.visibility = vec4<f32>(projection.params.x);
+    out.plane_id = 0u;
+    return out;
+}
