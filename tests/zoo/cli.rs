@@ -34,6 +34,12 @@ fn list_shows_every_technique_with_light_kinds() {
             line.contains(r.description) && line.contains(&r.light_kind_names()),
             "{line}"
         );
+        let opaque = zoo_host::MaskedCasters::Opaque;
+        assert_eq!(
+            line.contains(opaque.describe()),
+            r.masked_casters == opaque,
+            "{line}"
+        );
     }
 }
 

@@ -332,6 +332,7 @@ fn shadow_maps_test_alpha_on_the_foliage_scene() {
         let run = judge("foliage.ron", technique, &[], UVec2::new(192, 144));
         let judged = run.judged.scores.iter().filter(|s| s.metrics.is_some());
         assert_eq!(judged.count(), 2, "{technique} judges both lights");
+        assert!(!run.judged.masks_opaque);
         for score in &run.judged.scores {
             let Some(m) = score.metrics else { continue };
             eprintln!(
@@ -344,5 +345,23 @@ fn shadow_maps_test_alpha_on_the_foliage_scene() {
                 score.light
             );
         }
+    }
+}
+
+/// Shadow volumes cannot follow a mask: sv-zfail says so, and the judge measures what it
+/// costs (the holes' light shadowed).
+#[test]
+fn shadow_volumes_declare_and_show_masks_as_opaque() {
+    let run = judge("foliage.ron", "sv-zfail", &[], UVec2::new(192, 144));
+    assert!(run.judged.masks_opaque);
+    for score in &run.judged.scores {
+        let m = score.metrics.expect("sv-zfail supports every light");
+        eprintln!(
+            "sv-zfail light {}: core {:.4}/{:.4} mae {:.4}",
+            score.light, m.false_shadow_core, m.false_lit_core, m.mae
+        );
+        // Nothing falsely lit; the holes' light falsely shadowed.
+        assert!(m.false_lit_core <= 0.001, "{m:?}");
+        assert!(m.false_shadow_core > 0.005, "{m:?}");
     }
 }

@@ -747,6 +747,19 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             }
         );
     }
+    let judged = first.map(|v| v.judged.as_slice()).unwrap_or_default();
+    let masks_opaque: Vec<String> = judged
+        .iter()
+        .filter(|j| j.masks_opaque)
+        .map(|j| format!("`{}`", j.technique))
+        .collect();
+    if !masks_opaque.is_empty() {
+        let _ = writeln!(
+            w,
+            "- Alpha-masked casters: the reference lets light through their holes; {} treat them as opaque (their registrations say so: shadow volumes cannot follow a texture)",
+            masks_opaque.join(", ")
+        );
+    }
     let _ = writeln!(
         w,
         "\nFractions are of the pixels each light reaches. `core` leaves out the one-pixel band around reference shadow boundaries; `mae` and `p95` compare with the area-light reference. Error maps: red = false shadow, blue = false lit, grey = both shadowed.\n"
