@@ -1,5 +1,5 @@
 // The scene's materials: bind group 1 of the passes that draw the scene's geometry (the
-// G-buffer and the shadow-map depth passes). Layout mirrors `zoo_host::render::materials`.
+// G-buffer, the shadow-map depth passes, planar's flattened casters, lpv's reflective maps). Layout mirrors `zoo_host::render::materials`.
 //
 // Alpha tests read the mask at full resolution (level 0), bilinearly, with repeating
 // coordinates: the rule the judge's `Textures::alpha` follows, so that a technique's holes
@@ -23,4 +23,12 @@ fn covered(object: u32, uv: vec2<f32>) -> bool {
     let m = object_materials[object];
     let alpha = textureSampleLevel(material_textures, material_sampler, uv, max(m.mask_layer, 0), 0.0).a;
     return m.mask_layer < 0 || alpha >= m.alpha_cutoff;
+}
+
+// The albedo texture's colour of `object` at `uv`, filtered at the level the fragment's
+// derivatives pick (white without a texture). Fragment stage, uniform control flow.
+fn albedo_texel(object: u32, uv: vec2<f32>) -> vec3<f32> {
+    let layer = object_materials[object].albedo_layer;
+    let texel = textureSample(material_textures, material_sampler, uv, max(layer, 0)).rgb;
+    return select(vec3<f32>(1.0), texel, layer >= 0);
 }

@@ -40,10 +40,8 @@ struct GBufferOut {
 @fragment
 fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     let object = objects[in.object];
-    let material = object_materials[in.object];
-    // Sampled unconditionally (derivatives need uniform control flow), used where the object
-    // has an albedo texture.
-    let texel = textureSample(material_textures, material_sampler, in.uv, max(material.albedo_layer, 0));
+    // Sampled before the alpha test: derivatives need uniform control flow.
+    let texel = albedo_texel(in.object, in.uv);
     if !covered(in.object, in.uv) {
         discard;
     }
@@ -55,9 +53,6 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     var out: GBufferOut;
     out.view_depth = bitcast<u32>(-(camera.view * vec4<f32>(in.world, 1.0)).z);
     out.normal = vec4<f32>(n, object.material.x / 256.0);
-    out.albedo = object.color;
-    if material.albedo_layer >= 0 {
-        out.albedo = vec4<f32>(object.color.rgb * texel.rgb, object.color.a);
-    }
+    out.albedo = vec4<f32>(object.color.rgb * texel, object.color.a);
     return out;
 }

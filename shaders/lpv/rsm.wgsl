@@ -5,8 +5,12 @@
 // (relative to the scene's centre: 16-bit floats keep 1e-3 of the scene's size, and every
 // backend renders them).
 
+// Alpha-masked surfaces reflect nothing where their masks have holes, and albedo textures
+// colour the reflected light, as in the G-buffer.
+
 #import "common/frame.wgsl"
 #import "common/lighting.wgsl"
+#import "common/materials.wgsl"
 
 struct RsmCamera {
     view_proj: mat4x4<f32>,
@@ -23,19 +27,21 @@ struct RsmCamera {
     _pad2: u32,
 }
 
-@group(1) @binding(0) var<uniform> rsm_camera: RsmCamera;
+@group(2) @binding(0) var<uniform> rsm_camera: RsmCamera;
 
 struct RsmVertex {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) object: u32,
+    @location(3) uv: vec2<f32>,
 }
 
 @vertex
 fn vs_rsm(
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
     @builtin(instance_index) object: u32,
 ) -> RsmVertex {
     var out: RsmVertex;
@@ -43,6 +49,7 @@ fn vs_rsm(
     out.world = position;
     out.normal = normal;
     out.object = object;
+    out.uv = uv;
     return out;
 }
 
@@ -54,6 +61,10 @@ struct RsmTexel {
 
 @fragment
 fn fs_rsm(v: RsmVertex, @builtin(front_facing) front: bool) -> RsmTexel {
+    let textured = albedo_texel(v.object, v.uv);
+    if !covered(v.object, v.uv) {
+        discard;
+    }
     let light = lights[rsm_camera.light];
     var n = normalize(v.normal);
     let l = light_vector(light, v.world);
@@ -67,7 +78,7 @@ fn fs_rsm(v: RsmVertex, @builtin(front_facing) front: bool) -> RsmTexel {
         texel *= dot(v.world - rsm_camera.eye.xyz, rsm_camera.axis.xyz);
     }
     let across = texel * texel;
-    let albedo = saturate(objects[v.object].color.rgb);
+    let albedo = saturate(objects[v.object].color.rgb * textured);
     var out: RsmTexel;
     out.flux = vec4<f32>(select(vec3<f32>(0.0), albedo * light.radiance * light_falloff(light, v.world) * across, cosine > 0.0), 1.0);
     out.normal = vec4<f32>(n, across / max(cosine, 0.05));

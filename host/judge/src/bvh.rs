@@ -178,12 +178,23 @@ impl TriangleBvh {
     }
 
     /// The nearest triangle `query` hits: its input index and distance.
+    #[cfg(test)]
     pub(crate) fn closest(&self, query: &Query) -> Option<(usize, f32)> {
+        self.closest_where(query, |_, _| true)
+    }
+
+    /// The nearest hit that `accept(input index, distance)` takes (masked surfaces let rays
+    /// through their holes).
+    pub(crate) fn closest_where(
+        &self,
+        query: &Query,
+        mut accept: impl FnMut(usize, f32) -> bool,
+    ) -> Option<(usize, f32)> {
         let mut best = None;
         self.traverse(query, |range, ray| {
             for i in range {
                 let t = self.triangles[i].intersect(ray);
-                if t < ray.tmax {
+                if t < ray.tmax && accept(self.sources[i], t) {
                     ray.tmax = t;
                     best = Some((self.sources[i], t));
                 }

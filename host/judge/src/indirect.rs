@@ -11,20 +11,32 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use zoo_scene::shading::falloff;
-use zoo_scene::{Light, Scene};
+use zoo_scene::{AlphaMask, Light, Scene, Textures};
 
 use crate::occluders::Occluders;
 use crate::robust::to_light;
 use crate::sampling::stratified_disk;
-use crate::surfaces::{SurfacePoint, Surfaces};
+use crate::surfaces::{SurfacePoint, Surfaces, texture_coordinates};
 
-/// Every surface of a scene as a diffuse reflector: its triangles with their albedo.
+/// Every surface of a scene as a diffuse reflector: its triangles with their albedo, textured
+/// and alpha-tested as the G-buffer draws them.
 pub struct Reflectors {
     surfaces: Surfaces,
-    /// Per triangle: albedo.
-    albedo: Vec<Vec3>,
+    /// Per triangle: its material.
+    materials: Vec<ReflectorMaterial>,
+    textures: Textures,
     /// The corners' least and greatest coordinates.
     bounds: (Vec3, Vec3),
+}
+
+/// The material of one reflecting triangle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ReflectorMaterial {
+    color: Vec3,
+    /// The corners' texture coordinates, where the object has an albedo texture or a mask.
+    uvs: [Vec2; 3],
+    albedo_texture: Option<u32>,
+    alpha_mask: Option<AlphaMask>,
 }
 
 /// Where a ray meets a reflector.
@@ -37,27 +49,55 @@ pub struct ReflectorHit {
 }
 
 impl Reflectors {
-    /// Every object of `scene` (shadow casters or not) with its colour as albedo.
+    /// Every object of `scene` (shadow casters or not): its colour times its albedo texture
+    /// as albedo, its mask's holes passed through (texels read at full resolution, as the
+    /// judge's alpha test does).
     pub fn new(scene: &Scene) -> Reflectors {
-        let mut triangles = Vec::new();
+        let mut corners = Vec::new();
+        let mut materials = Vec::new();
         for object in &scene.objects {
             for tri in scene.mesh.indices[object.indices.clone()].chunks_exact(3) {
-                let corners = [tri[0], tri[1], tri[2]].map(|i| scene.mesh.positions[i as usize]);
-                triangles.push((corners, object.color));
+                let tri = [tri[0], tri[1], tri[2]];
+                corners.push(tri.map(|i| scene.mesh.positions[i as usize]));
+                materials.push(ReflectorMaterial {
+                    color: object.color,
+                    uvs: tri.map(|i| scene.mesh.uvs.get(i as usize).copied().unwrap_or_default()),
+                    albedo_texture: object.albedo_texture,
+                    alpha_mask: object.alpha_mask,
+                });
             }
         }
-        Reflectors::from_triangles(&triangles)
+        Reflectors::with_materials(corners, materials, scene.textures.clone())
     }
 
     /// Reflectors from world-space triangles and their albedo.
     pub fn from_triangles(triangles: &[([Vec3; 3], Vec3)]) -> Reflectors {
-        let bounds = triangles.iter().flat_map(|(t, _)| t).fold(
+        let materials = triangles
+            .iter()
+            .map(|(_, color)| ReflectorMaterial {
+                color: *color,
+                uvs: [Vec2::ZERO; 3],
+                albedo_texture: None,
+                alpha_mask: None,
+            })
+            .collect();
+        let corners = triangles.iter().map(|(t, _)| *t).collect();
+        Reflectors::with_materials(corners, materials, Textures::default())
+    }
+
+    fn with_materials(
+        corners: Vec<[Vec3; 3]>,
+        materials: Vec<ReflectorMaterial>,
+        textures: Textures,
+    ) -> Reflectors {
+        let bounds = corners.iter().flatten().fold(
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),
         );
         Reflectors {
-            surfaces: Surfaces::from_triangles(triangles.iter().map(|(t, _)| *t).collect()),
-            albedo: triangles.iter().map(|(_, albedo)| *albedo).collect(),
+            surfaces: Surfaces::from_triangles(corners),
+            materials,
+            textures,
             bounds,
         }
     }
@@ -65,19 +105,35 @@ impl Reflectors {
     /// The least and greatest coordinates of every reflector (both the origin when there
     /// are none).
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        if self.albedo.is_empty() {
+        if self.materials.is_empty() {
             (Vec3::ZERO, Vec3::ZERO)
         } else {
             self.bounds
         }
     }
 
-    /// The nearest reflector from `origin` along unit `direction`.
+    /// The nearest reflector from `origin` along unit `direction` (through mask holes).
     pub fn closest(&self, origin: Vec3, direction: Vec3) -> Option<ReflectorHit> {
-        let hit = self.surfaces.closest(origin, direction)?;
+        let uv_at = |triangle: usize, t: f32| {
+            let corners = self.surfaces.corners(triangle);
+            let uvs = &self.materials[triangle].uvs;
+            texture_coordinates(corners, uvs, origin + direction * t)
+        };
+        let hit = self
+            .surfaces
+            .closest_where(origin, direction, |triangle, t| {
+                self.materials[triangle].alpha_mask.is_none_or(|mask| {
+                    self.textures.alpha(mask.layer, uv_at(triangle, t)) >= mask.cutoff
+                })
+            })?;
+        let material = &self.materials[hit.triangle];
+        let texel = material.albedo_texture.map_or(Vec3::ONE, |layer| {
+            self.textures
+                .linear_rgb(layer, uv_at(hit.triangle, hit.distance))
+        });
         Some(ReflectorHit {
             point: hit.point,
-            albedo: self.albedo[hit.triangle],
+            albedo: material.color * texel,
             distance: hit.distance,
         })
     }

@@ -4,6 +4,7 @@ use glam::{Vec2, Vec3};
 use zoo_scene::{AlphaMask, Scene, Textures};
 
 use crate::bvh::{Query, TriangleBvh};
+use crate::surfaces::texture_coordinates;
 
 /// Translucent shadow casters: their triangles, the object each belongs to, and the colour
 /// each object lets through.
@@ -27,14 +28,8 @@ impl MaskedCasters {
     /// (alpha at or above the cutoff), read where the hit point's barycentric coordinates put
     /// it in the texture.
     fn blocks(&self, index: usize, origin: Vec3, direction: Vec3, t: f32) -> bool {
-        let ([a, b, c], [ua, ub, uc], mask) = self.triangles[index];
-        let p = origin + direction * t;
-        let (e1, e2, d) = (b - a, c - a, p - a);
-        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-        let (d1, d2) = (d.dot(e1), d.dot(e2));
-        let det = d11 * d22 - d12 * d12;
-        let (v, w) = ((d22 * d1 - d12 * d2) / det, (d11 * d2 - d12 * d1) / det);
-        let uv = ua * (1.0 - v - w) + ub * v + uc * w;
+        let (corners, uvs, mask) = &self.triangles[index];
+        let uv = texture_coordinates(corners, uvs, origin + direction * t);
         self.textures.alpha(mask.layer, uv) >= mask.cutoff
     }
 }

@@ -1,7 +1,7 @@
 //! The surface seen at each pixel, located on the scene's exact triangles, and where rays from
 //! it start.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use zoo_scene::Scene;
 
 use crate::bvh::{Query, TriangleBvh};
@@ -90,10 +90,25 @@ impl Surfaces {
         }
     }
 
+    /// The corners of triangle `index`.
+    pub fn corners(&self, index: usize) -> &[Vec3; 3] {
+        &self.triangles[index]
+    }
+
     /// The nearest surface from `origin` along unit `direction`.
     pub fn closest(&self, origin: Vec3, direction: Vec3) -> Option<SurfaceHit> {
+        self.closest_where(origin, direction, |_, _| true)
+    }
+
+    /// The nearest surface that `accept(triangle, distance)` takes.
+    pub fn closest_where(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        accept: impl FnMut(usize, f32) -> bool,
+    ) -> Option<SurfaceHit> {
         let query = Query::new(origin, direction, f32::INFINITY)?;
-        let (triangle, distance) = self.bvh.closest(&query)?;
+        let (triangle, distance) = self.bvh.closest_where(&query, accept)?;
         let corners = &self.triangles[triangle];
         let (position, error) = barycentric_point(corners, origin, direction);
         let mut normal = (corners[1] - corners[0])
@@ -152,6 +167,18 @@ impl Surfaces {
 /// G-buffer's surface (silhouettes).
 fn reconstruction_error(eye: Vec3, position: Vec3, depth: f32) -> f32 {
     gamma(16) * (eye.abs().max_element() + position.abs().max_element() + depth)
+}
+
+/// The texture coordinates at `point` on the triangle `corners` whose corners have `uvs`
+/// (barycentric interpolation; `point` is taken to lie in the triangle's plane).
+pub(crate) fn texture_coordinates(corners: &[Vec3; 3], uvs: &[Vec2; 3], point: Vec3) -> Vec2 {
+    let [a, b, c] = *corners;
+    let (e1, e2, d) = (b - a, c - a, point - a);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d1, d2) = (d.dot(e1), d.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    let (v, w) = ((d22 * d1 - d12 * d2) / det, (d11 * d2 - d12 * d1) / det);
+    uvs[0] * (1.0 - v - w) + uvs[1] * v + uvs[2] * w
 }
 
 /// The point where the ray from `origin` along `direction` meets the plane of `corners`,

@@ -88,26 +88,46 @@ impl Textures {
     /// full-resolution layer, coordinates repeating outside [0, 1]. The GPU's alpha tests
     /// read the same (level 0, linear filtering, repeat addressing).
     pub fn alpha(&self, layer: u32, uv: Vec2) -> f32 {
-        let Some(texels) = self.layers.get(layer as usize).map(|l| &l.rgba) else {
-            return 1.0;
-        };
+        self.bilinear(layer, uv, |t| f32::from(t[3]) / 255.0)
+            .unwrap_or(1.0)
+    }
+
+    /// The linear colour of `layer` at `uv`: its sRGB texels decoded, then bilinear as
+    /// [`Self::alpha`] (the full-resolution value that GPU filtering of an sRGB texture
+    /// approaches). A missing layer is white.
+    pub fn linear_rgb(&self, layer: u32, uv: Vec2) -> Vec3 {
+        let decode = |c: u8| crate::shading::srgb_to_linear(f32::from(c) / 255.0);
+        self.bilinear(layer, uv, |t| {
+            Vec3::new(decode(t[0]), decode(t[1]), decode(t[2]))
+        })
+        .unwrap_or(Vec3::ONE)
+    }
+
+    /// `texel(rgba)` filtered bilinearly at `uv` in `layer` (`None` for a missing layer or
+    /// non-finite coordinates, which read as opaque white).
+    fn bilinear<T>(&self, layer: u32, uv: Vec2, texel: impl Fn(&[u8]) -> T) -> Option<T>
+    where
+        T: std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+    {
+        let texels = &self.layers.get(layer as usize)?.rgba;
         // Coordinates repeat; wrapped first, so that huge ones cannot overflow the texel index.
         let uv = uv - uv.floor();
         if !uv.is_finite() {
-            return 1.0;
+            return None;
         }
         let n = self.size as i64;
         let x = uv * self.size as f32 - 0.5;
         let base = x.floor();
         let f = x - base;
-        let texel = |dx: i64, dy: i64| {
+        let at = |dx: i64, dy: i64| {
             let i = (base.x as i64 + dx).rem_euclid(n);
             let j = (base.y as i64 + dy).rem_euclid(n);
-            f32::from(texels[((j * n + i) * 4 + 3) as usize]) / 255.0
+            let start = ((j * n + i) * 4) as usize;
+            texel(&texels[start..start + 4])
         };
-        let top = texel(0, 0) * (1.0 - f.x) + texel(1, 0) * f.x;
-        let bottom = texel(0, 1) * (1.0 - f.x) + texel(1, 1) * f.x;
-        top * (1.0 - f.y) + bottom * f.y
+        let top = at(0, 0) * (1.0 - f.x) + at(1, 0) * f.x;
+        let bottom = at(0, 1) * (1.0 - f.x) + at(1, 1) * f.x;
+        Some(top * (1.0 - f.y) + bottom * f.y)
     }
 }
 

@@ -64,6 +64,15 @@ pub fn tonemap(c: Vec3) -> Vec3 {
     Vec3::ONE - (-c).exp()
 }
 
+/// sRGB-encoded [0, 1] to linear [0, 1].
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// Linear [0, 1] to sRGB-encoded [0, 1].
 pub fn linear_to_srgb(c: f32) -> f32 {
     if c <= 0.003_130_8 {

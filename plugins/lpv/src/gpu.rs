@@ -256,7 +256,11 @@ impl Rsm {
         let cameras = UniformSlots::new(ctx.gpu, "lpv rsm cameras", 1, stages);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("lpv rsm pipeline layout"),
-            bind_group_layouts: &[Some(&ctx.frame.layout), Some(cameras.layout())],
+            bind_group_layouts: &[
+                Some(&ctx.frame.layout),
+                Some(&ctx.scene_buffers.materials.layout),
+                Some(cameras.layout()),
+            ],
             immediate_size: 0,
         });
         let targets: Vec<Option<wgpu::ColorTargetState>> = RSM_FORMATS
@@ -352,7 +356,8 @@ impl Rsm {
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            pass.set_bind_group(1, self.cameras.bind_group(), &[self.cameras.offset(layer)]);
+            pass.set_bind_group(1, &ctx.scene_buffers.materials.bind_group, &[]);
+            pass.set_bind_group(2, self.cameras.bind_group(), &[self.cameras.offset(layer)]);
             ctx.scene_buffers.draw_objects(&mut pass, ctx.scene, false);
         }
         Ok(())

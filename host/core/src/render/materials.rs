@@ -155,14 +155,7 @@ fn texture_array(gpu: &GpuContext, scene: &Scene) -> wgpu::Texture {
 /// in linear light (the layers are sRGB-encoded) and alpha as stored.
 fn half_size(level: &[u8], side: u32, usage: TextureUse) -> Vec<u8> {
     let half = side / 2;
-    let decode = |c: u8| {
-        let c = f32::from(c) / 255.0;
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    };
+    let decode = |c: u8| crate::scene::shading::srgb_to_linear(f32::from(c) / 255.0);
     let encode = |c: f32| (crate::scene::shading::linear_to_srgb(c) * 255.0).round() as u8;
     let mut out = Vec::with_capacity((half * half * 4) as usize);
     for y in 0..half {
