@@ -88,13 +88,16 @@ fn check_out_folder(out: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn print_scene(scene: &Scene) {
+/// The scene's size and how long loading it took.
+fn print_scene(scene: &Scene, load_time: std::time::Duration) {
     println!(
-        "scene: {} ({} triangles, {} lights, {} objects)",
+        "scene: {} ({} triangles, {} lights, {} objects, {} texture layers; loaded in {:.2} s)",
         scene.name,
         scene.triangle_count(),
         scene.lights.len(),
-        scene.objects.len()
+        scene.objects.len(),
+        scene.textures.layers.len(),
+        load_time.as_secs_f64()
     );
 }
 
@@ -108,11 +111,13 @@ fn render_sheet(args: &RenderArgs) -> anyhow::Result<()> {
     }
     let registry = zoo_host::registry();
     let params = crate::compare::technique_params(&registry, &args.set)?;
+    let started = std::time::Instant::now();
     let scene = load_scene(args.scene.as_deref())?;
+    let load_time = started.elapsed();
     check_out_folder(&args.out)?;
     let gpu = headless_gpu()?;
     let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
-    print_scene(&scene);
+    print_scene(&scene, load_time);
     let (available, unavailable) = contact_sheet::available_techniques(&gpu);
     for (id, reason) in &unavailable {
         println!("note: {id} is unavailable on this adapter: {reason}");
@@ -162,7 +167,9 @@ fn render_one(args: &RenderArgs, id: &str) -> anyhow::Result<()> {
     let mut values = params::defaults(&schema);
     params::apply_assignments(&schema, &mut values, &args.set)
         .with_context(|| format!("technique `{}`", technique.id))?;
+    let started = std::time::Instant::now();
     let scene = load_scene(args.scene.as_deref())?;
+    let load_time = started.elapsed();
     let view: View = args.view.parse().expect("infallible");
     if let View::Visibility { light } = view
         && light >= scene.lights.len()
@@ -176,7 +183,7 @@ fn render_one(args: &RenderArgs, id: &str) -> anyhow::Result<()> {
 
     let gpu = headless_gpu()?;
     let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
-    print_scene(&scene);
+    print_scene(&scene, load_time);
     let unsupported: Vec<String> = scene
         .lights
         .iter()

@@ -132,10 +132,10 @@ fn build_object(mesh: &MeshData, range: Range<usize>, out: &mut Adjacency) {
         *weld.entry(key).or_insert(index)
     };
 
-    // (min, max) welded vertex pair -> incidences in order of appearance.
-    let mut incidences: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
-    let mut order: Vec<(u32, u32)> = Vec::new();
+    // Every incidence as ((min, max) welded vertex pair, its place in the sequence, incidence),
+    // sorted by pair: each run is one edge, its incidences in order of appearance.
     let first_triangle = range.start / 3;
+    let mut incidences: Vec<(u64, u32, u32)> = Vec::with_capacity(range.len());
     for (t, tri) in mesh.indices[range].chunks_exact(3).enumerate() {
         let triangle = (first_triangle + t) as u32;
         let w = [tri[0], tri[1], tri[2]].map(&mut representative);
@@ -144,30 +144,39 @@ fn build_object(mesh: &MeshData, range: Range<usize>, out: &mut Adjacency) {
             if a == b {
                 continue;
             }
-            let key = (a.min(b), a.max(b));
+            let key = u64::from(a.min(b)) << 32 | u64::from(a.max(b));
             let reversed = u32::from(a > b);
-            let list = incidences.entry(key).or_insert_with(|| {
-                order.push(key);
-                Vec::new()
-            });
-            list.push(triangle << 1 | reversed);
+            incidences.push((key, incidences.len() as u32, triangle << 1 | reversed));
         }
     }
+    incidences.sort_unstable();
 
-    for key in order {
-        let faces = &incidences[&key];
-        let kind = match faces.as_slice() {
+    // Edges in order of their first appearance.
+    let mut runs: Vec<(u32, std::ops::Range<usize>)> = Vec::new();
+    let mut start = 0;
+    for end in 1..=incidences.len() {
+        if end == incidences.len() || incidences[end].0 != incidences[start].0 {
+            runs.push((incidences[start].1, start..end));
+            start = end;
+        }
+    }
+    runs.sort_unstable_by_key(|(first, _)| *first);
+    for (_, run) in runs {
+        let key = incidences[run.start].0;
+        let first_face = out.edge_faces.len();
+        out.edge_faces
+            .extend(incidences[run].iter().map(|&(_, _, incidence)| incidence));
+        let kind = match &out.edge_faces[first_face..] {
             [_] => EdgeKind::Boundary,
             [a, b] if (a & 1) != (b & 1) => EdgeKind::Manifold,
             _ => EdgeKind::NonManifold,
         };
         out.edges.push(EdgeRecord {
-            v0: key.0,
-            v1: key.1,
-            first_face: out.edge_faces.len() as u32,
-            info: EdgeRecord::pack_info(faces.len() as u32, kind),
+            v0: (key >> 32) as u32,
+            v1: key as u32,
+            first_face: first_face as u32,
+            info: EdgeRecord::pack_info((out.edge_faces.len() - first_face) as u32, kind),
         });
-        out.edge_faces.extend_from_slice(faces);
     }
 }
 

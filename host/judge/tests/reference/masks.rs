@@ -93,9 +93,11 @@ fn reflectors_are_textured_and_pass_rays_through_mask_holes() {
     let dir = std::env::temp_dir().join(format!("zoo-judge-reflectors-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // Left half covered, right half a hole; sRGB 188 is linear 0.5 (0.5029).
-    image::RgbaImage::from_fn(8, 8, |x, _| image::Rgba([188, 188, 188, if x < 4 { 255 } else { 0 }]))
-        .save(dir.join("half.png"))
-        .unwrap();
+    image::RgbaImage::from_fn(8, 8, |x, _| {
+        image::Rgba([188, 188, 188, if x < 4 { 255 } else { 0 }])
+    })
+    .save(dir.join("half.png"))
+    .unwrap();
     let text = r#"(
         camera: (position: (0, 5, 5), target: (0, 0, 0)),
         lights: [Directional(direction: (0, -1, 0))],
@@ -108,12 +110,16 @@ fn reflectors_are_textured_and_pass_rays_through_mask_holes() {
     let scene = Scene::from_ron(text, &dir.join("reflectors.ron"), &dir).unwrap();
     let reflectors = zoo_judge::Reflectors::new(&scene);
     // Straight up from below the plate's covered half (x < 0): the plate, textured.
-    let hit = reflectors.closest(Vec3::new(-0.5, 0.0, 0.2), Vec3::Y).unwrap();
+    let hit = reflectors
+        .closest(Vec3::new(-0.5, 0.0, 0.2), Vec3::Y)
+        .unwrap();
     assert!((hit.distance - 1.0).abs() < 1e-5, "{hit:?}");
     let expected = Vec3::new(0.8, 0.6, 0.4) * zoo_scene::shading::srgb_to_linear(188.0 / 255.0);
     assert!(hit.albedo.abs_diff_eq(expected, 1e-5), "{hit:?}");
     // Through the hole (x > 0): the plane above, untextured.
-    let hit = reflectors.closest(Vec3::new(0.5, 0.0, 0.2), Vec3::Y).unwrap();
+    let hit = reflectors
+        .closest(Vec3::new(0.5, 0.0, 0.2), Vec3::Y)
+        .unwrap();
     assert!((hit.distance - 3.0).abs() < 1e-5, "{hit:?}");
     assert_eq!(hit.albedo, Vec3::new(0.2, 0.3, 0.4));
     std::fs::remove_dir_all(&dir).unwrap();
