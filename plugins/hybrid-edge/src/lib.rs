@@ -616,7 +616,8 @@ zoo_host::register_technique! {
     source: "seed 003 (hybrid SM/SV at shadow edges)",
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
-    // Its maps alpha-test, but the volumes that resolve its edge band cannot.
+    // Its edge band is resolved by volumes or by exact tests against triangle ids, and neither
+    // follows a mask (nor do its coverage and id maps).
     masked_casters: zoo_host::MaskedCasters::Opaque,
     required_features: || wgpu::Features::DEPTH_CLIP_CONTROL,
     required_limits: || wgpu::Limits {
