@@ -1,9 +1,8 @@
 // The scene's materials: bind group 1 of the passes that draw the scene's geometry (the
-// G-buffer, the shadow-map depth passes, planar's flattened casters, lpv's reflective maps). Layout mirrors `zoo_host::render::materials`.
-//
-// Alpha tests read the mask at full resolution (level 0), bilinearly, with repeating
-// coordinates: the rule the judge's `Textures::alpha` follows, so that a technique's holes
-// are the reference's.
+// G-buffer, the shadow-map depth passes, planar's flattened casters, lpv's reflective maps).
+// Layout mirrors `zoo_host::render::materials`.
+
+#import "common/alpha_test.wgsl"
 
 struct ObjectMaterial {
     // Texture layers, -1 for none.
@@ -21,8 +20,7 @@ struct ObjectMaterial {
 // Whether the surface of `object` at `uv` is there (not a hole of its alpha mask).
 fn covered(object: u32, uv: vec2<f32>) -> bool {
     let m = object_materials[object];
-    let alpha = textureSampleLevel(material_textures, material_sampler, uv, max(m.mask_layer, 0), 0.0).a;
-    return m.mask_layer < 0 || alpha >= m.alpha_cutoff;
+    return alpha_covers(material_textures, material_sampler, uv, m.mask_layer, m.alpha_cutoff);
 }
 
 // The albedo texture's colour of `object` at `uv`, filtered at the level the fragment's

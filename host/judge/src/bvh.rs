@@ -53,6 +53,35 @@ impl Query {
     }
 }
 
+/// A bounding volume hierarchy in flat arrays: the judge's own build (boxes grown by the
+/// triangle test's rounding), for traversal on the GPU.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FlatBvh {
+    /// Node 0 is the root; an inner node's children are nodes `first` and `first + 1`.
+    pub nodes: Vec<FlatNode>,
+    /// The input index of each stored triangle: a leaf holds stored triangles
+    /// `first..first + count`. Degenerate triangles are left out.
+    pub triangles: Vec<u32>,
+}
+
+/// One node of a [`FlatBvh`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlatNode {
+    pub min: Vec3,
+    pub max: Vec3,
+    /// First child (inner nodes) or first stored triangle (leaves).
+    pub first: u32,
+    /// Number of triangles: 0 for inner nodes.
+    pub count: u32,
+}
+
+impl FlatBvh {
+    /// The hierarchy over world-space `triangles`.
+    pub fn build(triangles: &[[Vec3; 3]]) -> FlatBvh {
+        TriangleBvh::new(triangles).flat()
+    }
+}
+
 /// What a leaf visit tells the traversal.
 enum Visit {
     /// Keep going (with the ray's `tmax` possibly shortened by the visitor).
@@ -125,6 +154,24 @@ impl TriangleBvh {
             bvh,
             triangles,
             sources,
+        }
+    }
+
+    /// The hierarchy in flat arrays, for traversal elsewhere (the GPU's ray tracing).
+    pub(crate) fn flat(&self) -> FlatBvh {
+        if self.triangles.is_empty() {
+            return FlatBvh::default();
+        }
+        FlatBvh {
+            nodes: (self.bvh.nodes.iter())
+                .map(|n| FlatNode {
+                    min: n.aabb.min.into(),
+                    max: n.aabb.max.into(),
+                    first: n.first_index,
+                    count: n.prim_count,
+                })
+                .collect(),
+            triangles: self.sources.iter().map(|&s| s as u32).collect(),
         }
     }
 

@@ -24,6 +24,10 @@ pub struct GpuObjectMaterial {
 pub struct MaterialBindings {
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
+    /// The texture array (for passes that bind it in a group of their own).
+    pub textures: wgpu::TextureView,
+    /// The repeating, linearly filtering sampler of alpha tests and albedo.
+    pub sampler: wgpu::Sampler,
 }
 
 impl MaterialBindings {
@@ -84,7 +88,12 @@ impl MaterialBindings {
                 wgpu::BindingResource::Sampler(&sampler),
             ],
         );
-        MaterialBindings { layout, bind_group }
+        MaterialBindings {
+            layout,
+            bind_group,
+            textures: view,
+            sampler,
+        }
     }
 }
 

@@ -1,0 +1,296 @@
+//! Ray tracing on any adapter: the scene's shadow casters in a bounding volume hierarchy built
+//! on the CPU by the judge's own builder ([`zoo_host::judge::FlatBvh`]), uploaded once per
+//! scene and traversed in WGSL (`ray-tracing/trace.wgsl`: `rt_occluded`, an any-hit shadow
+//! ray). Alpha-masked casters are tested at the hit with the alpha test every pass shares
+//! (`common/alpha_test.wgsl`); translucent casters block like opaque ones.
+//!
+//! The bindings are one group: bind it as group [`GROUP`] of a pipeline whose shader imports
+//! `ray-tracing/trace.wgsl` (a [`zoo_host::kit::FullscreenLightPass`]'s first own group).
+
+use bytemuck::{Pod, Zeroable};
+use zoo_host::judge::FlatBvh;
+use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
+use zoo_host::scene::Scene;
+use zoo_host::{RenderContext, wgpu};
+
+/// The bind group index `ray-tracing/trace.wgsl` declares its bindings in.
+pub const GROUP: u32 = 3;
+
+/// `RtNode` in `ray-tracing/trace.wgsl`: a box, and its children (`first`, `first + 1`) or,
+/// for a leaf (`count` > 0), its triangles `first..first + count`.
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuNode {
+    pub min: [f32; 3],
+    pub first: u32,
+    pub max: [f32; 3],
+    pub count: u32,
+}
+
+/// `RtTriangle` in `ray-tracing/trace.wgsl`: a corner and the two edges from it, the object it
+/// belongs to, and its alpha test (mask layer, -1 for none, and cutoff).
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuTriangle {
+    pub v0: [f32; 3],
+    pub object: u32,
+    pub e1: [f32; 3],
+    pub mask_layer: i32,
+    pub e2: [f32; 3],
+    pub alpha_cutoff: f32,
+}
+
+/// `RtTexcoords` in `ray-tracing/trace.wgsl`: a triangle's corners' texture coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuTexcoords {
+    pub uv: [[f32; 2]; 3],
+    pub _pad: [f32; 2],
+}
+
+/// The shadow casters as the GPU traces them, triangles in the hierarchy's leaf order.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CasterGeometry {
+    pub nodes: Vec<GpuNode>,
+    pub triangles: Vec<GpuTriangle>,
+    pub texcoords: Vec<GpuTexcoords>,
+}
+
+impl CasterGeometry {
+    /// Every shadow caster of `scene` (degenerate triangles left out).
+    pub fn of(scene: &Scene) -> CasterGeometry {
+        let mut corners = Vec::new();
+        let mut records = Vec::new();
+        for (object, o) in scene.objects.iter().enumerate() {
+            if !o.casts_shadows {
+                continue;
+            }
+            for tri in scene.mesh.indices[o.indices.clone()].chunks_exact(3) {
+                let tri = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+                corners.push(tri.map(|i| scene.mesh.positions[i]));
+                let uv = tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default());
+                records.push((object as u32, o.alpha_mask, uv));
+            }
+        }
+        let bvh = FlatBvh::build(&corners);
+        let nodes = bvh
+            .nodes
+            .iter()
+            .map(|n| GpuNode {
+                min: n.min.to_array(),
+                first: n.first,
+                max: n.max.to_array(),
+                count: n.count,
+            })
+            .collect();
+        let (triangles, texcoords) = bvh
+            .triangles
+            .iter()
+            .map(|&source| {
+                let [a, b, c] = corners[source as usize];
+                let (object, mask, uv) = records[source as usize];
+                let triangle = GpuTriangle {
+                    v0: a.to_array(),
+                    object,
+                    e1: (b - a).to_array(),
+                    mask_layer: mask.map_or(-1, |m| m.layer as i32),
+                    e2: (c - a).to_array(),
+                    alpha_cutoff: mask.map_or(0.0, |m| m.cutoff),
+                };
+                let texcoords = GpuTexcoords {
+                    uv: uv.map(|t| t.to_array()),
+                    _pad: [0.0; 2],
+                };
+                (triangle, texcoords)
+            })
+            .unzip();
+        CasterGeometry {
+            nodes,
+            triangles,
+            texcoords,
+        }
+    }
+}
+
+/// The uploaded hierarchy and its bind group (group [`GROUP`]).
+pub struct RayTracing {
+    pub bind_group: wgpu::BindGroup,
+    /// The scene vertex buffer it was built from (a new scene has a new one).
+    vertices: wgpu::Buffer,
+    /// Casters' triangles traced.
+    pub triangle_count: usize,
+}
+
+/// The layout of the ray-tracing group (for the pipelines that bind it).
+pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let stages = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+    bind_group_layout(
+        device,
+        "ray tracing layout",
+        &[
+            storage(0, stages, true),
+            storage(1, stages, true),
+            storage(2, stages, true),
+            texture(
+                3,
+                stages,
+                wgpu::TextureSampleType::Float { filterable: true },
+                wgpu::TextureViewDimension::D2Array,
+            ),
+            sampler(4, stages, wgpu::SamplerBindingType::Filtering),
+        ],
+    )
+}
+
+impl RayTracing {
+    /// Builds and uploads the hierarchy of `ctx`'s scene.
+    pub fn new(ctx: &RenderContext<'_>, layout: &wgpu::BindGroupLayout) -> RayTracing {
+        let geometry = CasterGeometry::of(ctx.scene);
+        let device = &ctx.gpu.device;
+        // Storage buffers cannot be empty: a scene without casters gets one node that no ray
+        // enters (an inverted box) and one unused triangle.
+        let empty = GpuNode {
+            min: [1.0; 3],
+            first: 0,
+            max: [-1.0; 3],
+            count: 0,
+        };
+        let nodes = if geometry.nodes.is_empty() {
+            vec![empty]
+        } else {
+            geometry.nodes.clone()
+        };
+        let or_one = |v: &[u8], size: usize| -> Vec<u8> {
+            if v.is_empty() {
+                vec![0; size]
+            } else {
+                v.to_vec()
+            }
+        };
+        let buffer = |label: &str, contents: &[u8]| {
+            use zoo_host::wgpu::util::DeviceExt;
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let nodes = buffer("ray tracing nodes", bytemuck::cast_slice(&nodes));
+        let triangles = buffer(
+            "ray tracing triangles",
+            &or_one(
+                bytemuck::cast_slice(&geometry.triangles),
+                size_of::<GpuTriangle>(),
+            ),
+        );
+        let texcoords = buffer(
+            "ray tracing texture coordinates",
+            &or_one(
+                bytemuck::cast_slice(&geometry.texcoords),
+                size_of::<GpuTexcoords>(),
+            ),
+        );
+        let materials = &ctx.scene_buffers.materials;
+        let bind_group = bind_group(
+            device,
+            "ray tracing bind group",
+            layout,
+            &[
+                nodes.as_entire_binding(),
+                triangles.as_entire_binding(),
+                texcoords.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&materials.textures),
+                wgpu::BindingResource::Sampler(&materials.sampler),
+            ],
+        );
+        RayTracing {
+            bind_group,
+            vertices: ctx.scene_buffers.vertices.clone(),
+            triangle_count: geometry.triangles.len(),
+        }
+    }
+
+    /// Whether it was built for `ctx`'s scene.
+    pub fn is_for(&self, ctx: &RenderContext<'_>) -> bool {
+        self.vertices == ctx.scene_buffers.vertices
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror};
+
+    #[test]
+    fn records_mirror_the_shader() {
+        let node = zoo_host::mirror_fields!(GpuNode {
+            min,
+            first,
+            max,
+            count
+        });
+        check_embedded_mirror("ray-tracing/trace.wgsl", "RtNode", node, SizeRule::Equal).unwrap();
+        let triangle = zoo_host::mirror_fields!(GpuTriangle {
+            v0,
+            object,
+            e1,
+            mask_layer,
+            e2,
+            alpha_cutoff
+        });
+        check_embedded_mirror(
+            "ray-tracing/trace.wgsl",
+            "RtTriangle",
+            triangle,
+            SizeRule::Equal,
+        )
+        .unwrap();
+        let texcoords = zoo_host::mirror_fields!(GpuTexcoords { uv, _pad });
+        check_embedded_mirror(
+            "ray-tracing/trace.wgsl",
+            "RtTexcoords",
+            texcoords,
+            SizeRule::Equal,
+        )
+        .unwrap();
+    }
+
+    #[test]
+    fn every_caster_triangle_is_stored_once_inside_its_leaf() {
+        let scene = zoo_host::test_support::scene_from_ron(
+            "casters.ron",
+            r#"(camera: (position: (0, 3, 6), target: (0, 0, 0)),
+                lights: [Point(position: (0, 4, 0))],
+                objects: [
+                    (mesh: Plane(size: 10), casts_shadows: false),
+                    (mesh: Sphere(radius: 1, segments: 12, rings: 8)),
+                    (mesh: Box(size: (1, 2, 1)), transform: (translation: (2, 1, 0))),
+                ])"#,
+        );
+        let geometry = CasterGeometry::of(&scene);
+        let casters = scene.objects[1..]
+            .iter()
+            .map(|o| o.indices.len() / 3)
+            .sum::<usize>();
+        assert_eq!(geometry.triangles.len(), casters);
+        assert!(geometry.triangles.iter().all(|t| t.object >= 1));
+        let mut covered = vec![0; geometry.triangles.len()];
+        for node in geometry.nodes.iter().filter(|n| n.count > 0) {
+            let (lo, hi) = (glam_vec(node.min), glam_vec(node.max));
+            for t in &geometry.triangles[node.first as usize..(node.first + node.count) as usize] {
+                let v0 = glam_vec(t.v0);
+                for p in [v0, v0 + glam_vec(t.e1), v0 + glam_vec(t.e2)] {
+                    assert!(p.cmpge(lo - 1e-4).all() && p.cmple(hi + 1e-4).all());
+                }
+            }
+            for c in &mut covered[node.first as usize..(node.first + node.count) as usize] {
+                *c += 1;
+            }
+        }
+        assert!(covered.iter().all(|&c| c == 1), "{covered:?}");
+    }
+
+    fn glam_vec(v: [f32; 3]) -> zoo_host::glam::Vec3 {
+        zoo_host::glam::Vec3::from(v)
+    }
+}

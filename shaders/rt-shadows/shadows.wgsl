@@ -1,0 +1,98 @@
+// Ray-traced shadows: from each pixel's surface, any-hit rays through the casters' hierarchy
+// (`ray-tracing/trace.wgsl`) to the light: one to its centre (hard), or several to points of
+// its disk (soft), the disk and its orientation those of the judge's area reference (a disk
+// of the light's radius facing the point; for the sun, a cone of its angular radius).
+
+#import "common/frame.wgsl"
+#import "common/gbuffer.wgsl"
+#import "common/lighting.wgsl"
+#import "common/fullscreen.wgsl"
+#import "ray-tracing/trace.wgsl"
+
+// Mirrors `RtLight` in plugins/rt-shadows/src/lib.rs.
+struct RtLight {
+    light: u32,
+    // Rays per pixel toward the light's disk (1: its centre).
+    rays: u32,
+    _pad: vec2<u32>,
+}
+
+@group(2) @binding(0) var<uniform> rt_light: RtLight;
+
+// Two unit vectors perpendicular to unit `w` and to each other.
+fn basis(w: vec3<f32>) -> mat2x3<f32> {
+    let helper = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(w.x) < 0.9);
+    let u = normalize(cross(w, helper));
+    return mat2x3<f32>(u, cross(w, u));
+}
+
+// A point of the unit disk for `square` in [0, 1)², area-preserving (Shirley and Chiu's
+// concentric map).
+fn concentric_disk(square: vec2<f32>) -> vec2<f32> {
+    let a = square * 2.0 - 1.0;
+    if all(a == vec2<f32>(0.0)) {
+        return a;
+    }
+    let quarter = 0.78539816;
+    if abs(a.x) > abs(a.y) {
+        let phi = quarter * a.y / a.x;
+        return a.x * vec2<f32>(cos(phi), sin(phi));
+    }
+    let phi = 2.0 * quarter - quarter * a.x / a.y;
+    return a.y * vec2<f32>(cos(phi), sin(phi));
+}
+
+// A hash of the pixel in [0, 1)² (PCG), the rotation of its sample pattern.
+fn pixel_rotation(pixel: vec2<u32>) -> vec2<f32> {
+    var h = pixel.x * 747796405u + pixel.y * 2891336453u + 1u;
+    h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+    let a = (h >> 22u) ^ h;
+    let b = a * 747796405u + 2891336453u;
+    return vec2<f32>(f32(a >> 8u), f32(b >> 8u)) / 16777216.0;
+}
+
+@fragment
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let pixel = vec2<i32>(in.position.xy);
+    let s = load_surface(pixel);
+    let light = lights[rt_light.light];
+    let toward = light_vector(light, s.position);
+    if !s.valid || light_falloff(light, s.position) <= 0.0 {
+        discard;
+    }
+    // Off the surface, on the light's side, by more than the reconstruction's error.
+    let side = select(-s.normal, s.normal, dot(s.normal, toward) >= 0.0);
+    let magnitude = max(max(abs(s.position.x), abs(s.position.y)), abs(s.position.z));
+    let origin = s.position + side * (distance(s.position, camera.position) * 1e-4 + magnitude * 1e-6);
+
+    let rays = select(rt_light.rays, 1u, light.radius <= 0.0);
+    let disk = basis(toward);
+    let rotation = pixel_rotation(vec2<u32>(pixel));
+    var lit = 0u;
+    for (var i = 0u; i < rays; i++) {
+        // A rotated R2 low-discrepancy sequence: stratified for any count.
+        var offset = vec2<f32>(0.0);
+        if rays > 1u {
+            let square = fract(rotation + f32(i) * vec2<f32>(0.7548776662, 0.5698402910));
+            offset = concentric_disk(square);
+        }
+        var direction: vec3<f32>;
+        var reach: f32;
+        if light.kind == LIGHT_DIRECTIONAL {
+            direction = normalize(toward + tan(light.radius) * (disk * offset));
+            reach = 3.0e38;
+        } else {
+            let target_point = light.position + light.radius * (disk * offset);
+            reach = distance(target_point, origin);
+            direction = (target_point - origin) / reach;
+        }
+        if !rt_occluded(origin, direction, reach) {
+            lit += 1u;
+        }
+    }
+    if lit == rays {
+        discard;
+    }
+    // Every channel: the pass's blend constant keeps only this light's.
+    return vec4<f32>(f32(lit) / f32(rays));
+}
