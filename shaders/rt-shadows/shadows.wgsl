@@ -8,16 +8,7 @@
 #import "common/lighting.wgsl"
 #import "common/fullscreen.wgsl"
 #import "ray-tracing/trace.wgsl"
-
-// Mirrors `RtLight` in plugins/rt-shadows/src/lib.rs.
-struct RtLight {
-    light: u32,
-    // Rays per pixel toward the light's disk (1: its centre).
-    rays: u32,
-    _pad: vec2<u32>,
-}
-
-@group(2) @binding(0) var<uniform> rt_light: RtLight;
+#import "rt-shadows/light.wgsl"
 
 // Two unit vectors perpendicular to unit `w` and to each other.
 fn basis(w: vec3<f32>) -> mat2x3<f32> {

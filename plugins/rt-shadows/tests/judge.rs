@@ -41,15 +41,20 @@ fn one_ray_per_light_is_exact() {
 }
 
 /// Soft shadows from rays to the light's disk: the mean error against the area reference
-/// falls as rays are added.
+/// falls as rays are added, and the edge-aware filter lowers it further at a few rays.
 #[test]
-fn soft_shadows_approach_the_area_reference_with_more_rays() {
-    let mae = |rays: &str| {
-        let run = judge("soft.ron", "rt-shadows", &[("rays_per_pixel", rays)], SIZE);
+fn soft_shadows_approach_the_area_reference_with_more_rays_and_the_filter() {
+    let mae = |rays: &str, radius: &str| {
+        let params = [("rays_per_pixel", rays), ("denoise_radius", radius)];
+        let run = judge("soft.ron", "rt-shadows", &params, SIZE);
         let scores: Vec<_> = run.judged.scores.iter().filter_map(|s| s.metrics).collect();
         scores.iter().map(|m| m.mae).sum::<f64>() / scores.len() as f64
     };
-    let (one, four, sixteen) = (mae("1"), mae("4"), mae("16"));
-    eprintln!("soft: mae {one:.4} (1 ray), {four:.4} (4), {sixteen:.4} (16)");
+    let (one, four, sixteen) = (mae("1", "0"), mae("4", "0"), mae("16", "0"));
+    let filtered = mae("4", "2");
+    eprintln!(
+        "soft: mae {one:.4} (1 ray), {four:.4} (4), {sixteen:.4} (16); 4 rays filtered {filtered:.4}"
+    );
     assert!(four < one && sixteen < 0.8 * four, "{one} {four} {sixteen}");
+    assert!(filtered < 0.8 * four, "filtered {filtered} against {four}");
 }
