@@ -12,10 +12,10 @@ struct RtNode {
     count: u32,
 }
 
-// Mirrors `GpuTriangle`: a corner, the edges from it, its object and its alpha test.
+// Mirrors `GpuTriangle`: a corner, the edges from it and its alpha test.
 struct RtTriangle {
     v0: vec3<f32>,
-    object: u32,
+    _pad: u32,
     e1: vec3<f32>,
     mask_layer: i32,
     e2: vec3<f32>,
@@ -34,8 +34,8 @@ struct RtTexcoords {
 @group(3) @binding(3) var rt_textures: texture_2d_array<f32>;
 @group(3) @binding(4) var rt_sampler: sampler;
 
-// Nodes a traversal can hold pending: a binary hierarchy over a few million triangles is far
-// shallower.
+// Nodes a traversal can hold pending (`zoo_ray_tracing::STACK_SIZE`, which refuses deeper
+// hierarchies).
 const RT_STACK_SIZE: u32 = 64u;
 
 // Whether the ray enters the node's box before `tmax` (slab test; `inv_dir` finite).

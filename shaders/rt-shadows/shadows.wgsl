@@ -59,7 +59,11 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let rays = select(rt_light.rays, 1u, light.radius <= 0.0);
     let disk = basis(toward);
     let rotation = pixel_rotation(vec2<u32>(pixel));
+    // Each ray counts with its cosine to the normal, as the judge's area reference: the part
+    // of the light below the surface's horizon lights nothing, shadowed or not.
     var lit = 0u;
+    var arrived = 0.0;
+    var total = 0.0;
     for (var i = 0u; i < rays; i++) {
         // A rotated R2 low-discrepancy sequence: stratified for any count.
         var offset = vec2<f32>(0.0);
@@ -77,13 +81,19 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             reach = distance(target_point, origin);
             direction = (target_point - origin) / reach;
         }
+        let weight = max(dot(s.normal, direction), 0.0);
+        total += weight;
         if !rt_occluded(origin, direction, reach) {
             lit += 1u;
+            arrived += weight;
         }
     }
     if lit == rays {
         discard;
     }
     // Every channel: the pass's blend constant keeps only this light's.
-    return vec4<f32>(f32(lit) / f32(rays));
+    if rays == 1u || total <= 0.0 {
+        return vec4<f32>(f32(lit) / f32(rays));
+    }
+    return vec4<f32>(arrived / total);
 }

@@ -10,6 +10,7 @@ mod contact_sheet;
 mod filtered_shadow_maps;
 mod foliage;
 mod gl_backend;
+mod gpu_judge;
 mod indirect_light;
 mod judge;
 mod kit;

@@ -114,6 +114,20 @@ pub struct CompareArgs {
     /// copies built in), so edited shaders take effect without a rebuild.
     #[arg(long, value_name = "DIR")]
     pub shaders: Option<PathBuf>,
+    /// Where the reference visibility is traced: `cpu` (the arbiter) or `gpu` (the ray-tracing
+    /// library through rt-shadows, at most 64 area samples; scenes without translucent
+    /// casters).
+    #[arg(long, value_enum, default_value_t = Judge::Cpu)]
+    pub judge: Judge,
+}
+
+/// Where `compare` traces its reference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Judge {
+    /// The CPU judge (exact surfaces and error bounds): the arbiter.
+    Cpu,
+    /// The GPU ray tracer.
+    Gpu,
 }
 
 /// Arguments of `shadow-zoo render`.

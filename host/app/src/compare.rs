@@ -15,7 +15,7 @@ use zoo_host::params::{self, ParamValues};
 use zoo_host::scene::paths;
 use zoo_host::{Renderer, Scene, TechniqueRegistration};
 
-use crate::cli::CompareArgs;
+use crate::cli::{CompareArgs, Judge};
 use crate::setup::headless_gpu;
 
 /// The exact header of `results.csv`.
@@ -179,7 +179,14 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     for (view, &time) in times.iter().enumerate() {
         go_to(&mut renderer, time);
         bar.set_message(format!("view {view}: reference"));
-        let mut reference = SceneReference::compute(&mut renderer, args.samples, |_| bar.inc(1))?;
+        let mut reference = match args.judge {
+            Judge::Cpu => SceneReference::compute(&mut renderer, args.samples, |_| bar.inc(1))?,
+            Judge::Gpu => {
+                let traced = crate::gpu_judge::trace_reference(&mut renderer, args.samples)?;
+                bar.inc(light_count as u64);
+                traced
+            }
+        };
         let mut judged = Vec::new();
         for (technique, values) in techniques.iter().zip(&params) {
             bar.set_message(format!("view {view}: {}", technique.id));
@@ -207,10 +214,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     for v in &views {
         println!(
-            "reference{}: {} occluder triangles, {} area samples, traced in {:.2} s",
+            "reference{}: {} occluder triangles, {} area samples, traced on the {} in {:.2} s",
             view_label(v, views.len()),
             v.reference.occluder_triangles,
             v.reference.lights.first().map_or(0, |l| l.samples),
+            judge_name(args.judge),
             v.reference.seconds
         );
     }
@@ -232,6 +240,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         lights: light_count,
         size: (args.size.x, args.size.y),
         adapter: &adapter,
+        judge: args.judge,
         views: &views,
         failures: &failures,
     });
@@ -646,6 +655,14 @@ fn save_radiance(path: &Path, values: &[Vec3], width: usize) -> anyhow::Result<(
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
+/// Where a reference was traced, as the report says it.
+fn judge_name(judge: Judge) -> &'static str {
+    match judge {
+        Judge::Cpu => "CPU",
+        Judge::Gpu => "GPU (rt-shadows)",
+    }
+}
+
 struct ReportInputs<'a> {
     scene: &'a str,
     scene_path: &'a Path,
@@ -653,6 +670,7 @@ struct ReportInputs<'a> {
     lights: usize,
     size: (u32, u32),
     adapter: &'a str,
+    judge: Judge,
     views: &'a [JudgedView],
     /// (view, technique, error) of the runs that failed.
     failures: &'a [(usize, &'static str, String)],
@@ -723,9 +741,10 @@ fn report_md(r: &ReportInputs<'_>) -> String {
         let seconds: f64 = r.views.iter().map(|v| v.reference.seconds).sum();
         let _ = writeln!(
             w,
-            "- Reference: {} occluder triangles, {} area samples per pixel, traced in {:.2} s",
+            "- Reference: {} occluder triangles, {} area samples per pixel, traced on the {} in {:.2} s",
             v.reference.occluder_triangles,
             v.reference.lights.first().map_or(0, |l| l.samples),
+            judge_name(r.judge),
             seconds
         );
     }

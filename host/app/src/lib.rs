@@ -9,6 +9,7 @@ pub mod commands;
 pub mod compare;
 pub mod contact_sheet;
 pub mod font;
+pub mod gpu_judge;
 pub mod setup;
 pub mod viewer;
 

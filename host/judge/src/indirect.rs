@@ -56,12 +56,11 @@ impl Reflectors {
         let mut corners = Vec::new();
         let mut materials = Vec::new();
         for object in &scene.objects {
-            for tri in scene.mesh.indices[object.indices.clone()].chunks_exact(3) {
-                let tri = [tri[0], tri[1], tri[2]];
-                corners.push(tri.map(|i| scene.mesh.positions[i as usize]));
+            for tri in scene.triangle_indices(object) {
+                corners.push(tri.map(|i| scene.mesh.positions[i]));
                 materials.push(ReflectorMaterial {
                     color: object.color,
-                    uvs: tri.map(|i| scene.mesh.uvs.get(i as usize).copied().unwrap_or_default()),
+                    uvs: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
                     albedo_texture: object.albedo_texture,
                     alpha_mask: object.alpha_mask,
                 });

@@ -16,14 +16,14 @@ struct TranslucentCasters {
 }
 
 /// Alpha-tested casters: their triangles with texture coordinates and each one's mask.
-struct MaskedCasters {
+struct AlphaTestedCasters {
     bvh: TriangleBvh,
     /// Per input triangle: its corners, their texture coordinates and its mask.
     triangles: Vec<([Vec3; 3], [Vec2; 3], AlphaMask)>,
     textures: Textures,
 }
 
-impl MaskedCasters {
+impl AlphaTestedCasters {
     /// Whether the hit `t` along the ray on triangle `index` lands on the mask's coverage
     /// (alpha at or above the cutoff), read where the hit point's barycentric coordinates put
     /// it in the texture.
@@ -44,16 +44,8 @@ impl MaskedCasters {
 /// their error bound, [`crate::SurfacePoint::ray_origin`]).
 pub struct Occluders {
     opaque: TriangleBvh,
-    masked: Option<MaskedCasters>,
+    masked: Option<AlphaTestedCasters>,
     translucent: Option<TranslucentCasters>,
-}
-
-/// An object's world-space triangles.
-fn object_triangles(scene: &Scene, object: &zoo_scene::SceneObject) -> Vec<[Vec3; 3]> {
-    scene.mesh.indices[object.indices.clone()]
-        .chunks_exact(3)
-        .map(|tri| [tri[0], tri[1], tri[2]].map(|i| scene.mesh.positions[i as usize]))
-        .collect()
 }
 
 impl Occluders {
@@ -64,13 +56,12 @@ impl Occluders {
         let mut translucent = Vec::new();
         let mut masked = Vec::new();
         for object in scene.objects.iter().filter(|o| o.casts_shadows) {
-            let triangles = object_triangles(scene, object);
+            let triangles: Vec<[Vec3; 3]> = scene.object_triangles(object).collect();
             match (object.transmittance(), object.alpha_mask) {
                 (None, None) => opaque.extend(triangles),
                 (None, Some(mask)) => {
-                    let uvs = scene.mesh.indices[object.indices.clone()]
-                        .chunks_exact(3)
-                        .map(|t| [t[0], t[1], t[2]].map(|i| scene.mesh.uvs[i as usize]));
+                    let uvs =
+                        (scene.triangle_indices(object)).map(|t| t.map(|i| scene.mesh.uvs[i]));
                     masked.extend(triangles.into_iter().zip(uvs).map(|(p, uv)| (p, uv, mask)));
                 }
                 (Some(t), _) => translucent.push((triangles, t)),
@@ -79,7 +70,7 @@ impl Occluders {
         let mut occluders = Occluders::with_translucent(&opaque, &translucent);
         if !masked.is_empty() {
             let corners: Vec<[Vec3; 3]> = masked.iter().map(|(p, _, _)| *p).collect();
-            occluders.masked = Some(MaskedCasters {
+            occluders.masked = Some(AlphaTestedCasters {
                 bvh: TriangleBvh::new(&corners),
                 triangles: masked,
                 textures: scene.textures.clone(),

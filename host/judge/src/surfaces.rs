@@ -70,14 +70,8 @@ pub struct Surfaces {
 impl Surfaces {
     /// Every object of `scene`.
     pub fn new(scene: &Scene) -> Surfaces {
-        let triangles = scene
-            .objects
-            .iter()
-            .flat_map(|object| {
-                scene.mesh.indices[object.indices.clone()]
-                    .chunks_exact(3)
-                    .map(|tri| [tri[0], tri[1], tri[2]].map(|i| scene.mesh.positions[i as usize]))
-            })
+        let triangles = (scene.objects.iter())
+            .flat_map(|object| scene.object_triangles(object))
             .collect();
         Surfaces::from_triangles(triangles)
     }

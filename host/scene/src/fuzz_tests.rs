@@ -147,6 +147,8 @@ mtllib parts.mtl
 v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1
 vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1
 vn 0 0 1\nvn 0 1 0
+v 1 2 3 0.5
+l 1 2 3
 o first
 usemtl painted
 f 1/1/1 2/2/1 3/3/1 4/4/1

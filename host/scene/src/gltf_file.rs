@@ -468,10 +468,16 @@ fn check_accessor(
         .view()
         .ok_or_else(|| "has no buffer view".to_string())?;
     let element = accessor.size();
-    let stride = view.stride().unwrap_or(element).max(element);
+    let stride = view.stride().unwrap_or(element);
+    if stride < element {
+        return Err(format!(
+            "its view's stride of {stride} bytes is less than its {element}-byte elements"
+        ));
+    }
     let end = (accessor.count() - 1)
         .checked_mul(stride)
-        .and_then(|n| n.checked_add(accessor.offset() + element));
+        .and_then(|n| n.checked_add(accessor.offset()))
+        .and_then(|n| n.checked_add(element));
     let data = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
     let view_fits = view
         .offset()

@@ -499,6 +499,19 @@ impl Scene {
         out
     }
 
+    /// The vertex indices of each of `object`'s triangles.
+    pub fn triangle_indices(&self, object: &SceneObject) -> impl Iterator<Item = [usize; 3]> + '_ {
+        self.mesh.indices[object.indices.clone()]
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]].map(|i| i as usize))
+    }
+
+    /// The world-space corners of each of `object`'s triangles.
+    pub fn object_triangles(&self, object: &SceneObject) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+        self.triangle_indices(object)
+            .map(|t| t.map(|i| self.mesh.positions[i]))
+    }
+
     /// Which object each triangle belongs to.
     pub fn triangle_objects(&self) -> Vec<u32> {
         let mut out = vec![0; self.triangle_count()];

@@ -26,9 +26,6 @@ pub enum TextureUse {
     /// Coverage in the layer's alpha: the image's alpha channel, or its red channel when it has
     /// none (greyscale masks, as `map_d` files usually are).
     Mask,
-    /// Coverage in the image's alpha channel alone, opaque when it has none (glTF's base
-    /// colour alpha).
-    Alpha,
 }
 
 /// Where an image's encoded bytes are.
@@ -295,25 +292,28 @@ impl ObjectMaterial {
         };
         let albedo_texture = request(&m.diffuse_texture, TextureUse::Albedo);
         let mask = request(&m.dissolve_texture, TextureUse::Mask);
+        // A masked material is an alpha-tested opaque one: `d` counts only without `map_d`.
+        let opacity = match (mask, m.dissolve.and_then(finite)) {
+            (Some(_), _) => 1.0,
+            (None, Some(d)) => d.clamp(0.0, 1.0),
+            (None, None) => own.opacity,
+        };
         ObjectMaterial {
             name: Some(m.name.clone()),
             color: m.diffuse.and_then(colour).unwrap_or(own.color),
             specular: (m.specular.and_then(colour)).map_or(own.specular, |s| s.max_element()),
             shininess: (m.shininess.and_then(finite))
                 .map_or(own.shininess, |n| n.clamp(1.0, 4096.0)),
-            // A masked material is an alpha-tested opaque one: `d` counts only without `map_d`.
-            opacity: match (mask, m.dissolve.and_then(finite)) {
-                (Some(_), _) => 1.0,
-                (None, Some(d)) => d.clamp(0.0, 1.0),
-                (None, None) => own.opacity,
-            },
+            opacity,
             albedo_texture: albedo_texture.or(own.albedo_texture),
+            // A translucent material is not masked: the object's own mask stays off it.
             alpha_mask: mask
                 .map(|layer| AlphaMask {
                     layer,
                     cutoff: own.alpha_cutoff,
                 })
-                .or(own.alpha_mask),
+                .or(own.alpha_mask)
+                .filter(|_| opacity >= 1.0),
             alpha_cutoff: own.alpha_cutoff,
             double_sided: own.double_sided,
         }
@@ -329,13 +329,11 @@ impl ObjectMaterial {
         textures: &mut TextureRequests,
     ) -> ObjectMaterial {
         let alpha = (m.roughness * m.roughness).max(1e-3);
-        let mut request =
-            |usage| (m.texture.as_ref()).map(|source| textures.request_source(source, usage));
-        let albedo_texture = request(TextureUse::Albedo);
+        let albedo_texture =
+            (m.texture.as_ref()).map(|source| textures.request_source(source, TextureUse::Albedo));
+        // The albedo layer keeps the image's alpha (opaque without one): the mask reads it.
         let alpha_mask = match m.alpha {
-            GltfAlpha::Mask { cutoff } => {
-                request(TextureUse::Alpha).map(|layer| AlphaMask { layer, cutoff })
-            }
+            GltfAlpha::Mask { cutoff } => albedo_texture.map(|layer| AlphaMask { layer, cutoff }),
             _ => None,
         };
         ObjectMaterial {
@@ -348,7 +346,11 @@ impl ObjectMaterial {
                 _ => 1.0,
             },
             albedo_texture: albedo_texture.or(own.albedo_texture),
-            alpha_mask: alpha_mask.or(own.alpha_mask),
+            // A translucent material is not masked: the object's own mask stays off it.
+            alpha_mask: match m.alpha {
+                GltfAlpha::Blend { .. } => None,
+                _ => alpha_mask.or(own.alpha_mask),
+            },
             alpha_cutoff: own.alpha_cutoff,
             double_sided: m.double_sided,
         }

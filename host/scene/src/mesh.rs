@@ -502,7 +502,22 @@ fn prevalidate_obj(text: &str) -> Result<usize, ObjError> {
         let column_of = |word: &str| word.as_ptr() as usize - line.as_ptr() as usize + 1;
         match keyword {
             "v" => {
-                let coords: Vec<&str> = words.take(3).collect();
+                let all: Vec<&str> = words.collect();
+                // x y z, then an optional w that divides them (or r g b, which do not).
+                if let [x, y, z, w] = all[..] {
+                    let scaled = [x, y, z].map(|c| {
+                        let (c, w) = (c.parse::<f32>(), w.parse::<f32>());
+                        c.ok().zip(w.ok()).map(|(c, w)| c / w)
+                    });
+                    if !scaled.iter().all(|c| c.is_some_and(f32::is_finite)) {
+                        return Err(ObjError::Syntax {
+                            line: line_no,
+                            col: column_of(w),
+                            message: format!("vertex weight `{w}` gives non-finite coordinates"),
+                        });
+                    }
+                }
+                let coords: Vec<&str> = all.into_iter().take(3).collect();
                 if coords.len() < 3 {
                     return Err(ObjError::Syntax {
                         line: line_no,
@@ -531,16 +546,17 @@ fn prevalidate_obj(text: &str) -> Result<usize, ObjError> {
                 }
                 vertex_count += 1;
             }
-            "f" => {
+            // Faces and polylines: tobj reads both with the same index rules.
+            "f" | "l" => {
                 let corners: Vec<&str> = words.collect();
-                if corners.len() < 3 {
+                if keyword == "f" && corners.len() < 3 {
                     return Err(ObjError::Syntax {
                         line: line_no,
                         col: line.len() + 1,
                         message: "face needs at least three vertices".into(),
                     });
                 }
-                if corners.len() > 3 {
+                if keyword == "f" && corners.len() > 3 {
                     polygons += 1;
                 }
                 for corner in corners {

@@ -11,10 +11,14 @@ use bytemuck::{Pod, Zeroable};
 use zoo_host::judge::FlatBvh;
 use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
 use zoo_host::scene::Scene;
-use zoo_host::{RenderContext, wgpu};
+use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
 /// The bind group index `ray-tracing/trace.wgsl` declares its bindings in.
 pub const GROUP: u32 = 3;
+
+/// Nodes a traversal can hold pending (`RT_STACK_SIZE` in `ray-tracing/trace.wgsl`): a
+/// hierarchy at most this deep is traversed exactly.
+pub const STACK_SIZE: u32 = 64;
 
 /// `RtNode` in `ray-tracing/trace.wgsl`: a box, and its children (`first`, `first + 1`) or,
 /// for a leaf (`count` > 0), its triangles `first..first + count`.
@@ -27,13 +31,13 @@ pub struct GpuNode {
     pub count: u32,
 }
 
-/// `RtTriangle` in `ray-tracing/trace.wgsl`: a corner and the two edges from it, the object it
-/// belongs to, and its alpha test (mask layer, -1 for none, and cutoff).
+/// `RtTriangle` in `ray-tracing/trace.wgsl`: a corner and the two edges from it, and its alpha
+/// test (mask layer, -1 for none, and cutoff).
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 #[repr(C)]
 pub struct GpuTriangle {
     pub v0: [f32; 3],
-    pub object: u32,
+    pub _pad: u32,
     pub e1: [f32; 3],
     pub mask_layer: i32,
     pub e2: [f32; 3],
@@ -61,15 +65,14 @@ impl CasterGeometry {
     pub fn of(scene: &Scene) -> CasterGeometry {
         let mut corners = Vec::new();
         let mut records = Vec::new();
-        for (object, o) in scene.objects.iter().enumerate() {
+        for o in &scene.objects {
             if !o.casts_shadows {
                 continue;
             }
-            for tri in scene.mesh.indices[o.indices.clone()].chunks_exact(3) {
-                let tri = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+            for tri in scene.triangle_indices(o) {
                 corners.push(tri.map(|i| scene.mesh.positions[i]));
                 let uv = tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default());
-                records.push((object as u32, o.alpha_mask, uv));
+                records.push((o.alpha_mask, uv));
             }
         }
         let bvh = FlatBvh::build(&corners);
@@ -88,10 +91,10 @@ impl CasterGeometry {
             .iter()
             .map(|&source| {
                 let [a, b, c] = corners[source as usize];
-                let (object, mask, uv) = records[source as usize];
+                let (mask, uv) = records[source as usize];
                 let triangle = GpuTriangle {
                     v0: a.to_array(),
-                    object,
+                    _pad: 0,
                     e1: (b - a).to_array(),
                     mask_layer: mask.map_or(-1, |m| m.layer as i32),
                     e2: (c - a).to_array(),
@@ -110,6 +113,25 @@ impl CasterGeometry {
             texcoords,
         }
     }
+
+    /// Levels of the hierarchy (0 without casters): a traversal holds at most this many
+    /// nodes plus one pending.
+    pub fn depth(&self) -> u32 {
+        let mut deepest = 0;
+        let mut pending = if self.nodes.is_empty() {
+            vec![]
+        } else {
+            vec![(0, 1)]
+        };
+        while let Some((index, level)) = pending.pop() {
+            deepest = deepest.max(level);
+            let node = &self.nodes[index as usize];
+            if node.count == 0 {
+                pending.extend([(node.first, level + 1), (node.first + 1, level + 1)]);
+            }
+        }
+        deepest
+    }
 }
 
 /// The uploaded hierarchy and its bind group (group [`GROUP`]).
@@ -117,8 +139,6 @@ pub struct RayTracing {
     pub bind_group: wgpu::BindGroup,
     /// The scene vertex buffer it was built from (a new scene has a new one).
     vertices: wgpu::Buffer,
-    /// Casters' triangles traced.
-    pub triangle_count: usize,
 }
 
 /// The layout of the ray-tracing group (for the pipelines that bind it).
@@ -143,17 +163,27 @@ pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 }
 
 impl RayTracing {
-    /// Builds and uploads the hierarchy of `ctx`'s scene.
-    pub fn new(ctx: &RenderContext<'_>, layout: &wgpu::BindGroupLayout) -> RayTracing {
+    /// Builds and uploads the hierarchy of `ctx`'s scene; an error when it is deeper than the
+    /// traversal's stack holds.
+    pub fn new(
+        ctx: &RenderContext<'_>,
+        layout: &wgpu::BindGroupLayout,
+    ) -> TechniqueResult<RayTracing> {
         let geometry = CasterGeometry::of(ctx.scene);
+        let depth = geometry.depth();
+        if depth >= STACK_SIZE {
+            return Err(TechniqueError::Other(format!(
+                "the casters' hierarchy has {depth} levels; GPU traversal holds {STACK_SIZE}"
+            )));
+        }
         let device = &ctx.gpu.device;
-        // Storage buffers cannot be empty: a scene without casters gets one node that no ray
-        // enters (an inverted box) and one unused triangle.
+        // Storage buffers cannot be empty: a scene without casters gets one leaf over one
+        // triangle without area, which no ray hits.
         let empty = GpuNode {
-            min: [1.0; 3],
+            min: [0.0; 3],
             first: 0,
-            max: [-1.0; 3],
-            count: 0,
+            max: [0.0; 3],
+            count: 1,
         };
         let nodes = if geometry.nodes.is_empty() {
             vec![empty]
@@ -203,11 +233,10 @@ impl RayTracing {
                 wgpu::BindingResource::Sampler(&materials.sampler),
             ],
         );
-        RayTracing {
+        Ok(RayTracing {
             bind_group,
             vertices: ctx.scene_buffers.vertices.clone(),
-            triangle_count: geometry.triangles.len(),
-        }
+        })
     }
 
     /// Whether it was built for `ctx`'s scene.
@@ -232,7 +261,7 @@ mod tests {
         check_embedded_mirror("ray-tracing/trace.wgsl", "RtNode", node, SizeRule::Equal).unwrap();
         let triangle = zoo_host::mirror_fields!(GpuTriangle {
             v0,
-            object,
+            _pad,
             e1,
             mask_layer,
             e2,
@@ -273,7 +302,9 @@ mod tests {
             .map(|o| o.indices.len() / 3)
             .sum::<usize>();
         assert_eq!(geometry.triangles.len(), casters);
-        assert!(geometry.triangles.iter().all(|t| t.object >= 1));
+        assert!(geometry.triangles.iter().all(|t| t.mask_layer == -1));
+        let depth = geometry.depth();
+        assert!((2..STACK_SIZE).contains(&depth), "{depth} levels");
         let mut covered = vec![0; geometry.triangles.len()];
         for node in geometry.nodes.iter().filter(|n| n.count > 0) {
             let (lo, hi) = (glam_vec(node.min), glam_vec(node.max));
@@ -288,6 +319,15 @@ mod tests {
             }
         }
         assert!(covered.iter().all(|&c| c == 1), "{covered:?}");
+    }
+
+    #[test]
+    fn the_shader_holds_as_many_pending_nodes_as_declared() {
+        let composed = zoo_host::ShaderLibrary::embedded()
+            .compose("ray-tracing/trace.wgsl")
+            .unwrap();
+        let size = zoo_host::gpu::layout::wgsl_integer_constant(&composed.source, "RT_STACK_SIZE");
+        assert_eq!(size, Ok(i64::from(STACK_SIZE)));
     }
 
     fn glam_vec(v: [f32; 3]) -> zoo_host::glam::Vec3 {

@@ -126,16 +126,12 @@ struct RtShadows {
 
 impl ShadowTechnique for RtShadows {
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.gpu.is_none() || changes.lights {
-            let tracing = self.gpu.take().and_then(|g| g.tracing);
-            self.gpu = Some(Gpu {
-                tracing,
-                ..Gpu::new(ctx)?
-            });
+        if self.gpu.is_none() {
+            self.gpu = Some(Gpu::new(ctx)?);
         }
         let gpu = self.gpu.as_mut().expect("built above");
-        if gpu.tracing.as_ref().is_none_or(|t| !t.is_for(ctx)) {
-            gpu.tracing = Some(RayTracing::new(ctx, &gpu.tracing_layout));
+        if changes.scene || gpu.tracing.as_ref().is_none_or(|t| !t.is_for(ctx)) {
+            gpu.tracing = Some(RayTracing::new(ctx, &gpu.tracing_layout)?);
         }
         Ok(())
     }

@@ -94,6 +94,26 @@ impl SceneReference {
         })
     }
 
+    /// A reference traced elsewhere (on the GPU): `lights` for the G-buffer `gbuffer`, from
+    /// `occluder_triangles` casters in `seconds`. The one-bounce reference is traced on the CPU
+    /// when asked for.
+    pub fn from_traced(
+        gbuffer: GBufferData,
+        lights: Vec<LightReference>,
+        occluder_triangles: usize,
+        seconds: f64,
+    ) -> SceneReference {
+        SceneReference {
+            gbuffer,
+            lights,
+            occluder_triangles,
+            seconds,
+            indirect: None,
+            unlit: None,
+            bounce: None,
+        }
+    }
+
     /// The one-bounce diffuse reference for this view (irradiance over π per pixel, the
     /// quantity of the indirect target), traced with `samples` rays per pixel when first asked
     /// for with these samples and lights (it costs a BVH of every surface and a shadow ray

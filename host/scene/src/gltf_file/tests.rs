@@ -239,6 +239,25 @@ fn malformed_files_give_one_error_naming_what_failed() {
         err.starts_with("meshes[0].primitives[0].POSITION: Vec4 of F32"),
         "{err}"
     );
+    // A stride shorter than the elements, and an offset that overflows.
+    let err = error_after(
+        &spec,
+        r#"{"buffer":0,"byteOffset":0,"byteLength":48}"#,
+        r#"{"buffer":0,"byteOffset":0,"byteLength":48,"byteStride":4}"#,
+    );
+    assert!(
+        err.contains("stride of 4 bytes is less than its 12-byte"),
+        "{err}"
+    );
+    let err = error_after(
+        &spec,
+        r#"{"bufferView":0,"componentType":5126"#,
+        r#"{"bufferView":0,"byteOffset":18446744073709551615,"componentType":5126"#,
+    );
+    assert!(
+        err.ends_with("reaches past its buffer") || err.contains("byteOffset"),
+        "{err}"
+    );
     // A node that is its own descendant.
     let err = error_after(&spec, r#""children":[1, 2]"#, r#""children":[1, 2, 0]"#);
     assert_eq!(err, "nodes[0]: reached twice: nodes must form trees");

@@ -1,0 +1,89 @@
+//! `compare --judge gpu`: the reference visibility traced on the GPU by the ray-tracing library,
+//! through the `rt-shadows` technique: one ray to each light's centre for hard visibility, and
+//! `samples` rays over its disk, cosine-weighted and unfiltered, for area visibility. Which
+//! pixels each light reaches comes from the CPU judge's own located surfaces, so both judges
+//! score the same pixels. The CPU judge stays the arbiter (`tests/zoo/gpu_judge.rs` measures
+//! their agreement).
+
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use zoo_host::judge::{LightReference, Surfaces};
+use zoo_host::judging::{SceneReference, surface_points};
+use zoo_host::params::{ParamValue, ParamValues, defaults};
+use zoo_host::render::View;
+use zoo_host::scene::shading::contributes;
+use zoo_host::{Renderer, find_technique};
+
+/// The technique that traces the GPU reference.
+pub const TRACER: &str = "rt-shadows";
+
+/// Most area rays per pixel the tracer takes.
+pub const MAX_SAMPLES: u32 = 64;
+
+/// Traces the reference of `renderer`'s current view on the GPU with `samples` area rays per
+/// pixel (at most [`MAX_SAMPLES`]). Scenes with translucent casters are refused: the tracer
+/// does not filter light through them yet.
+pub fn trace_reference(renderer: &mut Renderer, samples: u32) -> anyhow::Result<SceneReference> {
+    let scene = renderer.scene();
+    if scene.has_translucent_casters() {
+        bail!(
+            "--judge gpu: scene {} has translucent casters, which the GPU tracer does not filter \
+             light through yet; use --judge cpu",
+            scene.name
+        );
+    }
+    let tracer = find_technique(TRACER).context("--judge gpu traces with rt-shadows")?;
+    // Any technique leaves the G-buffer the same; render one frame to fill it.
+    renderer.render(&View::Final)?;
+    let gbuffer = renderer.read_gbuffer();
+    let points = surface_points(&gbuffer, &Surfaces::new(renderer.scene()));
+
+    let start = Instant::now();
+    let samples = samples.clamp(1, MAX_SAMPLES);
+    let traced = |renderer: &mut Renderer, rays: u32| -> anyhow::Result<Vec<Vec<f32>>> {
+        let mut values: ParamValues = defaults(&(tracer.params)());
+        values.insert("rays_per_pixel".into(), ParamValue::Int(i64::from(rays)));
+        values.insert("denoise_radius".into(), ParamValue::Int(0));
+        renderer.set_technique(TRACER, &values)?;
+        renderer.render(&View::Final)?;
+        Ok((0..renderer.lights().len())
+            .map(|light| renderer.read_visibility(light))
+            .collect())
+    };
+    let hard = traced(renderer, 1)?;
+    let area = traced(renderer, samples)?;
+    let seconds = start.elapsed().as_secs_f64();
+
+    let lights = renderer
+        .lights()
+        .iter()
+        .zip(hard.into_iter().zip(area))
+        .map(|(light, (hard, area))| {
+            let contributing: Vec<bool> = points
+                .iter()
+                .map(|p| p.is_some_and(|p| contributes(light, p.position, p.normal)))
+                .collect();
+            let keep = |values: Vec<f32>| -> Vec<f32> {
+                values
+                    .into_iter()
+                    .zip(&contributing)
+                    .map(|(v, &c)| if c { v } else { 1.0 })
+                    .collect()
+            };
+            LightReference {
+                hard: keep(hard),
+                area: keep(area),
+                contributing,
+                color: None,
+                samples,
+            }
+        })
+        .collect();
+    let casters = zoo_ray_tracing::CasterGeometry::of(renderer.scene())
+        .triangles
+        .len();
+    Ok(SceneReference::from_traced(
+        gbuffer, lights, casters, seconds,
+    ))
+}
