@@ -95,7 +95,7 @@ fn compare_backends(gl: &Arc<GpuContext>, scene: Scene) {
             registration.id
         );
         // Small maps: parity does not depend on their size.
-        let values = zoo_host::test_support::small_map_params(&(registration.params)());
+        let values = zoo_host::test_support::cheapest_params(&(registration.params)());
         let frame = |renderer: &mut Renderer| {
             renderer.set_technique(registration.id, &values).unwrap();
             renderer.render(&View::Final).unwrap();

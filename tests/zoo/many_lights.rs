@@ -91,7 +91,7 @@ fn a_thousand_and_twenty_four_lights_render_with_every_technique() {
         };
         on_defaults += usize::from(limits.starts_with("WebGPU"));
         let start = std::time::Instant::now();
-        let values = zoo_host::test_support::small_map_params(&(registration.params)());
+        let values = zoo_host::test_support::cheapest_params(&(registration.params)());
         renderer
             .set_technique(registration.id, &values)
             .unwrap_or_else(|e| panic!("{} ({limits}): {e}", registration.id));

@@ -6,7 +6,7 @@
 // Link the application, which links every plugin.
 use shadow_zoo as _;
 use zoo_host::glam::{Quat, UVec2, Vec3};
-use zoo_host::test_support::{gpu, scene_path, small_map_params};
+use zoo_host::test_support::{cheapest_params, gpu, scene_path};
 use zoo_host::{Renderer, View};
 
 const SIZE: UVec2 = UVec2::new(128, 96);
@@ -53,7 +53,7 @@ fn check(scene: &str, technique: &str, params: &[(&str, &str)]) -> (f64, f64) {
     let scene = zoo_host::Scene::load(&scene_path(scene)).unwrap();
     let registration = zoo_host::find_technique(technique).unwrap();
     let schema = (registration.params)();
-    let mut values = small_map_params(&schema);
+    let mut values = cheapest_params(&schema);
     let params: Vec<_> = (params.iter())
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect();

@@ -255,7 +255,7 @@ fn every_viewable_resource_of_every_technique_renders() {
     let mut renderer = Renderer::new(gpu(), scene, UVec2::new(96, 64)).unwrap();
     let mut shown = 0;
     for registration in crate::shipped_techniques() {
-        let values = zoo_host::test_support::small_map_params(&(registration.params)());
+        let values = zoo_host::test_support::cheapest_params(&(registration.params)());
         renderer.set_technique(registration.id, &values).unwrap();
         renderer.render(&View::Final).unwrap();
         let viewable: Vec<String> = renderer

@@ -124,15 +124,15 @@ pub fn scene_from_ron(name: &str, text: &str) -> crate::scene::Scene {
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// A technique's defaults with its shadow maps (`map_size`, where it has one) at the smallest
-/// size it allows: for tests of what renders, not of how accurately (big depth maps are the
-/// dearest work on a software rasterizer).
-pub fn small_map_params(schema: &[crate::params::ParamSpec]) -> crate::params::ParamValues {
+/// A technique's defaults with its dearest work at the least it allows: shadow maps
+/// (`map_size`) at their smallest and rays (`rays_per_pixel`) at their fewest. For tests of
+/// what renders, not of how accurately (big depth maps and many rays are the dearest work on a
+/// software rasterizer).
+pub fn cheapest_params(schema: &[crate::params::ParamSpec]) -> crate::params::ParamValues {
     let mut values = crate::params::defaults(schema);
     for spec in schema {
-        if let (true, crate::params::ParamKind::Int { min, .. }) =
-            (spec.key == "map_size", &spec.kind)
-        {
+        let dear = matches!(spec.key, "map_size" | "rays_per_pixel");
+        if let (true, crate::params::ParamKind::Int { min, .. }) = (dear, &spec.kind) {
             values.insert(spec.key.to_string(), crate::params::ParamValue::Int(*min));
         }
     }
