@@ -1,5 +1,6 @@
 //! A separable Gaussian blur of colour map layers (moment maps, for example), tile by tile
-//! through a one-page scratch texture (`shaders/shadow-maps/blur.wgsl`).
+//! through a one-page scratch texture, every tile of a page in one pass a direction
+//! (`shaders/shadow-maps/blur.wgsl`).
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::gpu::PassRecorder;
@@ -125,19 +126,27 @@ impl LayerBlur {
             })
             .collect();
         self.params.write(ctx.gpu, &params);
-        for (i, tile_pass) in passes.iter().enumerate() {
-            let name = tile_pass.name(base);
-            let page = tile_pass.tile.page as usize;
+        // One pass a page and direction, drawing every tile on the page: render passes, not
+        // draws, are what a tile costs (1024 lights blurred in 128 passes instead of 2048).
+        let mut pages: Vec<u32> = passes.iter().map(|p| p.tile.page).collect();
+        pages.sort_unstable();
+        pages.dedup();
+        for page in pages {
+            let on_page = || (passes.iter().enumerate()).filter(|(_, p)| p.tile.page == page);
             let steps = [
                 (
                     "horizontal",
                     &bound.maps_group,
                     &bound.scratch.layer_views[0],
                 ),
-                ("vertical", &bound.scratch_group, &maps.layer_views[page]),
+                (
+                    "vertical",
+                    &bound.scratch_group,
+                    &maps.layer_views[page as usize],
+                ),
             ];
             for (k, (direction, source, target)) in steps.into_iter().enumerate() {
-                let label = format!("{name} ({direction})");
+                let label = format!("{base} page {page} ({direction})");
                 let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&label),
                     color_attachments: &[zoo_host::gpu::color_attachment(
@@ -149,12 +158,14 @@ impl LayerBlur {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                tile_pass.tile.restrict(&mut pass);
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, source, &[]);
-                let offset = self.params.offset(2 * i + k);
-                pass.set_bind_group(1, self.params.bind_group(), &[offset]);
-                pass.draw(0..3, 0..1);
+                for (i, tile_pass) in on_page() {
+                    tile_pass.tile.restrict(&mut pass);
+                    let offset = self.params.offset(2 * i + k);
+                    pass.set_bind_group(1, self.params.bind_group(), &[offset]);
+                    pass.draw(0..3, 0..1);
+                }
             }
         }
     }

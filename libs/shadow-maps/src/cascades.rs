@@ -8,7 +8,8 @@ use zoo_host::glam::{Mat4, Vec3, Vec4};
 use zoo_host::scene::{Camera, Light, LightKind};
 
 use crate::light_space::{
-    Aabb, LightFrustum, Projection, corners, magnitude, resolvable, transformed_bounds, up_for,
+    Aabb, LightFrustum, Projection, corners, magnitude, resolvable, scene_unit, transformed_bounds,
+    up_for,
 };
 use crate::planning::{LayerPlan, PlanInputs};
 
@@ -26,7 +27,7 @@ pub struct Cascades {
 
 impl Cascades {
     /// The split distances C_0..C_m for `camera` (of `aspect`) over the scene's `objects`.
-    /// With `stable`, the fitted range is widened to quarter-octave steps (near down, far up)
+    /// With `stable`, the fitted range is widened to quarter-octave steps of the scene's size (near down, far up)
     /// so that it, and with it every split's crop, changes only now and then as the camera
     /// moves.
     pub fn distances(
@@ -38,12 +39,13 @@ impl Cascades {
     ) -> Vec<f32> {
         let (mut near, mut far) = visible_depth_range(camera, aspect, objects);
         if stable {
-            near = ((near.log2() * 4.0).floor() / 4.0)
-                .exp2()
-                .clamp(camera.near, near);
-            far = ((far.log2() * 4.0).ceil() / 4.0)
-                .exp2()
-                .clamp(far, camera.far.max(far));
+            // Octaves of the scene's size, so a scaled scene gets the same splits, scaled.
+            let unit = scene_unit(objects);
+            let step = |d: f32, round: fn(f32) -> f32| {
+                unit * (round((d / unit).log2() * 4.0) / 4.0).exp2()
+            };
+            near = step(near, f32::floor).clamp(camera.near, near);
+            far = step(far, f32::ceil).clamp(far, camera.far.max(far));
         }
         split_distances(near, far, self.splits, self.lambda)
     }
@@ -182,7 +184,7 @@ pub fn slice_sphere(corners: &[Vec3; 8]) -> (Vec3, f32) {
 /// whose box overlaps the crop.
 ///
 /// With `stable_texels` = Some(resolution) the crop is the slice's bounding sphere, its extent
-/// quantised (steps of 1/64 of a power of two) and its centre snapped to whole texels, so the
+/// quantised (steps of 1/64 of a power of two of the casters' overall size) and its centre snapped to whole texels, so the
 /// crop does not change as the camera turns and moves by whole texels as it walks: shadow
 /// edges do not shimmer. Without, the crop is the tight box around the slice.
 pub fn cascade_frustum(
@@ -196,7 +198,10 @@ pub fn cascade_frustum(
     let (mut centre, extent);
     if let Some(resolution) = stable_texels {
         let (sphere_centre, radius) = slice_sphere(corners);
-        let quantum = 2f32.powf(resolvable(2.0 * radius, magnitude(lo, hi)).log2().floor()) / 64.0;
+        // Powers of two of the scene's size, so a scaled scene gets the same crops, scaled.
+        let unit = scene_unit(casters);
+        let diameter = resolvable(2.0 * radius, magnitude(lo, hi));
+        let quantum = unit * 2f32.powf((diameter / unit).log2().floor()) / 64.0;
         // Two texels of margin: snapping moves the sphere by up to half a texel.
         extent = ((2.0 * radius) / quantum).ceil() * quantum * (1.0 + 2.0 / resolution as f32);
         let texel = extent / resolution as f32;
@@ -297,6 +302,50 @@ mod tests {
     fn inside(frustum: &LightFrustum, p: Vec3) -> bool {
         let q = frustum.view_proj.project_point3(p);
         q.x.abs() <= 1.0 + 1e-5 && q.y.abs() <= 1.0 + 1e-5 && (-1e-5..=1.0 + 1e-5).contains(&q.z)
+    }
+
+    #[test]
+    fn stable_splits_and_crops_scale_with_the_scene() {
+        // Quantised to the scene's size: the same scene at any scale gets the same splits and
+        // crops, scaled.
+        let direction = Vec3::new(0.82, -0.32, -0.48).normalize();
+        let fit = |s: f32| {
+            let c = camera();
+            let camera = Camera {
+                position: c.position * s,
+                target: c.target * s,
+                near: c.near * s,
+                far: c.far * s,
+                ..c
+            };
+            let ground = (
+                Vec3::new(-300.0, -1.0, -300.0) * s,
+                Vec3::new(300.0, 0.0, 300.0) * s,
+            );
+            let cascades = Cascades {
+                splits: 4,
+                lambda: 0.5,
+                blend: 0.0,
+            };
+            let d = cascades.distances(&camera, 1.5, &[ground], true);
+            let corners = slice_corners(&camera, 1.5, d[0], d[1]);
+            let f = cascade_frustum(direction, &corners, &[ground], Some(1024));
+            let Projection::Orthographic { extent, .. } = f.projection else {
+                unreachable!()
+            };
+            let mut out: Vec<f32> = d.iter().map(|x| x / s).collect();
+            out.push(extent / s);
+            out
+        };
+        let unit = fit(1.0);
+        for s in [0.01, 0.37, 100.0, 10_000.0] {
+            for (a, b) in unit.iter().zip(fit(s)) {
+                assert!(
+                    (a - b).abs() <= 1e-4 * a.abs().max(1.0),
+                    "{a} and {b} at scale {s}"
+                );
+            }
+        }
     }
 
     #[test]

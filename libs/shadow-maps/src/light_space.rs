@@ -113,6 +113,20 @@ pub fn resolvable(length: f32, magnitude: f32) -> f32 {
     length.max(magnitude.abs() * 1e-6).max(1e-30)
 }
 
+/// The diagonal of the box around `boxes` (1 when there are none): the unit that quantised
+/// fits are measured in, so that they scale with the scene.
+pub(crate) fn scene_unit(boxes: &[Aabb]) -> f32 {
+    let (lo, hi) = boxes.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
+    );
+    if lo.cmple(hi).all() && (hi - lo).is_finite() {
+        resolvable(lo.distance(hi), magnitude(lo, hi))
+    } else {
+        1.0
+    }
+}
+
 /// The largest absolute coordinate of two points.
 pub(crate) fn magnitude(a: Vec3, b: Vec3) -> f32 {
     a.abs().max(b.abs()).max_element()
@@ -237,7 +251,7 @@ pub fn camera_frustum_corners(camera: &Camera, aspect: f32, far: f32) -> [Vec3; 
 /// frustum), and its depth range reaches back to every caster that can shadow them.
 ///
 /// With `stable_texels` = Some(resolution), the extent is rounded up to a step of a geometric
-/// ladder (ratio 1.25) and the centre snapped to whole texels, so small camera moves leave the
+/// ladder (ratio 1.25, anchored to the size of the objects' bounds) and the centre snapped to whole texels, so small camera moves leave the
 /// map unchanged and larger ones move it by whole texels: shadow edges do not shimmer.
 pub fn directional_frustum(
     direction: Vec3,
@@ -283,9 +297,12 @@ pub fn directional_frustum(
     let mut extent = resolvable((hi.x - lo.x).max(hi.y - lo.y), magnitude(lo, hi)) * 1.02;
     let mut center = (lo + hi) * 0.5;
     if let Some(resolution) = stable_texels {
-        // Two texels of margin: rounding the centre moves the receivers by up to half a texel.
-        extent = 1.25f32.powf(extent.ln().div_euclid(1.25f32.ln()) + 1.0)
-            * (1.0 + 2.0 / resolution as f32);
+        // The ladder's rungs are fractions of the scene's size, not of a world unit, so a
+        // scene scaled by any factor gets the same map, scaled. Two texels of margin:
+        // rounding the centre moves the receivers by up to half a texel.
+        let unit = scene_unit(objects);
+        let rung = (extent / unit).ln().div_euclid(1.25f32.ln()) + 1.0;
+        extent = unit * 1.25f32.powf(rung) * (1.0 + 2.0 / resolution as f32);
         let texel = extent / resolution as f32;
         center.x = (center.x / texel).round() * texel;
         center.y = (center.y / texel).round() * texel;
@@ -383,6 +400,43 @@ mod tests {
             unreachable!()
         };
         assert_eq!(f.texel_world_size(Vec3::ZERO, 1024), extent / 1024.0);
+    }
+
+    #[test]
+    fn stable_directional_fits_scale_with_the_scene() {
+        // The extent's ladder is anchored to the scene's size: the same scene at any scale gets
+        // the same map, scaled (a ladder of world units gave maps up to 25 % apart).
+        let fit = |s: f32| {
+            let camera = Camera {
+                position: Vec3::new(3.0, 4.0, 6.0) * s,
+                target: Vec3::ZERO,
+                fov_y: 50f32.to_radians(),
+                near: 0.1 * s,
+                far: 200.0 * s,
+            };
+            let floor = (
+                Vec3::new(-7.0, -0.01, -7.0) * s,
+                Vec3::new(7.0, 0.0, 7.0) * s,
+            );
+            let post = (Vec3::new(-0.3, 0.0, -0.3) * s, Vec3::new(0.3, 2.5, 0.3) * s);
+            let direction = Vec3::new(0.5, -1.0, -0.3).normalize();
+            let objects = [floor, post];
+            let f = directional_frustum(direction, &camera, 1.0, &objects, &objects, Some(256));
+            let Projection::Orthographic { extent, near, far } = f.projection else {
+                unreachable!()
+            };
+            (extent / s, near / s, far / s)
+        };
+        let unit = fit(1.0);
+        for s in [0.01, 0.37, 100.0, 10_000.0] {
+            let scaled = fit(s);
+            for (a, b) in [(unit.0, scaled.0), (unit.1, scaled.1), (unit.2, scaled.2)] {
+                assert!(
+                    (a - b).abs() <= 1e-4 * a.abs().max(1.0),
+                    "{unit:?} at scale {s}: {scaled:?}"
+                );
+            }
+        }
     }
 
     #[test]
