@@ -1,5 +1,5 @@
 // Edge-aware spatial filter of rt-shadows' soft visibility: each pixel the weighted mean of the
-// traced visibility around it (a copy of the slots, group 3), weighted by a Gaussian of the
+// accumulated visibility around it (the history, group 3), weighted by a Gaussian of the
 // pixel distance, by how near each neighbour lies to the pixel's tangent plane (relative to its
 // view distance), by how closely their normals agree and by how close their traced values are
 // (a cross-bilateral filter), so that the noise of penumbrae is smoothed while shadows do not
@@ -11,7 +11,7 @@
 #import "common/fullscreen.wgsl"
 #import "rt-shadows/light.wgsl"
 
-@group(3) @binding(0) var traced: texture_2d_array<f32>;
+@group(3) @binding(0) var history: texture_2d_array<f32>;
 
 // A neighbour counts fully within this fraction of the view distance off the tangent plane.
 const PLANE_TOLERANCE: f32 = 0.01;
@@ -36,7 +36,7 @@ fn settled(pixel: vec2<i32>, centre: f32, size: vec2<i32>) -> bool {
 }
 
 fn traced_at(pixel: vec2<i32>) -> f32 {
-    return textureLoad(traced, pixel, rt_light.layer, 0)[rt_light.channel];
+    return textureLoad(history, pixel, rt_light.layer, 0)[rt_light.channel];
 }
 
 @fragment
@@ -44,15 +44,15 @@ fn fs_denoise(in: FullscreenOut) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(in.position.xy);
     let s = load_surface(pixel);
     let radius = i32(rt_light.denoise_radius);
-    if radius == 0 || !s.valid {
+    if rt_light.soft == 0u || !s.valid {
         discard;
     }
     let size = vec2<i32>(camera.size);
     let tolerance = PLANE_TOLERANCE * distance(s.position, camera.position);
     let sigma = max(f32(radius) * 0.5, 0.5);
     let centre = traced_at(pixel);
-    if settled(pixel, centre, size) {
-        discard;
+    if radius == 0 || settled(pixel, centre, size) {
+        return vec4<f32>(centre);
     }
     var sum = 0.0;
     var weights = 0.0;

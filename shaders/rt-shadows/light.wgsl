@@ -8,11 +8,15 @@ struct RtLight {
     // The light's visibility slot: array layer and channel.
     layer: u32,
     channel: u32,
-    // Radius in pixels of the denoising filter; 0 leaves the light as traced.
+    // Radius in pixels of the denoising filter (0: the history as it is).
     denoise_radius: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1: a soft light, traced into the history (`fs_accumulate`) and resolved into its slot by
+    // the filter; 0: traced straight into its slot (`fs_main`).
+    soft: u32,
+    // Frames since the view last changed: where the sample sequence continues.
+    frame: u32,
+    // Weight of the previous history in the new one (0: start again).
+    history_weight: f32,
 }
 
 @group(2) @binding(0) var<uniform> rt_light: RtLight;

@@ -1,7 +1,9 @@
 // Ray-traced shadows: from each pixel's surface, any-hit rays through the casters' hierarchy
 // (`ray-tracing/trace.wgsl`) to the light: one to its centre (hard), or several to points of
 // its disk (soft), the disk and its orientation those of the judge's area reference (a disk
-// of the light's radius facing the point; for the sun, a cone of its angular radius).
+// of the light's radius facing the point; for the sun, a cone of its angular radius). Hard
+// lights go straight into their slots; soft ones into a history averaged over frames, which
+// the filter (`rt-shadows/denoise.wgsl`) resolves into their slots.
 
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
@@ -33,6 +35,12 @@ fn concentric_disk(square: vec2<f32>) -> vec2<f32> {
     return a.y * vec2<f32>(cos(phi), sin(phi));
 }
 
+// Point `index` of the R2 low-discrepancy sequence (stratified for any count), in 0.32 fixed
+// point so that it stays exact however long frames accumulate.
+fn r2(index: u32) -> vec2<f32> {
+    return vec2<f32>(f32((index * 3242174889u) >> 8u), f32((index * 2447445413u) >> 8u)) / 16777216.0;
+}
+
 // A hash of the pixel in [0, 1)² (PCG), the rotation of its sample pattern.
 fn pixel_rotation(pixel: vec2<u32>) -> vec2<f32> {
     var h = pixel.x * 747796405u + pixel.y * 2891336453u + 1u;
@@ -42,14 +50,14 @@ fn pixel_rotation(pixel: vec2<u32>) -> vec2<f32> {
     return vec2<f32>(f32(a >> 8u), f32(b >> 8u)) / 16777216.0;
 }
 
-@fragment
-fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let pixel = vec2<i32>(in.position.xy);
+// The light's visibility from the surface at `pixel` (1 where there is none or the light does
+// not reach).
+fn trace(pixel: vec2<i32>) -> f32 {
     let s = load_surface(pixel);
     let light = lights[rt_light.light];
     let toward = light_vector(light, s.position);
     if !s.valid || light_falloff(light, s.position) <= 0.0 {
-        discard;
+        return 1.0;
     }
     // Off the surface, on the light's side, by more than the reconstruction's error.
     let side = select(-s.normal, s.normal, dot(s.normal, toward) >= 0.0);
@@ -65,11 +73,10 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     var arrived = 0.0;
     var total = 0.0;
     for (var i = 0u; i < rays; i++) {
-        // A rotated R2 low-discrepancy sequence: stratified for any count.
+        // The rotated R2 sequence, continued frame after frame.
         var offset = vec2<f32>(0.0);
         if rays > 1u {
-            let square = fract(rotation + f32(i) * vec2<f32>(0.7548776662, 0.5698402910));
-            offset = concentric_disk(square);
+            offset = concentric_disk(fract(rotation + r2(rt_light.frame * rays + i)));
         }
         var direction: vec3<f32>;
         var reach: f32;
@@ -88,12 +95,31 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             arrived += weight;
         }
     }
-    if lit == rays {
+    if rays == 1u || total <= 0.0 {
+        return f32(lit) / f32(rays);
+    }
+    return arrived / total;
+}
+
+// Hard lights, into their slots (which hold 1, lit, until written).
+@fragment
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let visibility = trace(vec2<i32>(in.position.xy));
+    if rt_light.soft == 1u || visibility >= 1.0 {
         discard;
     }
     // Every channel: the pass's blend constant keeps only this light's.
-    if rays == 1u || total <= 0.0 {
-        return vec4<f32>(f32(lit) / f32(rays));
-    }
-    return vec4<f32>(arrived / total);
+    return vec4<f32>(visibility);
+}
+
+// The history before this frame (`fs_accumulate` only).
+@group(4) @binding(0) var previous: texture_2d_array<f32>;
+
+// Soft lights, into the history: this frame's rays averaged with the frames before.
+@fragment
+fn fs_accumulate(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let pixel = vec2<i32>(in.position.xy);
+    let before = textureLoad(previous, pixel, rt_light.layer, 0)[rt_light.channel];
+    // Every channel: the pass's blend constant keeps only this light's.
+    return vec4<f32>(mix(trace(pixel), before, rt_light.history_weight));
 }

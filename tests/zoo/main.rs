@@ -20,6 +20,7 @@ mod perspective_aliasing;
 mod plugin_failure;
 mod recorder;
 mod slots;
+mod soft_ray_tracing;
 mod techniques;
 mod viewer;
 

@@ -45,6 +45,8 @@ pub fn trace_reference(renderer: &mut Renderer, samples: u32) -> anyhow::Result<
         let mut values: ParamValues = defaults(&(tracer.params)());
         values.insert("rays_per_pixel".into(), ParamValue::Int(i64::from(rays)));
         values.insert("denoise_radius".into(), ParamValue::Int(0));
+        // One frame of unfiltered rays: the reference's samples, nothing averaged in.
+        values.insert("accumulation".into(), ParamValue::Int(1));
         renderer.set_technique(TRACER, &values)?;
         renderer.render(&View::Final)?;
         Ok((0..renderer.lights().len())

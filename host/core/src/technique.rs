@@ -470,6 +470,13 @@ pub trait ShadowTechnique: Send {
         false
     }
 
+    /// Frames a still view takes to converge, for techniques that accumulate over frames
+    /// while nothing moves; the judge renders that many before it measures. 1 (the default)
+    /// for techniques whose every frame is complete.
+    fn frames_to_converge(&self) -> u32 {
+        1
+    }
+
     /// Creates or resizes resources after the scene, lights, resolution or camera changed.
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError>;
 

@@ -134,9 +134,33 @@ impl CasterGeometry {
     }
 }
 
+/// What building and uploading a hierarchy took, for counters and benchmarks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BuildStats {
+    pub triangles: usize,
+    pub nodes: usize,
+    /// Levels below the root.
+    pub depth: u32,
+    /// CPU time of the build and the upload, in milliseconds.
+    pub milliseconds: f64,
+}
+
+impl BuildStats {
+    /// The statistics as named counters (`ShadowTechnique::counters`).
+    pub fn counters(&self) -> Vec<(String, f64)> {
+        vec![
+            ("BVH triangles".to_string(), self.triangles as f64),
+            ("BVH nodes".to_string(), self.nodes as f64),
+            ("BVH depth".to_string(), f64::from(self.depth)),
+            ("BVH build ms".to_string(), self.milliseconds),
+        ]
+    }
+}
+
 /// The uploaded hierarchy and its bind group (group [`GROUP`]).
 pub struct RayTracing {
     pub bind_group: wgpu::BindGroup,
+    pub stats: BuildStats,
     /// The scene vertex buffer it was built from (a new scene has a new one).
     vertices: wgpu::Buffer,
 }
@@ -169,6 +193,7 @@ impl RayTracing {
         ctx: &RenderContext<'_>,
         layout: &wgpu::BindGroupLayout,
     ) -> TechniqueResult<RayTracing> {
+        let start = std::time::Instant::now();
         let geometry = CasterGeometry::of(ctx.scene);
         let depth = geometry.depth();
         if depth >= STACK_SIZE {
@@ -233,8 +258,15 @@ impl RayTracing {
                 wgpu::BindingResource::Sampler(&materials.sampler),
             ],
         );
+        let stats = BuildStats {
+            triangles: geometry.triangles.len(),
+            nodes: geometry.nodes.len(),
+            depth,
+            milliseconds: start.elapsed().as_secs_f64() * 1000.0,
+        };
         Ok(RayTracing {
             bind_group,
+            stats,
             vertices: ctx.scene_buffers.vertices.clone(),
         })
     }

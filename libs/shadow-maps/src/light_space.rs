@@ -113,6 +113,12 @@ pub fn resolvable(length: f32, magnitude: f32) -> f32 {
     length.max(magnitude.abs() * 1e-6).max(1e-30)
 }
 
+/// Rungs an octave of a stabilised directional map's extent ladder: a map covers at most
+/// 2^(1/8), 9 %, more than its fit (coarser rungs waste more texels, 25 % at ratio 1.25, and
+/// thin casters fall between them), and changes only when the fit has grown or shrunk by as
+/// much.
+pub const EXTENT_RUNGS_PER_OCTAVE: f32 = 8.0;
+
 /// The diagonal of the box around `boxes` (1 when there are none): the unit that quantised
 /// fits are measured in, so that they scale with the scene.
 pub(crate) fn scene_unit(boxes: &[Aabb]) -> f32 {
@@ -251,7 +257,8 @@ pub fn camera_frustum_corners(camera: &Camera, aspect: f32, far: f32) -> [Vec3; 
 /// frustum), and its depth range reaches back to every caster that can shadow them.
 ///
 /// With `stable_texels` = Some(resolution), the extent is rounded up to a step of a geometric
-/// ladder (ratio 1.25, anchored to the size of the objects' bounds) and the centre snapped to whole texels, so small camera moves leave the
+/// ladder ([`EXTENT_RUNGS_PER_OCTAVE`] rungs an octave, anchored to the size of the objects'
+/// bounds) and the centre snapped to whole texels, so small camera moves leave the
 /// map unchanged and larger ones move it by whole texels: shadow edges do not shimmer.
 pub fn directional_frustum(
     direction: Vec3,
@@ -301,8 +308,8 @@ pub fn directional_frustum(
         // scene scaled by any factor gets the same map, scaled. Two texels of margin:
         // rounding the centre moves the receivers by up to half a texel.
         let unit = scene_unit(objects);
-        let rung = (extent / unit).ln().div_euclid(1.25f32.ln()) + 1.0;
-        extent = unit * 1.25f32.powf(rung) * (1.0 + 2.0 / resolution as f32);
+        let rung = ((extent / unit).log2() * EXTENT_RUNGS_PER_OCTAVE).floor() + 1.0;
+        extent = unit * (rung / EXTENT_RUNGS_PER_OCTAVE).exp2() * (1.0 + 2.0 / resolution as f32);
         let texel = extent / resolution as f32;
         center.x = (center.x / texel).round() * texel;
         center.y = (center.y / texel).round() * texel;

@@ -1,11 +1,16 @@
 //! Ray-traced shadows on any adapter: from each pixel's surface, any-hit shadow rays through
 //! the scene's bounding volume hierarchy (`zoo-ray-tracing`, traversed in a fragment shader):
 //! one ray to each light's centre gives exact hard shadows; several rays to points of the
-//! light's disk (a rotated low-discrepancy pattern per pixel) give soft ones, smoothed by an
+//! light's disk (a rotated low-discrepancy pattern per pixel, continued frame after frame)
+//! give soft ones, averaged over the frames of a still view ([`history`]) and smoothed by an
 //! edge-aware spatial filter guided by the G-buffer's depth and normals.
 
 use zoo_host::prelude::*;
 use zoo_ray_tracing::RayTracing;
+
+mod history;
+
+use history::{Accumulation, History};
 
 zoo_host::technique_params! {
     /// Parameters of ray-traced shadows.
@@ -14,25 +19,28 @@ zoo_host::technique_params! {
         /// to its centre (hard shadows), as do lights without a radius.
         rays_per_pixel: u32 = 4, range(1, 64), step(1);
         /// Radius in pixels of the filter that smooths soft shadows' noise (0: off); lights
-        /// traced with one ray are left as they are.
+        /// traced with one ray are left as they are. It narrows as frames accumulate.
         denoise_radius: u32 = 2, range(0, 8), step(1);
+        /// Frames of soft shadows averaged while nothing moves (1: each frame on its own, its
+        /// rays the same every frame); each frame traces a new pattern.
+        accumulation: u32 = 16, range(1, 256), step(1);
     }
 }
 
-/// `RtLight` in `rt-shadows/light.wgsl`: the light, its rays per pixel, its visibility slot
-/// and the filter's radius for it.
+/// `RtLight` in `rt-shadows/light.wgsl`: the light, its rays per pixel, its visibility slot,
+/// the filter's radius for it and its accumulation.
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 #[bytemuck(crate = "zoo_host::bytemuck")]
 #[repr(C)]
-struct RtLight {
+pub(crate) struct RtLight {
     light: u32,
     rays: u32,
     layer: u32,
     channel: u32,
     denoise_radius: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    soft: u32,
+    frame: u32,
+    history_weight: f32,
 }
 
 const TRACE_SHADER: &str = "rt-shadows/shadows.wgsl";
@@ -41,20 +49,15 @@ const DENOISE_SHADER: &str = "rt-shadows/denoise.wgsl";
 const TRACE_PASS: &str = "Ray-traced shadows";
 const DENOISE_PASS: &str = "Denoise";
 
-/// A copy of the visibility slots as traced, read by the filter while it writes the slots.
-struct Traced {
-    texture: wgpu::Texture,
-    group: wgpu::BindGroup,
-}
-
-/// The pipelines and the hierarchy they trace.
+/// The pipelines, the hierarchy they trace and the soft lights' history.
 struct Gpu {
     tracing_layout: wgpu::BindGroupLayout,
     trace: FullscreenLightPass<RtLight>,
-    traced_layout: wgpu::BindGroupLayout,
+    history_layout: wgpu::BindGroupLayout,
+    accumulation: Accumulation,
     denoise: FullscreenLightPass<RtLight>,
     tracing: Option<RayTracing>,
-    traced: Option<Traced>,
+    history: Option<History>,
 }
 
 impl Gpu {
@@ -62,9 +65,9 @@ impl Gpu {
         let device = &ctx.gpu.device;
         let tracing_layout = zoo_ray_tracing::layout(device);
         let trace = FullscreenLightPass::new(ctx, TRACE_SHADER, "fs_main", &[&tracing_layout])?;
-        let traced_layout = kit::bind_group_layout(
+        let history_layout = kit::bind_group_layout(
             device,
-            "rt-shadows traced visibility layout",
+            "rt-shadows history layout",
             &[kit::texture(
                 0,
                 wgpu::ShaderStages::FRAGMENT,
@@ -72,86 +75,87 @@ impl Gpu {
                 wgpu::TextureViewDimension::D2Array,
             )],
         );
+        let accumulation = Accumulation::new(
+            ctx,
+            TRACE_SHADER,
+            "fs_accumulate",
+            &tracing_layout,
+            &history_layout,
+        )?;
         let denoise =
-            FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[&traced_layout])?;
+            FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[&history_layout])?;
         Ok(Gpu {
             tracing_layout,
             trace,
-            traced_layout,
+            history_layout,
+            accumulation,
             denoise,
             tracing: None,
-            traced: None,
+            history: None,
         })
-    }
-
-    /// The copy of the slots, made again when the slots' texture changed shape.
-    fn traced(&mut self, ctx: &RenderContext<'_>) -> &Traced {
-        let slots = &ctx.visibility.texture;
-        if self
-            .traced
-            .as_ref()
-            .is_none_or(|t| t.texture.size() != slots.size())
-        {
-            let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("rt-shadows traced visibility"),
-                size: slots.size(),
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: slots.format(),
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some("rt-shadows traced visibility view"),
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
-            let group = kit::bind_group(
-                &ctx.gpu.device,
-                "rt-shadows traced visibility",
-                &self.traced_layout,
-                &[wgpu::BindingResource::TextureView(&view)],
-            );
-            self.traced = Some(Traced { texture, group });
-        }
-        self.traced.as_ref().expect("made above")
     }
 }
 
 struct RtShadows {
     params: RtParams,
-    gpu: Option<Gpu>,
+    gpu: LazyGpu<Gpu>,
+    /// Frames accumulated since the view, the lights, the scene or a parameter last changed.
+    frames: u32,
+    /// Whether the last frame had soft lights (which accumulate).
+    soft_lights: bool,
 }
 
 impl ShadowTechnique for RtShadows {
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if self.gpu.is_none() {
-            self.gpu = Some(Gpu::new(ctx)?);
-        }
-        let gpu = self.gpu.as_mut().expect("built above");
+        let gpu = self.gpu.prepare(false, || Gpu::new(ctx))?;
         if changes.scene || gpu.tracing.as_ref().is_none_or(|t| !t.is_for(ctx)) {
             gpu.tracing = Some(RayTracing::new(ctx, &gpu.tracing_layout)?);
+        }
+        let Changes {
+            scene,
+            lights,
+            resolution,
+            camera,
+            params,
+        } = changes;
+        if scene || lights || resolution || camera || params {
+            self.frames = 0;
         }
         Ok(())
     }
 
     fn record(&mut self, ctx: &RenderContext<'_>, rec: &mut PassRecorder<'_>) -> TechniqueResult {
-        let (rays, radius) = (self.params.rays_per_pixel, self.params.denoise_radius);
-        let gpu = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
-        // Soft lights are filtered; hard ones (one ray, or no radius) are exact as traced.
-        let soft = |light: usize| rays > 1 && ctx.lights[light].radius > 0.0;
+        let p = &self.params;
+        let gpu = self.gpu.get_mut()?;
+        // Soft lights are traced into the history and resolved by the filter; hard ones (one
+        // ray, or no radius) are exact as traced.
+        let soft = |light: usize| p.rays_per_pixel > 1 && ctx.lights[light].radius > 0.0;
+        let soft_lights: Vec<usize> = (0..ctx.lights.len()).filter(|&l| soft(l)).collect();
+        self.soft_lights = !soft_lights.is_empty();
+        if gpu.history.as_ref().is_some_and(|h| !h.fits(ctx)) || !self.soft_lights {
+            gpu.history = None;
+        }
+        if self.soft_lights && gpu.history.is_none() {
+            gpu.history = Some(History::new(ctx, &gpu.history_layout));
+            self.frames = 0;
+        }
+        // The n-th frame since a change weighs 1/n; past `accumulation`, a moving average.
+        let accumulated = self.frames.min(p.accumulation - 1);
+        let history_weight = accumulated as f32 / (accumulated + 1) as f32;
+        // The filter narrows as the noise falls with the frames averaged.
+        let radius = (p.denoise_radius as f32 / ((accumulated + 1) as f32).sqrt()) as u32;
+        let frame = if p.accumulation > 1 { self.frames } else { 0 };
         let per_light = |light: usize| {
             let (layer, channel) = ctx.visibility.slots.slot(light);
             RtLight {
                 light: light as u32,
-                rays,
+                rays: p.rays_per_pixel,
                 layer,
                 channel,
-                denoise_radius: if soft(light) { radius } else { 0 },
-                _pad0: 0,
-                _pad1: 0,
-                _pad2: 0,
+                denoise_radius: radius,
+                soft: u32::from(soft(light)),
+                frame,
+                history_weight,
             }
         };
         let tracing = gpu
@@ -162,31 +166,55 @@ impl ShadowTechnique for RtShadows {
             .record_with(ctx, rec, TRACE_PASS, per_light, |_, pass| {
                 pass.set_bind_group(zoo_ray_tracing::GROUP, &tracing.bind_group, &[]);
             });
-        if radius == 0 || !(0..ctx.lights.len()).any(soft) {
-            return Ok(());
+        if let Some(history) = &gpu.history {
+            (gpu.accumulation).record(
+                ctx,
+                rec,
+                history,
+                &tracing.bind_group,
+                &soft_lights,
+                per_light,
+            );
+            let group = &history.current_group;
+            gpu.denoise
+                .record_with(ctx, rec, DENOISE_PASS, per_light, |_, pass| {
+                    pass.set_bind_group(3, group, &[]);
+                });
+            self.frames = self.frames.saturating_add(1);
         }
-        let traced = gpu.traced(ctx);
-        let slots = &ctx.visibility.texture;
-        rec.encoder().copy_texture_to_texture(
-            slots.as_image_copy(),
-            traced.texture.as_image_copy(),
-            slots.size(),
-        );
-        let group = traced.group.clone();
-        gpu.denoise
-            .record_with(ctx, rec, DENOISE_PASS, per_light, |_, pass| {
-                pass.set_bind_group(3, &group, &[]);
-            });
         Ok(())
     }
+
+    fn frames_to_converge(&self) -> u32 {
+        if self.soft_lights {
+            self.params.accumulation
+        } else {
+            1
+        }
+    }
+
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
         Ok(self.params.update(values)?)
+    }
+
+    fn counters(&self) -> Vec<(String, f64)> {
+        let tracing = self.gpu.built().and_then(|g| g.tracing.as_ref());
+        let mut counters = tracing.map(|t| t.stats.counters()).unwrap_or_default();
+        if self.soft_lights {
+            counters.push(("frames accumulated".to_string(), f64::from(self.frames)));
+        }
+        counters
     }
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
     let params = RtParams::from_values(values)?;
-    Ok(Box::new(RtShadows { params, gpu: None }))
+    Ok(Box::new(RtShadows {
+        params,
+        gpu: LazyGpu::default(),
+        frames: 0,
+        soft_lights: false,
+    }))
 }
 
 zoo_host::register_technique! {
@@ -218,9 +246,9 @@ mod tests {
             layer,
             channel,
             denoise_radius,
-            _pad0,
-            _pad1,
-            _pad2
+            soft,
+            frame,
+            history_weight
         });
         check_embedded_mirror("rt-shadows/light.wgsl", "RtLight", mirror, SizeRule::Equal).unwrap();
     }

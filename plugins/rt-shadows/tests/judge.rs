@@ -40,12 +40,17 @@ fn one_ray_per_light_is_exact() {
     }
 }
 
-/// Soft shadows from rays to the light's disk: the mean error against the area reference
-/// falls as rays are added, and the edge-aware filter lowers it further at a few rays.
+/// Soft shadows from rays to the light's disk, one frame each: the mean error against the
+/// area reference falls as rays are added, and the edge-aware filter lowers it further at a
+/// few rays.
 #[test]
 fn soft_shadows_approach_the_area_reference_with_more_rays_and_the_filter() {
     let mae = |rays: &str, radius: &str| {
-        let params = [("rays_per_pixel", rays), ("denoise_radius", radius)];
+        let params = [
+            ("rays_per_pixel", rays),
+            ("denoise_radius", radius),
+            ("accumulation", "1"),
+        ];
         let run = judge("soft.ron", "rt-shadows", &params, SIZE);
         let scores: Vec<_> = run.judged.scores.iter().filter_map(|s| s.metrics).collect();
         scores.iter().map(|m| m.mae).sum::<f64>() / scores.len() as f64
@@ -57,4 +62,78 @@ fn soft_shadows_approach_the_area_reference_with_more_rays_and_the_filter() {
     );
     assert!(four < one && sixteen < 0.8 * four, "{one} {four} {sixteen}");
     assert!(filtered < 0.8 * four, "filtered {filtered} against {four}");
+}
+
+/// The hierarchy's size and build time are counters (bench reports them per configuration):
+/// every shadow-casting triangle once, in a hierarchy the GPU traversal can hold.
+#[test]
+fn the_hierarchy_is_counted() {
+    use zoo_host::test_support::{gpu, scene_path};
+    let scene = zoo_host::Scene::load(&scene_path("planar-room.ron")).unwrap();
+    let casting: usize = (scene.objects.iter())
+        .filter(|o| o.casts_shadows)
+        .map(|o| scene.triangle_indices(o).count())
+        .sum();
+    let mut renderer = zoo_host::Renderer::new(gpu(), scene, UVec2::new(64, 48)).unwrap();
+    renderer
+        .set_technique("rt-shadows", &Default::default())
+        .unwrap();
+    renderer.render(&zoo_host::View::Final).unwrap();
+    let counters = renderer.wait_for_counters();
+    let counter = |name: &str| {
+        (counters.iter())
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v)
+            .unwrap_or_else(|| panic!("no counter {name} in {counters:?}"))
+    };
+    assert_eq!(counter("BVH triangles"), casting as f64);
+    assert!(counter("BVH nodes") >= 1.0 && counter("BVH nodes") < 2.0 * casting as f64);
+    assert!((1.0..64.0).contains(&counter("BVH depth")));
+    assert!(counter("BVH build ms") > 0.0);
+}
+
+/// Frames of a still view continue one sample sequence: sixteen frames of four unfiltered rays
+/// come as close to the area reference as one frame of 64 rays.
+#[test]
+fn sixteen_frames_of_four_rays_match_one_frame_of_sixty_four() {
+    let mae = |params: &[(&str, &str)]| {
+        let run = judge("soft.ron", "rt-shadows", params, SIZE);
+        let scores: Vec<_> = run.judged.scores.iter().filter_map(|s| s.metrics).collect();
+        scores.iter().map(|m| m.mae).sum::<f64>() / scores.len() as f64
+    };
+    let unfiltered = ("denoise_radius", "0");
+    let frames = mae(&[("rays_per_pixel", "4"), unfiltered, ("accumulation", "16")]);
+    let rays = mae(&[("rays_per_pixel", "64"), unfiltered, ("accumulation", "1")]);
+    eprintln!("soft: 16 frames of 4 rays mae {frames:.4}, one frame of 64 rays {rays:.4}");
+    assert!(frames <= 1.2 * rays, "{frames} against {rays}");
+}
+
+/// The history starts again whenever the view changes, and counts the frames of a still one.
+#[test]
+fn a_camera_move_starts_the_accumulation_again() {
+    use zoo_host::test_support::{gpu, scene_path};
+    let scene = zoo_host::Scene::load(&scene_path("soft.ron")).unwrap();
+    let mut renderer = zoo_host::Renderer::new(gpu(), scene, UVec2::new(64, 48)).unwrap();
+    renderer
+        .set_technique("rt-shadows", &Default::default())
+        .unwrap();
+    let frames = |renderer: &zoo_host::Renderer| {
+        (renderer.technique_instance().counters().into_iter())
+            .find(|(name, _)| name == "frames accumulated")
+            .map(|(_, v)| v)
+    };
+    for _ in 0..5 {
+        renderer.render(&zoo_host::View::Final).unwrap();
+    }
+    assert_eq!(frames(&renderer), Some(5.0));
+    let mut camera = *renderer.camera();
+    camera.position.x += 0.1;
+    renderer.set_camera(camera);
+    renderer.render(&zoo_host::View::Final).unwrap();
+    assert_eq!(frames(&renderer), Some(1.0), "a camera move starts again");
+    assert_eq!(
+        renderer.technique_instance().frames_to_converge(),
+        16,
+        "the judge waits for the default frames"
+    );
 }

@@ -269,8 +269,12 @@ pub fn judge_technique(
     params: &ParamValues,
 ) -> Result<Judged, RenderError> {
     renderer.set_technique(id, params)?;
-    // A first frame lets techniques with temporal state settle; the second is measured.
+    // A first frame lets techniques with temporal state settle; those that accumulate over
+    // frames get as many more as they converge in; the last is measured.
     renderer.render(&View::Final)?;
+    for _ in 2..renderer.technique_instance().frames_to_converge() {
+        renderer.render(&View::Final)?;
+    }
     let timings = renderer.render(&View::Final)?;
     let registration = renderer.technique();
     let (width, height) = reference.size();
