@@ -101,11 +101,13 @@ fn vertex_position(index: u32) -> vec3<f32> {
 // texels: depth precision, and the planes of a curved receiver's neighbouring triangles.
 const COVERAGE_CLEARANCE: f32 = 0.02;
 
-// Shading normals this close to the terminator (their cosine to the light) join the band: a
-// triangle of a coarsely tessellated curve can face away from the light there while its
-// shading normal does not (sin 11.25°: the facets of a 16-sided cylinder), and taps and
-// coverage, one texel apart, cannot tell.
-const TERMINATOR: f32 = 0.2;
+// Surfaces the light grazes (the cosine of their shading normal to it) join the band: one
+// texel spans a long stretch of them, so the samples and the coverage test, a texel apart,
+// cannot settle their shadow; near a coarse curve's terminator a triangle may even face away
+// from the light while its shading normal does not (sin 11.25°: a 16-sided cylinder). Under
+// a light lower than this over a flat receiver, the whole receiver joins the band: exact, and
+// as dear as the volumes everywhere.
+const GRAZING: f32 = 0.2;
 
 // The step from p to the neighbour of `pixel` along `step` or against it, whichever lies
 // nearer p (pixels beside a silhouette take the surface they belong to), oriented along `step`.
@@ -158,7 +160,7 @@ fn plane_depth(id: u32, m: MapPoint) -> f32 {
 }
 
 // Whether a caster may cross the light ray of the pixel's surface: its triangle faces away
-// from the light, or the plane of the coverage map's triangle under the ray lies nearer the
+// from the light, the light grazes it, or the plane of the coverage map's triangle under the ray lies nearer the
 // light than the surface there.
 fn coverage_blocked(c: Classified, pixel: vec2<i32>) -> bool {
     let p = c.surface.position;
@@ -169,7 +171,7 @@ fn coverage_blocked(c: Classified, pixel: vec2<i32>) -> bool {
         clearance = min(clearance, 0.5 * length(to_light));
         to_light = normalize(to_light);
     }
-    if dot(face_normal(pixel, c.surface), to_light) <= 0.0 || dot(c.surface.normal, to_light) < TERMINATOR {
+    if dot(face_normal(pixel, c.surface), to_light) <= 0.0 || dot(c.surface.normal, to_light) < GRAZING {
         return true;
     }
     let layer = header_layer(edge.map, p);

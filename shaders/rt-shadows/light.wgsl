@@ -15,8 +15,6 @@ struct RtLight {
     soft: u32,
     // Frames since the view last changed: where the sample sequence continues.
     frame: u32,
-    // Weight of the previous history in the new one (0: start again).
-    history_weight: f32,
 }
 
 @group(2) @binding(0) var<uniform> rt_light: RtLight;

@@ -104,22 +104,20 @@ fn trace(pixel: vec2<i32>) -> f32 {
 // Hard lights, into their slots (which hold 1, lit, until written).
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    if rt_light.soft == 1u {
+        discard;
+    }
     let visibility = trace(vec2<i32>(in.position.xy));
-    if rt_light.soft == 1u || visibility >= 1.0 {
+    if visibility >= 1.0 {
         discard;
     }
     // Every channel: the pass's blend constant keeps only this light's.
     return vec4<f32>(visibility);
 }
 
-// The history before this frame (`fs_accumulate` only).
-@group(4) @binding(0) var previous: texture_2d_array<f32>;
-
-// Soft lights, into the history: this frame's rays averaged with the frames before.
+// Soft lights, into the history: the pass's blend weighs this frame against the frames
+// before (and keeps only this light's channel).
 @fragment
 fn fs_accumulate(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let pixel = vec2<i32>(in.position.xy);
-    let before = textureLoad(previous, pixel, rt_light.layer, 0)[rt_light.channel];
-    // Every channel: the pass's blend constant keeps only this light's.
-    return vec4<f32>(mix(trace(pixel), before, rt_light.history_weight));
+    return vec4<f32>(trace(vec2<i32>(in.position.xy)));
 }

@@ -108,8 +108,8 @@ impl LayerBlur {
             self.bound = Some(self.bind(ctx.gpu, maps));
         }
         let bound = self.bound.as_ref().expect("bound above");
-        // Each tile's horizontal pass reads it from its page into the same texels of the
-        // scratch page; its vertical pass reads those back into the page.
+        // A tile's horizontal step reads it from its page into the same texels of the scratch
+        // page; its vertical step reads those back into the page.
         let step = |tile, vertical| BlurParams {
             tile,
             radius,
@@ -146,7 +146,7 @@ impl LayerBlur {
                 ),
             ];
             for (k, (direction, source, target)) in steps.into_iter().enumerate() {
-                let label = format!("{base} page {page} ({direction})");
+                let label = format!("{base}: page {page} ({direction})");
                 let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&label),
                     color_attachments: &[zoo_host::gpu::color_attachment(

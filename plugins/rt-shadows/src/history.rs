@@ -1,6 +1,6 @@
-//! Accumulation over frames: soft lights' traced visibility averaged into a floating-point
-//! history laid out like the visibility slots (each light's layer and channel), while nothing
-//! moves. The filter pass then resolves the history into the slots.
+//! Accumulation over frames: soft lights' traced visibility averaged, by blending, into a
+//! floating-point history laid out like the visibility slots (each light's layer and channel),
+//! while nothing moves. The filter pass then resolves the history into the slots.
 
 use zoo_host::prelude::*;
 
@@ -11,63 +11,33 @@ const PASS: &str = "Accumulate";
 /// Format of the history: averages of many frames need more than the slots' eight bits.
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// The history, the previous frame's copy the accumulation reads, and their bindings.
+/// The history and its binding.
 pub struct History {
-    history: wgpu::Texture,
+    pub texture: wgpu::Texture,
     layer_views: Vec<wgpu::TextureView>,
-    previous: wgpu::Texture,
-    /// The previous frame's history (the accumulation pass's group 4).
-    pub previous_group: wgpu::BindGroup,
-    /// The current history (the filter pass's group 3).
-    pub current_group: wgpu::BindGroup,
+    /// The history as the filter pass reads it (its group 3).
+    pub group: wgpu::BindGroup,
 }
 
 impl History {
-    /// A history shaped like `ctx`'s visibility slots, both groups made with `layout` (one
-    /// unfilterable 2D array texture at binding 0).
+    /// A history shaped like `ctx`'s visibility slots, bound with `layout` (one unfilterable
+    /// 2D array texture at binding 0).
     pub fn new(ctx: &RenderContext<'_>, layout: &wgpu::BindGroupLayout) -> History {
         let device = &ctx.gpu.device;
         let size = ctx.visibility.texture.size();
-        let texture = |label: &str, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: FORMAT,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let history = texture(
-            "rt-shadows history",
-            wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-        );
-        let previous = texture(
-            "rt-shadows previous history",
-            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        );
-        let array_view = |texture: &wgpu::Texture, label: &str| {
-            texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some(label),
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            })
-        };
-        let group = |label: &str, view: &wgpu::TextureView| {
-            kit::bind_group(
-                device,
-                label,
-                layout,
-                &[wgpu::BindingResource::TextureView(view)],
-            )
-        };
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("rt-shadows history"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
         let layer_views = (0..size.depth_or_array_layers)
             .map(|layer| {
-                history.create_view(&wgpu::TextureViewDescriptor {
+                texture.create_view(&wgpu::TextureViewDescriptor {
                     label: Some(&format!("rt-shadows history layer {layer}")),
                     dimension: Some(wgpu::TextureViewDimension::D2),
                     base_array_layer: layer,
@@ -76,30 +46,34 @@ impl History {
                 })
             })
             .collect();
-        let previous_group = group(
-            "rt-shadows previous history",
-            &array_view(&previous, "rt-shadows previous history view"),
-        );
-        let current_group = group(
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("rt-shadows history view"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let group = kit::bind_group(
+            device,
             "rt-shadows history",
-            &array_view(&history, "rt-shadows history view"),
+            layout,
+            &[wgpu::BindingResource::TextureView(&view)],
         );
         History {
-            history,
+            texture,
             layer_views,
-            previous,
-            previous_group,
-            current_group,
+            group,
         }
     }
 
     /// Whether it still has the slots' shape.
     pub fn fits(&self, ctx: &RenderContext<'_>) -> bool {
-        self.history.size() == ctx.visibility.texture.size()
+        self.texture.size() == ctx.visibility.texture.size()
     }
 }
 
 /// The accumulation pass: traces a soft light's rays and blends them into its history.
+/// The blend does the averaging: the slots' blend (source times the constant, plus the
+/// destination times one minus it) with the light's channel of the constant set to the new
+/// frame's weight keeps the other channels and gives `traced · (1 − w) + history · w`.
 pub struct Accumulation {
     pipeline: wgpu::RenderPipeline,
     uniforms: kit::UniformSlots<RtLight>,
@@ -107,13 +81,12 @@ pub struct Accumulation {
 
 impl Accumulation {
     /// The pipeline of fragment `entry` in `shader`, after the frame and G-buffer groups: the
-    /// per-light uniform (2), the ray-tracing group (3) and the previous history (4).
+    /// per-light uniform (2) and the ray-tracing group (3).
     pub fn new(
         ctx: &RenderContext<'_>,
         shader: &str,
         entry: &str,
         tracing: &wgpu::BindGroupLayout,
-        history: &wgpu::BindGroupLayout,
     ) -> TechniqueResult<Accumulation> {
         let module = ctx.shaders.create_module(&ctx.gpu.device, shader)?;
         let uniforms = kit::UniformSlots::new(
@@ -122,9 +95,8 @@ impl Accumulation {
             ctx.lights.len(),
             wgpu::ShaderStages::FRAGMENT,
         );
-        let groups = [uniforms.layout(), tracing, history];
+        let groups = [uniforms.layout(), tracing];
         let layout = kit::pipeline_layout(ctx, "rt-shadows accumulation layout", &groups);
-        // The slots' blend: the pass's constant keeps only the light's channel.
         let target = wgpu::ColorTargetState {
             format: FORMAT,
             ..kit::slot_target()
@@ -140,24 +112,23 @@ impl Accumulation {
         Ok(Accumulation { pipeline, uniforms })
     }
 
-    /// Copies the history aside, then records one pass per light in `lights` (named
-    /// `"Accumulate: light {l}"`) into its layer and channel of the history.
+    /// Writes the frame's per-light uniforms (every light's, once per frame).
+    pub fn write(&mut self, ctx: &RenderContext<'_>, per_light: impl Fn(usize) -> RtLight) {
+        let values: Vec<RtLight> = (0..ctx.lights.len()).map(per_light).collect();
+        self.uniforms.write(ctx.gpu, &values);
+    }
+
+    /// Records one pass per light in `lights` (named `"Accumulate: light {l}"`) into its layer
+    /// and channel of `history`, the new frame weighing `weight` and the history the rest.
     pub fn record(
-        &mut self,
+        &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         history: &History,
         tracing: &wgpu::BindGroup,
         lights: &[usize],
-        per_light: impl Fn(usize) -> RtLight,
+        weight: f64,
     ) {
-        recorder.encoder().copy_texture_to_texture(
-            history.history.as_image_copy(),
-            history.previous.as_image_copy(),
-            history.history.size(),
-        );
-        let values: Vec<RtLight> = (0..ctx.lights.len()).map(per_light).collect();
-        self.uniforms.write(ctx.gpu, &values);
         for &light in lights {
             let (layer, _) = ctx.visibility.slots.slot(light);
             let label = kit::light_pass_name(PASS, light);
@@ -172,7 +143,13 @@ impl Accumulation {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_blend_constant(ctx.visibility.light_slot(light).blend_constant);
+            let channel = ctx.visibility.light_slot(light).blend_constant;
+            pass.set_blend_constant(wgpu::Color {
+                r: channel.r * weight,
+                g: channel.g * weight,
+                b: channel.b * weight,
+                a: channel.a * weight,
+            });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
             pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
@@ -182,7 +159,6 @@ impl Accumulation {
                 &[self.uniforms.offset(light)],
             );
             pass.set_bind_group(zoo_ray_tracing::GROUP, tracing, &[]);
-            pass.set_bind_group(4, &history.previous_group, &[]);
             pass.draw(0..3, 0..1);
         }
     }

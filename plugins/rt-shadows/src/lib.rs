@@ -5,6 +5,7 @@
 //! give soft ones, averaged over the frames of a still view ([`history`]) and smoothed by an
 //! edge-aware spatial filter guided by the G-buffer's depth and normals.
 
+use zoo_host::ResourceInfo;
 use zoo_host::prelude::*;
 use zoo_ray_tracing::RayTracing;
 
@@ -40,7 +41,6 @@ pub(crate) struct RtLight {
     denoise_radius: u32,
     soft: u32,
     frame: u32,
-    history_weight: f32,
 }
 
 const TRACE_SHADER: &str = "rt-shadows/shadows.wgsl";
@@ -75,13 +75,7 @@ impl Gpu {
                 wgpu::TextureViewDimension::D2Array,
             )],
         );
-        let accumulation = Accumulation::new(
-            ctx,
-            TRACE_SHADER,
-            "fs_accumulate",
-            &tracing_layout,
-            &history_layout,
-        )?;
+        let accumulation = Accumulation::new(ctx, TRACE_SHADER, "fs_accumulate", &tracing_layout)?;
         let denoise =
             FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[&history_layout])?;
         Ok(Gpu {
@@ -141,7 +135,7 @@ impl ShadowTechnique for RtShadows {
         }
         // The n-th frame since a change weighs 1/n; past `accumulation`, a moving average.
         let accumulated = self.frames.min(p.accumulation - 1);
-        let history_weight = accumulated as f32 / (accumulated + 1) as f32;
+        let new_frame_weight = 1.0 / f64::from(accumulated + 1);
         // The filter narrows as the noise falls with the frames averaged.
         let radius = (p.denoise_radius as f32 / ((accumulated + 1) as f32).sqrt()) as u32;
         let frame = if p.accumulation > 1 { self.frames } else { 0 };
@@ -155,7 +149,6 @@ impl ShadowTechnique for RtShadows {
                 denoise_radius: radius,
                 soft: u32::from(soft(light)),
                 frame,
-                history_weight,
             }
         };
         let tracing = gpu
@@ -167,15 +160,11 @@ impl ShadowTechnique for RtShadows {
                 pass.set_bind_group(zoo_ray_tracing::GROUP, &tracing.bind_group, &[]);
             });
         if let Some(history) = &gpu.history {
-            (gpu.accumulation).record(
-                ctx,
-                rec,
-                history,
-                &tracing.bind_group,
-                &soft_lights,
-                per_light,
-            );
-            let group = &history.current_group;
+            gpu.accumulation.write(ctx, per_light);
+            let weight = new_frame_weight;
+            let accumulation = &gpu.accumulation;
+            accumulation.record(ctx, rec, history, &tracing.bind_group, &soft_lights, weight);
+            let group = &history.group;
             gpu.denoise
                 .record_with(ctx, rec, DENOISE_PASS, per_light, |_, pass| {
                     pass.set_bind_group(3, group, &[]);
@@ -201,9 +190,18 @@ impl ShadowTechnique for RtShadows {
         let tracing = self.gpu.built().and_then(|g| g.tracing.as_ref());
         let mut counters = tracing.map(|t| t.stats.counters()).unwrap_or_default();
         if self.soft_lights {
-            counters.push(("frames accumulated".to_string(), f64::from(self.frames)));
+            // Frames in the average (past `accumulation`, a moving average of about as many).
+            let frames = self.frames.min(self.params.accumulation);
+            counters.push(("frames accumulated".to_string(), f64::from(frames)));
         }
         counters
+    }
+
+    fn resources(&self) -> Vec<ResourceInfo> {
+        let history = self.gpu.built().and_then(|g| g.history.as_ref());
+        (history.into_iter())
+            .map(|h| ResourceInfo::texture("soft lights' history", &h.texture, false))
+            .collect()
     }
 }
 
@@ -247,8 +245,7 @@ mod tests {
             channel,
             denoise_radius,
             soft,
-            frame,
-            history_weight
+            frame
         });
         check_embedded_mirror("rt-shadows/light.wgsl", "RtLight", mirror, SizeRule::Equal).unwrap();
     }
