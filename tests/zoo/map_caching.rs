@@ -6,18 +6,14 @@
 // Link the application, which links every plugin.
 use shadow_zoo as _;
 use zoo_host::glam::{Quat, UVec2, Vec3};
-use zoo_host::test_support::{cheapest_params, gpu, scene_path};
+use zoo_host::test_support::{cheapest_params, counter, gpu, scene_path};
 use zoo_host::{Renderer, View};
 
 const SIZE: UVec2 = UVec2::new(128, 96);
 
 /// The `maps rendered` counter of the last frame.
 fn maps_rendered(renderer: &Renderer) -> f64 {
-    let counters = renderer.wait_for_counters();
-    counters
-        .iter()
-        .find(|(name, _)| name == "maps rendered")
-        .map(|(_, value)| *value)
+    counter(&renderer.wait_for_counters(), "maps rendered")
         .expect("the technique counts the maps it renders")
 }
 

@@ -191,9 +191,8 @@ fn psm_warps_a_wide_spot_above_a_long_view_and_beats_its_cone_map() {
     zoo_host::params::apply_assignments(&(registration.params)(), &mut params, &values).unwrap();
     renderer.set_technique("psm", &params).unwrap();
     renderer.render(&View::Final).unwrap();
-    let fallbacks = (renderer.wait_for_counters().into_iter())
-        .find(|(name, _)| name == "standard-fit fallbacks")
-        .map(|(_, v)| v);
+    let fallbacks =
+        zoo_host::test_support::counter(&renderer.wait_for_counters(), "standard-fit fallbacks");
     eprintln!(
         "wide spot: psm core {} (fallbacks {fallbacks:?}), cone map {}",
         core(&psm),

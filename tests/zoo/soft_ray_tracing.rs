@@ -7,7 +7,7 @@ use shadow_zoo as _;
 use zoo_host::glam::UVec2;
 use zoo_host::judging::{DEFAULT_SAMPLES, Judged, SceneReference, judge_technique};
 use zoo_host::params::{apply_assignments, defaults};
-use zoo_host::test_support::{gpu, scene_path};
+use zoo_host::test_support::{counter, gpu, scene_path};
 use zoo_host::{Renderer, Scene};
 
 const SIZE: UVec2 = UVec2::new(192, 144);
@@ -55,9 +55,10 @@ fn accumulated_rays_keep_half_of_pcss_error_on_soft_scenes() {
             &[rays, one_frame].concat(),
         );
         let accumulated = judged(&mut renderer, &reference, "rt-shadows", &rays);
-        let frames = (renderer.technique_instance().counters().into_iter())
-            .find(|(name, _)| name == "frames accumulated")
-            .map(|(_, v)| v);
+        let frames = counter(
+            &renderer.technique_instance().counters(),
+            "frames accumulated",
+        );
         let (single, accumulated) = (mean_mae(&single), mean_mae(&accumulated));
         eprintln!(
             "{scene}: PCSS mae {pcss:.4}; rt-shadows at 4 rays, filtered: one frame {single:.4}, \

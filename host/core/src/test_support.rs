@@ -124,6 +124,14 @@ pub fn scene_from_ron(name: &str, text: &str) -> crate::scene::Scene {
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The value of counter `name` among `counters` (from [`crate::Renderer::wait_for_counters`]
+/// or a technique's own), or `None` where it is not counted.
+pub fn counter(counters: &[(String, f64)], name: &str) -> Option<f64> {
+    (counters.iter())
+        .find(|(n, _)| n == name)
+        .map(|(_, value)| *value)
+}
+
 /// A technique's defaults with its dearest work at the least it allows: shadow maps
 /// (`map_size`) at their smallest and rays (`rays_per_pixel`) at their fewest. For tests of
 /// what renders, not of how accurately (big depth maps and many rays are the dearest work on a

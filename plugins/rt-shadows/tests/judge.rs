@@ -68,7 +68,7 @@ fn soft_shadows_approach_the_area_reference_with_more_rays_and_the_filter() {
 /// every shadow-casting triangle once, in a hierarchy the GPU traversal can hold.
 #[test]
 fn the_hierarchy_is_counted() {
-    use zoo_host::test_support::{gpu, scene_path};
+    use zoo_host::test_support::{counter, gpu, scene_path};
     let scene = zoo_host::Scene::load(&scene_path("planar-room.ron")).unwrap();
     let casting: usize = (scene.objects.iter())
         .filter(|o| o.casts_shadows)
@@ -80,16 +80,13 @@ fn the_hierarchy_is_counted() {
         .unwrap();
     renderer.render(&zoo_host::View::Final).unwrap();
     let counters = renderer.wait_for_counters();
-    let counter = |name: &str| {
-        (counters.iter())
-            .find(|(n, _)| n == name)
-            .map(|(_, v)| *v)
-            .unwrap_or_else(|| panic!("no counter {name} in {counters:?}"))
+    let value = |name: &str| {
+        counter(&counters, name).unwrap_or_else(|| panic!("no counter {name} in {counters:?}"))
     };
-    assert_eq!(counter("BVH triangles"), casting as f64);
-    assert!(counter("BVH nodes") >= 1.0 && counter("BVH nodes") < 2.0 * casting as f64);
-    assert!((1.0..64.0).contains(&counter("BVH depth")));
-    assert!(counter("BVH build ms") > 0.0);
+    assert_eq!(value("BVH triangles"), casting as f64);
+    assert!(value("BVH nodes") >= 1.0 && value("BVH nodes") < 2.0 * casting as f64);
+    assert!((1.0..64.0).contains(&value("BVH depth")));
+    assert!(value("BVH build ms") > 0.0);
 }
 
 /// Frames of a still view continue one sample sequence: sixteen frames of four unfiltered rays
@@ -111,16 +108,17 @@ fn sixteen_frames_of_four_rays_match_one_frame_of_sixty_four() {
 /// The history starts again whenever the view changes, and counts the frames of a still one.
 #[test]
 fn a_camera_move_starts_the_accumulation_again() {
-    use zoo_host::test_support::{gpu, scene_path};
+    use zoo_host::test_support::{counter, gpu, scene_path};
     let scene = zoo_host::Scene::load(&scene_path("soft.ron")).unwrap();
     let mut renderer = zoo_host::Renderer::new(gpu(), scene, UVec2::new(64, 48)).unwrap();
     renderer
         .set_technique("rt-shadows", &Default::default())
         .unwrap();
     let frames = |renderer: &zoo_host::Renderer| {
-        (renderer.technique_instance().counters().into_iter())
-            .find(|(name, _)| name == "frames accumulated")
-            .map(|(_, v)| v)
+        counter(
+            &renderer.technique_instance().counters(),
+            "frames accumulated",
+        )
     };
     for _ in 0..5 {
         renderer.render(&zoo_host::View::Final).unwrap();

@@ -176,11 +176,7 @@ fn two_hundred_and_fifty_six_lights_render_with_every_pass_timed() {
     assert!(shadowed);
     let counters = renderer.wait_for_counters();
     eprintln!("{counters:?}");
-    let layers = counters
-        .iter()
-        .find(|(n, _)| n == "screen-space layers")
-        .map(|(_, v)| *v)
-        .unwrap();
+    let layers = zoo_host::test_support::counter(&counters, "screen-space layers").unwrap();
     assert!((2.0..=64.0).contains(&layers), "{layers} layers");
 }
 
@@ -231,11 +227,7 @@ fn batches_of_layers_give_the_visibility_of_one_batch() {
         renderer.render(&View::Final).unwrap();
         assert_eq!(renderer.technique().id, "ssss");
         let counters = renderer.wait_for_counters();
-        let layers = counters
-            .iter()
-            .find(|(n, _)| n == "screen-space layers")
-            .map(|(_, v)| *v)
-            .unwrap();
+        let layers = zoo_host::test_support::counter(&counters, "screen-space layers").unwrap();
         let visibility: Vec<Vec<f32>> = (0..scene.lights.len())
             .map(|i| renderer.read_visibility(i))
             .collect();
