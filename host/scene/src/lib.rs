@@ -154,6 +154,18 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// The same camera in a world scaled by `factor` about the origin: position, target and
+    /// the near and far planes scaled, the field of view kept.
+    pub fn scaled(&self, factor: f32) -> Camera {
+        Camera {
+            position: self.position * factor,
+            target: self.target * factor,
+            near: self.near * factor,
+            far: self.far * factor,
+            ..*self
+        }
+    }
+
     /// World-to-view matrix (right-handed, Y up).
     pub fn view(&self) -> Mat4 {
         let forward = (self.target - self.position).normalize_or_zero();
@@ -476,11 +488,7 @@ impl Scene {
                 *corner *= factor;
             }
         }
-        let camera = &mut out.camera;
-        camera.position *= factor;
-        camera.target *= factor;
-        camera.near *= factor;
-        camera.far *= factor;
+        out.camera = self.camera.scaled(factor);
         for key in &mut out.paths.camera {
             key.position *= factor;
             key.target *= factor;

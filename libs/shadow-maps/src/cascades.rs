@@ -310,14 +310,7 @@ mod tests {
         // crops, scaled.
         let direction = Vec3::new(0.82, -0.32, -0.48).normalize();
         let fit = |s: f32| {
-            let c = camera();
-            let camera = Camera {
-                position: c.position * s,
-                target: c.target * s,
-                near: c.near * s,
-                far: c.far * s,
-                ..c
-            };
+            let camera = camera().scaled(s);
             let ground = (
                 Vec3::new(-300.0, -1.0, -300.0) * s,
                 Vec3::new(300.0, 0.0, 300.0) * s,

@@ -415,12 +415,13 @@ mod tests {
         // the same map, scaled (a ladder of world units gave maps up to 25 % apart).
         let fit = |s: f32| {
             let camera = Camera {
-                position: Vec3::new(3.0, 4.0, 6.0) * s,
+                position: Vec3::new(3.0, 4.0, 6.0),
                 target: Vec3::ZERO,
                 fov_y: 50f32.to_radians(),
-                near: 0.1 * s,
-                far: 200.0 * s,
-            };
+                near: 0.1,
+                far: 200.0,
+            }
+            .scaled(s);
             let floor = (
                 Vec3::new(-7.0, -0.01, -7.0) * s,
                 Vec3::new(7.0, 0.0, 7.0) * s,

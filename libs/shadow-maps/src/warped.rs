@@ -596,13 +596,7 @@ mod tests {
         let base = camera();
         let size = UVec2::new(320, 200);
         let coarseness_at = |s: f32, resolution: u32| {
-            let c = Camera {
-                position: base.position * s,
-                target: base.target * s,
-                near: base.near * s,
-                far: base.far * s,
-                ..base
-            };
+            let c = base.scaled(s);
             let scaled = [(ground().0 * s, ground().1 * s)];
             let fit = psm_frustum(
                 &light,
