@@ -43,7 +43,9 @@ fn a_tiny_run_writes_well_formed_csv_markdown_and_plots() {
     let mut p = plan(&["unshadowed", "planar"], PathMode::Camera, 3, &[]);
     p.sweeps = vec![parse_sweep("size", &["64x64".into(), "96x96".into()]).unwrap()];
     let out = temp_dir("tiny");
-    let results = bench::run_plans(&[p], &ShaderLibrary::embedded(), &out, None).unwrap();
+    let results = bench::run_plans(&[p], &ShaderLibrary::embedded(), &out, None)
+        .unwrap()
+        .results;
     assert_eq!(results.len(), 4, "2 techniques x 2 sizes");
 
     let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();

@@ -3,35 +3,15 @@
 //! reference's shadow edges and in all, and how far area visibility moves. Scenes with
 //! translucent casters are refused with a clear error.
 
-use std::path::PathBuf;
-
 use glam::UVec2;
 use shadow_zoo::gpu_judge::trace_reference;
 use zoo_host::judge::edge_band;
 use zoo_host::judging::SceneReference;
-use zoo_host::test_support::{gpu, workspace_root};
+use zoo_host::test_support::{gpu, standard_scenes};
 use zoo_host::{Renderer, Scene};
 
 const SIZE: UVec2 = UVec2::new(96, 72);
 const SAMPLES: u32 = 16;
-
-/// Every scene of `scenes/` but the many-lamp benchmark plazas (`lights-*`, hundreds of lights:
-/// the CPU reference alone would take minutes here).
-fn standard_scenes() -> Vec<PathBuf> {
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir(workspace_root().join("scenes"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-        .filter(|p| {
-            !p.file_stem()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with("lights-")
-        })
-        .collect();
-    scenes.sort();
-    scenes
-}
 
 #[test]
 fn the_gpu_judge_agrees_with_the_cpu_judge_on_every_standard_scene() {

@@ -450,6 +450,77 @@ fn reference_overlay_judges_in_the_background() {
     harness.get_by_label("stale: the view changed since it was judged (map hidden)");
 }
 
+/// The live judge traces on the GPU every frame the view changes: hard visibility at once,
+/// then area rays frame by frame up to the GPU judge's samples; its verdict follows the camera
+/// and agrees with the CPU judge's.
+#[test]
+fn live_reference_follows_the_camera_and_agrees_with_the_cpu_judge() {
+    use shadow_zoo::gpu_judge::MAX_SAMPLES;
+    let mut harness = harness();
+    harness.run();
+    harness.get_by_label("sm-pcf").click();
+    harness.run();
+    harness.get_by_label("live (GPU)").click();
+    harness.step();
+    harness.step();
+    let current = |harness: &Harness<'_, ViewerState>| {
+        let state = harness.state();
+        assert!(state.error.is_none(), "{:?}", state.error);
+        let result = state.reference.result.as_ref().expect("a live verdict");
+        assert_eq!(result.view.technique, "sm-pcf");
+        assert_eq!(&result.view.camera, state.renderer.camera());
+        assert!(!state.reference.is_stale(&state.renderer));
+        result.metrics.clone()
+    };
+    current(&harness);
+    for _ in 0..2 * MAX_SAMPLES {
+        if harness.state().reference.live_samples() == Some(MAX_SAMPLES) {
+            break;
+        }
+        harness.step();
+    }
+    assert_eq!(harness.state().reference.live_samples(), Some(MAX_SAMPLES));
+    harness.get_by_label_contains("live on the GPU, 64 area rays a pixel");
+    let live = current(&harness);
+
+    // The camera moves: the verdict follows at once, from hard visibility again.
+    harness
+        .state_mut()
+        .camera
+        .drag(zoo_host::glam::Vec2::new(12.0, 0.0));
+    harness.step();
+    current(&harness);
+    assert_eq!(harness.state().reference.live_samples(), Some(0));
+    harness
+        .state_mut()
+        .camera
+        .drag(zoo_host::glam::Vec2::new(-12.0, 0.0));
+    harness.step();
+
+    // The CPU judge, the arbiter, replaces it and agrees.
+    harness.get_by_label("Judge view").click();
+    harness.step();
+    assert_eq!(harness.state().reference.live_samples(), None);
+    harness.state_mut().reference.wait().unwrap();
+    let cpu = harness.state().reference.result.as_ref().unwrap();
+    for (light, (live, cpu)) in live.iter().zip(&cpu.metrics).enumerate() {
+        let (live, cpu) = (live.as_ref().unwrap(), cpu.as_ref().unwrap());
+        eprintln!(
+            "light {light}: live mae {:.4} fs {:.4} fl {:.4}; CPU judge mae {:.4} fs {:.4} fl {:.4}",
+            live.mae, live.false_shadow, live.false_lit, cpu.mae, cpu.false_shadow, cpu.false_lit
+        );
+        assert!((live.mae - cpu.mae).abs() <= 0.01, "light {light}");
+        assert!(
+            (live.false_shadow - cpu.false_shadow).abs() <= 0.01,
+            "light {light}"
+        );
+        assert!(
+            (live.false_lit - cpu.false_lit).abs() <= 0.01,
+            "light {light}"
+        );
+    }
+}
+
 #[test]
 fn ab_split_and_difference_compare_two_techniques() {
     let mut harness = harness();

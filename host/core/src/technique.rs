@@ -231,6 +231,14 @@ macro_rules! register_technique {
     };
 }
 
+/// The value of counter `name` among `counters` (from [`crate::Renderer::wait_for_counters`]
+/// or [`ShadowTechnique::counters`]), or `None` where it is not counted.
+pub fn counter(counters: &[(String, f64)], name: &str) -> Option<f64> {
+    (counters.iter())
+        .find(|(n, _)| n == name)
+        .map(|(_, value)| *value)
+}
+
 /// Errors a technique reports. The host disables a technique that returns one.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum TechniqueError {

@@ -118,19 +118,27 @@ pub fn judge(scene: &str, technique: &str, params: &[(&str, &str)], size: glam::
     judge_scene(loaded, technique, params, size)
 }
 
+/// Every scene of `scenes/` (sorted) but the many-lamp benchmark plazas (`lights-*`, hundreds
+/// of lights: the CPU reference alone would take minutes in a test).
+pub fn standard_scenes() -> Vec<PathBuf> {
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(workspace_root().join("scenes"))
+        .unwrap_or_else(|e| panic!("scenes/: {e}"))
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .filter(|p| !(p.file_stem()).is_some_and(|s| s.to_string_lossy().starts_with("lights-")))
+        .collect();
+    scenes.sort();
+    scenes
+}
+
 /// Parses a scene from RON text (OBJ paths relative to `scenes/`).
 pub fn scene_from_ron(name: &str, text: &str) -> crate::scene::Scene {
     crate::scene::Scene::from_ron(text, Path::new(name), &workspace_root().join("scenes"))
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// The value of counter `name` among `counters` (from [`crate::Renderer::wait_for_counters`]
-/// or a technique's own), or `None` where it is not counted.
-pub fn counter(counters: &[(String, f64)], name: &str) -> Option<f64> {
-    (counters.iter())
-        .find(|(n, _)| n == name)
-        .map(|(_, value)| *value)
-}
+pub use crate::technique::counter;
 
 /// A technique's defaults with its dearest work at the least it allows: shadow maps
 /// (`map_size`) at their smallest and rays (`rays_per_pixel`) at their fewest. For tests of

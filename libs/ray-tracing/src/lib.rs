@@ -1,163 +1,212 @@
-//! Ray tracing on any adapter: the scene's shadow casters in a bounding volume hierarchy built
-//! on the CPU by the judge's own builder ([`zoo_host::judge::FlatBvh`]), uploaded once per
-//! scene and traversed in WGSL (`ray-tracing/trace.wgsl`: `rt_occluded`, an any-hit shadow
-//! ray). Alpha-masked casters are tested at the hit with the alpha test every pass shares
+//! Ray tracing on any adapter: any-hit shadow rays against the scene's shadow casters, uploaded
+//! once per scene. Two traversals give the same answers (`rt_occluded(origin, dir, tmax)`):
+//!
+//! - [`Tracer::Compute`]: the judge's own bounding volume hierarchy
+//!   ([`zoo_host::judge::FlatBvh`]) walked in WGSL (`ray-tracing/trace.wgsl`), on every
+//!   adapter with storage buffers;
+//! - [`Tracer::RayQuery`]: an acceleration structure built by the driver and traversed by
+//!   hardware ray queries (`ray-tracing/query.wgsl`), where the device has
+//!   `EXPERIMENTAL_RAY_QUERY`.
+//!
+//! Alpha-masked casters are tested at the hit with the alpha test every pass shares
 //! (`common/alpha_test.wgsl`); translucent casters block like opaque ones.
 //!
-//! The bindings are one group: bind it as group [`GROUP`] of a pipeline whose shader imports
-//! `ray-tracing/trace.wgsl` (a [`zoo_host::kit::FullscreenLightPass`]'s first own group).
+//! A shader imports `ray-tracing/trace.wgsl`; [`shader_source`] swaps the import for the
+//! chosen tracer. The bindings are one group: bind [`RayTracing::bind_group`] as group
+//! [`GROUP`] (a [`zoo_host::kit::FullscreenLightPass`]'s first own group).
 
-use bytemuck::{Pod, Zeroable};
-use zoo_host::judge::FlatBvh;
-use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
-use zoo_host::scene::Scene;
-use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
+use bytemuck::Pod;
+use zoo_host::glam::{Vec2, Vec3};
+use zoo_host::scene::{AlphaMask, Scene};
+use zoo_host::{RenderContext, ShaderLibrary, TechniqueError, TechniqueResult, wgpu};
 
-/// The bind group index `ray-tracing/trace.wgsl` declares its bindings in.
+mod compute;
+mod query;
+
+pub use compute::{CasterGeometry, GpuNode, GpuTexcoords, GpuTriangle, STACK_SIZE};
+pub use query::GpuMaskedTriangle;
+
+/// The bind group index both traversals declare their bindings in.
 pub const GROUP: u32 = 3;
 
-/// Nodes a traversal can hold pending (`RT_STACK_SIZE` in `ray-tracing/trace.wgsl`): a
-/// hierarchy at most this deep is traversed exactly.
-pub const STACK_SIZE: u32 = 64;
+/// The module a tracing shader imports (the portable traversal).
+pub const TRACE_MODULE: &str = "ray-tracing/trace.wgsl";
+/// The module [`shader_source`] imports instead for hardware ray queries.
+pub const QUERY_MODULE: &str = "ray-tracing/query.wgsl";
 
-/// `RtNode` in `ray-tracing/trace.wgsl`: a box, and its children (`first`, `first + 1`) or,
-/// for a leaf (`count` > 0), its triangles `first..first + count`.
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuNode {
-    pub min: [f32; 3],
-    pub first: u32,
-    pub max: [f32; 3],
-    pub count: u32,
+/// Stages that may trace rays.
+const STAGES: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
+
+zoo_host::param_choice! {
+    /// How shadow rays find casters: hardware ray queries where the device has them (`Auto`),
+    /// or always the portable BVH walk in a shader (`Compute`), or always ray queries
+    /// (`RayQuery`, an error on devices without them).
+    pub enum Traversal { Auto, Compute, RayQuery }
 }
 
-/// `RtTriangle` in `ray-tracing/trace.wgsl`: a corner and the two edges from it, and its alpha
-/// test (mask layer, -1 for none, and cutoff).
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuTriangle {
-    pub v0: [f32; 3],
-    pub _pad: u32,
-    pub e1: [f32; 3],
-    pub mask_layer: i32,
-    pub e2: [f32; 3],
-    pub alpha_cutoff: f32,
+/// The traversal a device runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tracer {
+    /// The BVH walked in WGSL (`ray-tracing/trace.wgsl`).
+    Compute,
+    /// Hardware ray queries (`ray-tracing/query.wgsl`).
+    RayQuery,
 }
 
-/// `RtTexcoords` in `ray-tracing/trace.wgsl`: a triangle's corners' texture coordinates.
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuTexcoords {
-    pub uv: [[f32; 2]; 3],
-    pub _pad: [f32; 2],
-}
+impl Tracer {
+    /// Whether `device` can trace with ray queries.
+    pub fn has_ray_queries(device: &wgpu::Device) -> bool {
+        device
+            .features()
+            .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
+    }
 
-/// The shadow casters as the GPU traces them, triangles in the hierarchy's leaf order.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct CasterGeometry {
-    pub nodes: Vec<GpuNode>,
-    pub triangles: Vec<GpuTriangle>,
-    pub texcoords: Vec<GpuTexcoords>,
-}
-
-impl CasterGeometry {
-    /// Every shadow caster of `scene` (degenerate triangles left out).
-    pub fn of(scene: &Scene) -> CasterGeometry {
-        let mut corners = Vec::new();
-        let mut records = Vec::new();
-        for o in &scene.objects {
-            if !o.casts_shadows {
-                continue;
-            }
-            for tri in scene.triangle_indices(o) {
-                corners.push(tri.map(|i| scene.mesh.positions[i]));
-                let uv = tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default());
-                records.push((o.alpha_mask, uv));
-            }
-        }
-        let bvh = FlatBvh::build(&corners);
-        let nodes = bvh
-            .nodes
-            .iter()
-            .map(|n| GpuNode {
-                min: n.min.to_array(),
-                first: n.first,
-                max: n.max.to_array(),
-                count: n.count,
-            })
-            .collect();
-        let (triangles, texcoords) = bvh
-            .triangles
-            .iter()
-            .map(|&source| {
-                let [a, b, c] = corners[source as usize];
-                let (mask, uv) = records[source as usize];
-                let triangle = GpuTriangle {
-                    v0: a.to_array(),
-                    _pad: 0,
-                    e1: (b - a).to_array(),
-                    mask_layer: mask.map_or(-1, |m| m.layer as i32),
-                    e2: (c - a).to_array(),
-                    alpha_cutoff: mask.map_or(0.0, |m| m.cutoff),
-                };
-                let texcoords = GpuTexcoords {
-                    uv: uv.map(|t| t.to_array()),
-                    _pad: [0.0; 2],
-                };
-                (triangle, texcoords)
-            })
-            .unzip();
-        CasterGeometry {
-            nodes,
-            triangles,
-            texcoords,
+    /// The tracer `traversal` asks for on `device`; technique `id` is unavailable when it
+    /// asks for ray queries the device lacks.
+    pub fn choose(
+        traversal: Traversal,
+        device: &wgpu::Device,
+        id: &str,
+    ) -> TechniqueResult<Tracer> {
+        let queries = Self::has_ray_queries(device);
+        match traversal {
+            Traversal::Auto if queries => Ok(Tracer::RayQuery),
+            Traversal::Auto | Traversal::Compute => Ok(Tracer::Compute),
+            Traversal::RayQuery if queries => Ok(Tracer::RayQuery),
+            Traversal::RayQuery => Err(TechniqueError::Unavailable {
+                id: id.to_string(),
+                reason: "traversal RayQuery needs hardware ray queries (EXPERIMENTAL_RAY_QUERY), \
+                         which this device lacks; use Auto or Compute"
+                    .into(),
+            }),
         }
     }
 
-    /// Levels of the hierarchy (0 without casters): a traversal holds at most this many
-    /// nodes plus one pending.
-    pub fn depth(&self) -> u32 {
-        let mut deepest = 0;
-        let mut pending = if self.nodes.is_empty() {
-            vec![]
-        } else {
-            vec![(0, 1)]
-        };
-        while let Some((index, level)) = pending.pop() {
-            deepest = deepest.max(level);
-            let node = &self.nodes[index as usize];
-            if node.count == 0 {
-                pending.extend([(node.first, level + 1), (node.first + 1, level + 1)]);
-            }
+    /// The layout of its group.
+    pub fn layout(self, device: &wgpu::Device) -> wgpu::BindGroupLayout {
+        match self {
+            Tracer::Compute => compute::layout(device),
+            Tracer::RayQuery => query::layout(device),
         }
-        deepest
+    }
+
+    /// How `list`, counters and notes name it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Tracer::Compute => "BVH walked in a shader",
+            Tracer::RayQuery => "hardware ray queries",
+        }
     }
 }
 
-/// What building and uploading a hierarchy took, for counters and benchmarks.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BuildStats {
-    pub triangles: usize,
+/// The text of library shader `shader` (which imports [`TRACE_MODULE`]) for `tracer`: as
+/// written for the portable traversal, with [`QUERY_MODULE`] imported instead for ray queries.
+pub fn shader_source(
+    library: &ShaderLibrary,
+    shader: &str,
+    tracer: Tracer,
+) -> Result<String, zoo_host::gpu::ShaderError> {
+    let text = library.source(shader)?;
+    let import = |module: &str| format!("#import \"{module}\"");
+    let portable = import(TRACE_MODULE);
+    let Some(line) = text.lines().position(|l| l.trim() == portable) else {
+        return Err(zoo_host::gpu::ShaderError::Import {
+            file: shader.to_string(),
+            line: 1,
+            message: format!("a ray-tracing shader imports `{TRACE_MODULE}`"),
+        });
+    };
+    Ok(match tracer {
+        Tracer::Compute => text,
+        Tracer::RayQuery => {
+            let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+            lines[line] = import(QUERY_MODULE);
+            lines.join("\n")
+        }
+    })
+}
+
+/// One shadow-casting triangle as both traversals store it.
+pub(crate) struct CasterTriangle {
+    pub corners: [Vec3; 3],
+    pub mask: Option<AlphaMask>,
+    pub uv: [Vec2; 3],
+}
+
+/// Every shadow-casting triangle of `scene`, in object order.
+pub(crate) fn caster_triangles(scene: &Scene) -> Vec<CasterTriangle> {
+    let mut casters = Vec::new();
+    for o in scene.objects.iter().filter(|o| o.casts_shadows) {
+        for tri in scene.triangle_indices(o) {
+            casters.push(CasterTriangle {
+                corners: tri.map(|i| scene.mesh.positions[i]),
+                mask: o.alpha_mask,
+                uv: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
+            });
+        }
+    }
+    casters
+}
+
+/// A read-only storage buffer holding `contents`.
+pub(crate) fn storage_buffer(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::Buffer {
+    use zoo_host::wgpu::util::DeviceExt;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE,
+    })
+}
+
+/// The bytes of `records`, or of one zeroed record (storage buffers cannot be empty).
+pub(crate) fn or_one_zeroed<T: Pod>(records: &[T]) -> Vec<u8> {
+    if records.is_empty() {
+        vec![0; size_of::<T>()]
+    } else {
+        bytemuck::cast_slice(records).to_vec()
+    }
+}
+
+/// The size of the portable traversal's hierarchy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Hierarchy {
     pub nodes: usize,
     /// Levels below the root.
     pub depth: u32,
-    /// CPU time of the build and the upload, in milliseconds.
+}
+
+/// What building and uploading the casters took, for counters and benchmarks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BuildStats {
+    pub tracer: Tracer,
+    pub triangles: usize,
+    /// The hierarchy the shader walks (the portable traversal only; the driver's is opaque).
+    pub hierarchy: Option<Hierarchy>,
+    /// CPU time of the build and the upload, in milliseconds (for ray queries, the driver's
+    /// build is recorded then and runs on the GPU before the first trace).
     pub milliseconds: f64,
 }
 
 impl BuildStats {
     /// The statistics as named counters (`ShadowTechnique::counters`).
     pub fn counters(&self) -> Vec<(String, f64)> {
-        vec![
+        let mut counters = vec![
             ("BVH triangles".to_string(), self.triangles as f64),
-            ("BVH nodes".to_string(), self.nodes as f64),
-            ("BVH depth".to_string(), f64::from(self.depth)),
             ("BVH build ms".to_string(), self.milliseconds),
-        ]
+            (
+                "hardware ray queries".to_string(),
+                f64::from(u8::from(self.tracer == Tracer::RayQuery)),
+            ),
+        ];
+        if let Some(h) = self.hierarchy {
+            counters.push(("BVH nodes".to_string(), h.nodes as f64));
+            counters.push(("BVH depth".to_string(), f64::from(h.depth)));
+        }
+        counters
     }
 }
 
-/// The uploaded hierarchy and its bind group (group [`GROUP`]).
+/// The uploaded casters and their bind group (group [`GROUP`]).
 pub struct RayTracing {
     pub bind_group: wgpu::BindGroup,
     pub stats: BuildStats,
@@ -165,105 +214,21 @@ pub struct RayTracing {
     vertices: wgpu::Buffer,
 }
 
-/// The layout of the ray-tracing group (for the pipelines that bind it).
-pub fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let stages = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-    bind_group_layout(
-        device,
-        "ray tracing layout",
-        &[
-            storage(0, stages, true),
-            storage(1, stages, true),
-            storage(2, stages, true),
-            texture(
-                3,
-                stages,
-                wgpu::TextureSampleType::Float { filterable: true },
-                wgpu::TextureViewDimension::D2Array,
-            ),
-            sampler(4, stages, wgpu::SamplerBindingType::Filtering),
-        ],
-    )
-}
-
 impl RayTracing {
-    /// Builds and uploads the hierarchy of `ctx`'s scene; an error when it is deeper than the
+    /// Uploads the casters of `ctx`'s scene for `tracer`, whose group layout is `layout`
+    /// ([`Tracer::layout`]); an error when the portable hierarchy is deeper than its
     /// traversal's stack holds.
     pub fn new(
         ctx: &RenderContext<'_>,
+        tracer: Tracer,
         layout: &wgpu::BindGroupLayout,
     ) -> TechniqueResult<RayTracing> {
         let start = std::time::Instant::now();
-        let geometry = CasterGeometry::of(ctx.scene);
-        let depth = geometry.depth();
-        if depth >= STACK_SIZE {
-            return Err(TechniqueError::Other(format!(
-                "the casters' hierarchy has {depth} levels; GPU traversal holds {STACK_SIZE}"
-            )));
-        }
-        let device = &ctx.gpu.device;
-        // Storage buffers cannot be empty: a scene without casters gets one leaf over one
-        // triangle without area, which no ray hits.
-        let empty = GpuNode {
-            min: [0.0; 3],
-            first: 0,
-            max: [0.0; 3],
-            count: 1,
+        let (bind_group, mut stats) = match tracer {
+            Tracer::Compute => compute::upload(ctx, layout)?,
+            Tracer::RayQuery => query::upload(ctx, layout)?,
         };
-        let nodes = if geometry.nodes.is_empty() {
-            vec![empty]
-        } else {
-            geometry.nodes.clone()
-        };
-        let or_one = |v: &[u8], size: usize| -> Vec<u8> {
-            if v.is_empty() {
-                vec![0; size]
-            } else {
-                v.to_vec()
-            }
-        };
-        let buffer = |label: &str, contents: &[u8]| {
-            use zoo_host::wgpu::util::DeviceExt;
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
-        let nodes = buffer("ray tracing nodes", bytemuck::cast_slice(&nodes));
-        let triangles = buffer(
-            "ray tracing triangles",
-            &or_one(
-                bytemuck::cast_slice(&geometry.triangles),
-                size_of::<GpuTriangle>(),
-            ),
-        );
-        let texcoords = buffer(
-            "ray tracing texture coordinates",
-            &or_one(
-                bytemuck::cast_slice(&geometry.texcoords),
-                size_of::<GpuTexcoords>(),
-            ),
-        );
-        let materials = &ctx.scene_buffers.materials;
-        let bind_group = bind_group(
-            device,
-            "ray tracing bind group",
-            layout,
-            &[
-                nodes.as_entire_binding(),
-                triangles.as_entire_binding(),
-                texcoords.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&materials.textures),
-                wgpu::BindingResource::Sampler(&materials.sampler),
-            ],
-        );
-        let stats = BuildStats {
-            triangles: geometry.triangles.len(),
-            nodes: geometry.nodes.len(),
-            depth,
-            milliseconds: start.elapsed().as_secs_f64() * 1000.0,
-        };
+        stats.milliseconds = start.elapsed().as_secs_f64() * 1000.0;
         Ok(RayTracing {
             bind_group,
             stats,
@@ -280,89 +245,20 @@ impl RayTracing {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror};
 
     #[test]
-    fn records_mirror_the_shader() {
-        let node = zoo_host::mirror_fields!(GpuNode {
-            min,
-            first,
-            max,
-            count
-        });
-        check_embedded_mirror("ray-tracing/trace.wgsl", "RtNode", node, SizeRule::Equal).unwrap();
-        let triangle = zoo_host::mirror_fields!(GpuTriangle {
-            v0,
-            _pad,
-            e1,
-            mask_layer,
-            e2,
-            alpha_cutoff
-        });
-        check_embedded_mirror(
-            "ray-tracing/trace.wgsl",
-            "RtTriangle",
-            triangle,
-            SizeRule::Equal,
-        )
-        .unwrap();
-        let texcoords = zoo_host::mirror_fields!(GpuTexcoords { uv, _pad });
-        check_embedded_mirror(
-            "ray-tracing/trace.wgsl",
-            "RtTexcoords",
-            texcoords,
-            SizeRule::Equal,
-        )
-        .unwrap();
-    }
-
-    #[test]
-    fn every_caster_triangle_is_stored_once_inside_its_leaf() {
-        let scene = zoo_host::test_support::scene_from_ron(
-            "casters.ron",
-            r#"(camera: (position: (0, 3, 6), target: (0, 0, 0)),
-                lights: [Point(position: (0, 4, 0))],
-                objects: [
-                    (mesh: Plane(size: 10), casts_shadows: false),
-                    (mesh: Sphere(radius: 1, segments: 12, rings: 8)),
-                    (mesh: Box(size: (1, 2, 1)), transform: (translation: (2, 1, 0))),
-                ])"#,
-        );
-        let geometry = CasterGeometry::of(&scene);
-        let casters = scene.objects[1..]
-            .iter()
-            .map(|o| o.indices.len() / 3)
-            .sum::<usize>();
-        assert_eq!(geometry.triangles.len(), casters);
-        assert!(geometry.triangles.iter().all(|t| t.mask_layer == -1));
-        let depth = geometry.depth();
-        assert!((2..STACK_SIZE).contains(&depth), "{depth} levels");
-        let mut covered = vec![0; geometry.triangles.len()];
-        for node in geometry.nodes.iter().filter(|n| n.count > 0) {
-            let (lo, hi) = (glam_vec(node.min), glam_vec(node.max));
-            for t in &geometry.triangles[node.first as usize..(node.first + node.count) as usize] {
-                let v0 = glam_vec(t.v0);
-                for p in [v0, v0 + glam_vec(t.e1), v0 + glam_vec(t.e2)] {
-                    assert!(p.cmpge(lo - 1e-4).all() && p.cmple(hi + 1e-4).all());
-                }
-            }
-            for c in &mut covered[node.first as usize..(node.first + node.count) as usize] {
-                *c += 1;
-            }
-        }
-        assert!(covered.iter().all(|&c| c == 1), "{covered:?}");
-    }
-
-    #[test]
-    fn the_shader_holds_as_many_pending_nodes_as_declared() {
-        let composed = zoo_host::ShaderLibrary::embedded()
-            .compose("ray-tracing/trace.wgsl")
-            .unwrap();
-        let size = zoo_host::gpu::layout::wgsl_integer_constant(&composed.source, "RT_STACK_SIZE");
-        assert_eq!(size, Ok(i64::from(STACK_SIZE)));
-    }
-
-    fn glam_vec(v: [f32; 3]) -> zoo_host::glam::Vec3 {
-        zoo_host::glam::Vec3::from(v)
+    fn the_query_variant_of_a_tracing_shader_validates_and_errors_point_home() {
+        let library = ShaderLibrary::embedded();
+        let shader = "rt-shadows/shadows.wgsl";
+        let portable = shader_source(&library, shader, Tracer::Compute).unwrap();
+        assert_eq!(portable, library.source(shader).unwrap());
+        let query = shader_source(&library, shader, Tracer::RayQuery).unwrap();
+        assert!(query.contains("#import \"ray-tracing/query.wgsl\""));
+        assert!(!query.contains(&format!("#import \"{TRACE_MODULE}\"")));
+        let (composed, _) = library.validate_source(shader, &query).unwrap();
+        assert!(composed.source.starts_with("enable wgpu_ray_query;"));
+        // A shader that does not import the portable traversal is refused by name.
+        let err = shader_source(&library, "common/frame.wgsl", Tracer::RayQuery).unwrap_err();
+        assert!(err.to_string().contains("common/frame.wgsl"), "{err}");
     }
 }

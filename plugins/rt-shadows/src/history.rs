@@ -80,15 +80,17 @@ pub struct Accumulation {
 }
 
 impl Accumulation {
-    /// The pipeline of fragment `entry` in `shader`, after the frame and G-buffer groups: the
-    /// per-light uniform (2) and the ray-tracing group (3).
+    /// The pipeline of fragment `entry` in WGSL `text` (library shader `shader` as composed
+    /// for the tracer), after the frame and G-buffer groups: the per-light uniform (2) and the
+    /// ray-tracing group (3).
     pub fn new(
         ctx: &RenderContext<'_>,
         shader: &str,
+        text: &str,
         entry: &str,
         tracing: &wgpu::BindGroupLayout,
     ) -> TechniqueResult<Accumulation> {
-        let module = ctx.shaders.create_module(&ctx.gpu.device, shader)?;
+        let module = (ctx.shaders).create_module_from_source(&ctx.gpu.device, shader, text)?;
         let uniforms = kit::UniformSlots::new(
             ctx.gpu,
             "rt-shadows accumulation",

@@ -1,5 +1,6 @@
 //! Ray-traced shadows on any adapter: from each pixel's surface, any-hit shadow rays through
-//! the scene's bounding volume hierarchy (`zoo-ray-tracing`, traversed in a fragment shader):
+//! the scene's casters (`zoo-ray-tracing`: a bounding volume hierarchy walked in a fragment
+//! shader, or hardware ray queries where the device has them):
 //! one ray to each light's centre gives exact hard shadows; several rays to points of the
 //! light's disk (a rotated low-discrepancy pattern per pixel, continued frame after frame)
 //! give soft ones, averaged over the frames of a still view ([`history`]) and smoothed by an
@@ -7,7 +8,7 @@
 
 use zoo_host::ResourceInfo;
 use zoo_host::prelude::*;
-use zoo_ray_tracing::RayTracing;
+use zoo_ray_tracing::{RayTracing, Tracer, Traversal};
 
 mod history;
 
@@ -25,6 +26,9 @@ zoo_host::technique_params! {
         /// Frames of soft shadows averaged while nothing moves (1: each frame on its own, its
         /// rays the same every frame); each frame traces a new pattern.
         accumulation: u32 = 16, range(1, 256), step(1);
+        /// How rays find casters: hardware ray queries where the device has them (`Auto`), the
+        /// portable BVH walk (`Compute`), or ray queries only (`RayQuery`).
+        traversal: Traversal = Traversal::Auto, flags(rebuild);
     }
 }
 
@@ -51,6 +55,7 @@ const DENOISE_PASS: &str = "Denoise";
 
 /// The pipelines, the hierarchy they trace and the soft lights' history.
 struct Gpu {
+    tracer: Tracer,
     tracing_layout: wgpu::BindGroupLayout,
     trace: FullscreenLightPass<RtLight>,
     history_layout: wgpu::BindGroupLayout,
@@ -61,10 +66,14 @@ struct Gpu {
 }
 
 impl Gpu {
-    fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Gpu> {
+    fn new(ctx: &RenderContext<'_>, traversal: Traversal) -> TechniqueResult<Gpu> {
         let device = &ctx.gpu.device;
-        let tracing_layout = zoo_ray_tracing::layout(device);
-        let trace = FullscreenLightPass::new(ctx, TRACE_SHADER, "fs_main", &[&tracing_layout])?;
+        let tracer = Tracer::choose(traversal, device, "rt-shadows")?;
+        let tracing_layout = tracer.layout(device);
+        let trace_text = zoo_ray_tracing::shader_source(ctx.shaders, TRACE_SHADER, tracer)?;
+        let groups = [&tracing_layout];
+        let trace =
+            FullscreenLightPass::from_source(ctx, TRACE_SHADER, &trace_text, "fs_main", &groups)?;
         let history_layout = kit::bind_group_layout(
             device,
             "rt-shadows history layout",
@@ -75,10 +84,17 @@ impl Gpu {
                 wgpu::TextureViewDimension::D2Array,
             )],
         );
-        let accumulation = Accumulation::new(ctx, TRACE_SHADER, "fs_accumulate", &tracing_layout)?;
+        let accumulation = Accumulation::new(
+            ctx,
+            TRACE_SHADER,
+            &trace_text,
+            "fs_accumulate",
+            &tracing_layout,
+        )?;
         let denoise =
             FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[&history_layout])?;
         Ok(Gpu {
+            tracer,
             tracing_layout,
             trace,
             history_layout,
@@ -101,9 +117,11 @@ struct RtShadows {
 
 impl ShadowTechnique for RtShadows {
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        let gpu = self.gpu.prepare(false, || Gpu::new(ctx))?;
+        let traversal = self.params.traversal;
+        let gpu = self.gpu.prepare(false, || Gpu::new(ctx, traversal))?;
         if changes.scene || gpu.tracing.as_ref().is_none_or(|t| !t.is_for(ctx)) {
-            gpu.tracing = Some(RayTracing::new(ctx, &gpu.tracing_layout)?);
+            let tracing = RayTracing::new(ctx, gpu.tracer, &gpu.tracing_layout)?;
+            gpu.tracing = Some(tracing);
         }
         let Changes {
             scene,
@@ -218,7 +236,7 @@ fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn Shado
 zoo_host::register_technique! {
     id: "rt-shadows",
     name: "Ray-traced shadows",
-    description: "Any-hit shadow rays through the scene's BVH in a fragment shader: one to each light (hard) or several to its disk (soft)",
+    description: "Any-hit shadow rays through the scene's BVH in a fragment shader, or by hardware ray queries: one to each light (hard) or several to its disk (soft)",
     source: "ray tracing (the judge's visibility on the GPU)",
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
@@ -227,6 +245,8 @@ zoo_host::register_technique! {
         max_storage_buffers_per_shader_stage: 5,
         ..wgpu::Limits::downlevel_defaults()
     },
+    // Hardware ray queries where the adapter has them (`traversal` Auto or RayQuery).
+    optional_features: || wgpu::Features::EXPERIMENTAL_RAY_QUERY,
     params: RtParams::schema,
     create: create,
 }

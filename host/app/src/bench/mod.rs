@@ -15,7 +15,8 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use zoo_host::ShaderLibrary;
+use zoo_host::render::RenderError;
+use zoo_host::{ShaderLibrary, TechniqueError};
 
 use crate::cli::BenchArgs;
 pub use crate::cli::PathMode;
@@ -24,13 +25,42 @@ pub use measure::*;
 pub use plan::*;
 pub use report::*;
 
-/// Runs plans with `shaders`, writes the outputs, and returns the results.
+/// A configuration this adapter cannot run (a technique, or a choice of one, needs a device
+/// feature it lacks), left out of the results.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Skipped {
+    /// The configuration, as `run: label`.
+    pub configuration: String,
+    pub reason: String,
+}
+
+/// What a benchmark measured, and what it had to leave out.
+pub struct BenchRun {
+    pub results: Vec<ConfigResult>,
+    pub skipped: Vec<Skipped>,
+}
+
+/// Whether `error` says the technique cannot run on this device (rather than that it failed).
+fn is_unavailable(error: &anyhow::Error) -> bool {
+    error.chain().any(|cause| {
+        let technique = cause.downcast_ref::<TechniqueError>().or_else(|| {
+            match cause.downcast_ref::<RenderError>() {
+                Some(RenderError::Technique(t)) => Some(t),
+                _ => None,
+            }
+        });
+        matches!(technique, Some(TechniqueError::Unavailable { .. }))
+    })
+}
+
+/// Runs plans with `shaders`, writes the outputs, and returns the results. Configurations this
+/// adapter cannot run are skipped and listed; any other failure stops the benchmark.
 pub fn run_plans(
     plans: &[BenchPlan],
     shaders: &ShaderLibrary,
     out: &Path,
     suite: Option<&suite::Suite>,
-) -> anyhow::Result<Vec<ConfigResult>> {
+) -> anyhow::Result<BenchRun> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output folder {}", out.display()))?;
     let probe = out.join("bench.csv");
@@ -55,11 +85,20 @@ pub fn run_plans(
             .expect("valid template"),
     );
     let mut results = Vec::new();
+    let mut skipped = Vec::new();
     for (i, config) in &configs {
         bar.set_message(config.label());
-        let result = run_configuration(&gpu, shaders, &plans[*i], config, || bar.inc(1))
-            .with_context(|| format!("{} in run {}", config.label(), config.run))?;
-        results.push(result);
+        match run_configuration(&gpu, shaders, &plans[*i], config, || bar.inc(1)) {
+            Ok(result) => results.push(result),
+            Err(e) if is_unavailable(&e) => {
+                bar.inc(u64::from(plans[*i].frames + plans[*i].warmup));
+                skipped.push(Skipped {
+                    configuration: format!("{}: {}", config.run, config.label()),
+                    reason: format!("{e:#}"),
+                });
+            }
+            Err(e) => return Err(e.context(format!("{} in run {}", config.label(), config.run))),
+        }
     }
     bar.finish_and_clear();
     let adapter = gpu.describe();
@@ -67,10 +106,10 @@ pub fn run_plans(
     std::fs::write(out.join("summary.csv"), summary_csv(&results))?;
     std::fs::write(
         out.join("bench.md"),
-        bench_md(plans, &results, &adapter, suite),
+        bench_md(plans, &results, &skipped, &adapter, suite),
     )?;
     write_plots(plans, &results, out)?;
-    Ok(results)
+    Ok(BenchRun { results, skipped })
 }
 
 /// Runs `shadow-zoo bench`.
@@ -125,7 +164,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         bail!("--frames must be at least 1");
     }
     let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
-    let results = run_plans(&plans, &shaders, &args.out, suite.as_ref())?;
+    let BenchRun { results, skipped } = run_plans(&plans, &shaders, &args.out, suite.as_ref())?;
     for r in &results {
         println!(
             "  {:10} {:50} frame {:8.2} ms  {}  flicker {}",
@@ -136,9 +175,39 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             r.flicker.map_or("-".into(), |f| format!("{f:.5}"))
         );
     }
+    for s in &skipped {
+        println!("  skipped {}: {}", s.configuration, s.reason);
+    }
     println!(
         "wrote {}/bench.csv, summary.csv, bench.md and plots",
         args.out.display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_what_the_device_cannot_run_is_skipped() {
+        let unavailable = TechniqueError::Unavailable {
+            id: "rt-shadows".into(),
+            reason: "needs hardware ray queries".into(),
+        };
+        let wrapped = anyhow::Error::from(RenderError::Technique(unavailable.clone()))
+            .context("rt-shadows in run ray-queries");
+        assert!(is_unavailable(&wrapped));
+        assert!(is_unavailable(&anyhow::Error::from(unavailable)));
+        let failed = TechniqueError::Validation {
+            id: "rt-shadows".into(),
+            message: "bad binding".into(),
+        };
+        assert!(!is_unavailable(&anyhow::Error::from(
+            RenderError::Technique(failed)
+        )));
+        assert!(!is_unavailable(&anyhow::anyhow!(
+            "scene.lights=8 but the scene has 1"
+        )));
+    }
 }

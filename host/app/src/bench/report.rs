@@ -240,6 +240,7 @@ pub fn per_light_costs(results: &[ConfigResult]) -> Vec<(String, String, String,
 pub fn bench_md(
     plans: &[BenchPlan],
     results: &[ConfigResult],
+    skipped: &[super::Skipped],
     adapter: &str,
     suite: Option<&suite::Suite>,
 ) -> String {
@@ -276,6 +277,13 @@ pub fn bench_md(
             plan.frames,
             plan.warmup,
             plan.path
+        );
+    }
+    for s in skipped {
+        let _ = writeln!(
+            w,
+            "- Skipped `{}`: this adapter cannot run it ({})",
+            s.configuration, s.reason
         );
     }
     let _ = writeln!(

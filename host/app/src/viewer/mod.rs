@@ -2,12 +2,14 @@
 //! through the same renderer as the CLI and is shown in egui; panels switch techniques, edit
 //! their generated parameters and the lights, pick debug views (full screen or overlaid),
 //! compare two techniques (A/B split or difference), judge the view against the ray-traced
-//! reference in the background, and show per-pass timings. Edits under `shaders/` are
+//! reference (in the background on the CPU, or live on the GPU as the view changes), and show
+//! per-pass timings. Edits under `shaders/` are
 //! reloaded while it runs.
 
 pub mod camera;
 pub mod hot_reload;
 pub mod lights;
+mod live;
 mod panels;
 pub mod reference;
 pub mod split;

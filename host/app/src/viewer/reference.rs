@@ -1,5 +1,6 @@
-//! The reference overlay: judges the current view against ray-traced visibility on a
-//! background thread and shows the error map with its metrics.
+//! The reference overlay: judges the current view against ray-traced visibility, on demand by
+//! the CPU judge on a background thread ("Judge view"), or live on the GPU as the view changes
+//! ([`LiveReference`]), and shows the error map with its metrics.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -12,6 +13,8 @@ use zoo_host::judging::{DEFAULT_SAMPLES, error_map, surface_points};
 use zoo_host::params::ParamValues;
 use zoo_host::scene::{Camera, Light};
 use zoo_host::{Renderer, View};
+
+use super::live::{LiveReference, RAYS_PER_FRAME};
 
 /// What a judgement was computed for; a different key makes it stale.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,6 +67,9 @@ pub struct ReferenceOverlay {
     pub light: usize,
     pub opacity: f32,
     pub visible: bool,
+    /// Whether the view is judged live on the GPU, following every change.
+    pub live: bool,
+    live_reference: LiveReference,
     texture: Option<(usize, egui::TextureHandle)>,
 }
 
@@ -133,6 +139,37 @@ impl ReferenceOverlay {
         Ok(())
     }
 
+    /// Judges what `renderer` shows on the GPU when the live judge is on and the view changed
+    /// or has samples to add (call once per frame, after rendering); turns the live judge off
+    /// on an error.
+    pub fn follow(&mut self, renderer: &Renderer) -> anyhow::Result<()> {
+        if !self.live {
+            return Ok(());
+        }
+        match self.live_reference.update(renderer) {
+            Ok(Some(judgement)) => {
+                self.show(judgement);
+                Ok(())
+            }
+            Ok(None) => Ok(()),
+            Err(e) => {
+                self.live = false;
+                Err(e)
+            }
+        }
+    }
+
+    /// Area rays a pixel the live judge has traced for the current view, while it is on.
+    pub fn live_samples(&self) -> Option<u32> {
+        self.live.then(|| self.live_reference.samples())
+    }
+
+    fn show(&mut self, judgement: Judgement) {
+        self.light = self.light.min(judgement.error_maps.len().saturating_sub(1));
+        self.texture = None;
+        self.result = Some(judgement);
+    }
+
     /// Whether a judgement is being computed.
     pub fn is_running(&self) -> bool {
         self.running.is_some()
@@ -159,9 +196,7 @@ impl ReferenceOverlay {
         let judgement = running.worker.join().map_err(|_| {
             anyhow::anyhow!("the reference judge failed for {}", running.view.technique)
         })?;
-        self.light = self.light.min(judgement.error_maps.len().saturating_sub(1));
-        self.texture = None;
-        self.result = Some(judgement);
+        self.show(judgement);
         self.visible = true;
         Ok(())
     }
@@ -212,11 +247,18 @@ impl ReferenceOverlay {
                     "Trace exact visibility for this view in the background and overlay \
                      where the technique disagrees",
                 );
-            if button.clicked()
-                && let Err(e) = self.start(renderer)
-            {
-                error = Some(format!("cannot judge the view: {e}"));
+            if button.clicked() {
+                // The CPU judge, the arbiter, replaces the live one.
+                self.live = false;
+                if let Err(e) = self.start(renderer) {
+                    error = Some(format!("cannot judge the view: {e}"));
+                }
             }
+            ui.checkbox(&mut self.live, "live (GPU)")
+                .on_hover_text(format!(
+                    "Judge every frame on the GPU as the view changes: hard visibility at once, \
+                 then {RAYS_PER_FRAME} area rays a pixel each frame"
+                ));
             if let Some((done, all)) = self.progress() {
                 ui.add(
                     egui::ProgressBar::new(done as f32 / all.max(1) as f32)
@@ -239,8 +281,13 @@ impl ReferenceOverlay {
                 "stale: the view changed since it was judged (map hidden)",
             );
         }
+        let traced = match self.live_samples() {
+            Some(0) => "live on the GPU, hard visibility".to_string(),
+            Some(samples) => format!("live on the GPU, {samples} area rays a pixel"),
+            None => "by the CPU judge".to_string(),
+        };
         ui.label(format!(
-            "{} · {} triangles traced in {:.2} s · red false shadow, blue false lit",
+            "{} · {} triangles traced {traced} in {:.2} s · red false shadow, blue false lit",
             result.view.technique, result.occluder_triangles, result.seconds
         ));
         egui::Grid::new("reference metrics")

@@ -501,6 +501,9 @@ impl ViewerState {
                 self.view = View::Final;
             }
         }
+        if let Err(e) = self.reference.follow(&self.renderer) {
+            self.error = Some(e.to_string());
+        }
         self.render_b(size, camera, &view);
         self.frame += 1;
     }

@@ -140,11 +140,9 @@ pub fn run() -> anyhow::Result<()> {
         ..Default::default()
     };
     if let egui_wgpu::WgpuSetup::CreateNew(create) = &mut options.wgpu_options.wgpu_setup {
-        create.device_descriptor = Arc::new(|adapter: &wgpu::Adapter| wgpu::DeviceDescriptor {
-            label: Some("shadow-zoo viewer device"),
-            required_features: GpuContext::wanted_features(adapter),
-            required_limits: adapter.limits(),
-            ..Default::default()
+        create.device_descriptor = Arc::new(|adapter: &wgpu::Adapter| {
+            let none_removed = wgpu::Features::empty();
+            GpuContext::device_descriptor(adapter, "shadow-zoo viewer device", none_removed)
         });
         create.native_adapter_selector = Some(Arc::new(
             |adapters: &[wgpu::Adapter], surface: Option<&wgpu::Surface<'_>>| {

@@ -74,14 +74,12 @@ impl GpuContext {
         let backends = descriptor.backends;
         let instance = wgpu::Instance::new(descriptor);
         let adapter = select_adapter(&instance, backends).await?;
-        let features = Self::wanted_features(&adapter) - removed;
+        let mut descriptor = Self::device_descriptor(&adapter, "shadow-zoo device", removed);
+        if let Some(limits) = limits {
+            descriptor.required_limits = limits;
+        }
         let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("shadow-zoo device"),
-                required_features: features,
-                required_limits: limits.unwrap_or_else(|| adapter.limits()),
-                ..Default::default()
-            })
+            .request_device(&descriptor)
             .await
             .map_err(|e| GpuError::Device(e.to_string()))?;
         Ok(Self::from_parts(instance, adapter, device, queue))
@@ -98,6 +96,34 @@ impl GpuContext {
             wanted |= (registration.required_features)() | (registration.optional_features)();
         }
         wanted & adapter.features()
+    }
+
+    /// The device to request from `adapter`: [`Self::wanted_features`] less `removed`, and the
+    /// adapter's limits. Experimental features (hardware ray queries) are opted into only when
+    /// a technique would use one the adapter has.
+    // The one unsafe block of the project: wgpu's opt-in token for experimental features.
+    #[allow(unsafe_code)]
+    pub fn device_descriptor(
+        adapter: &wgpu::Adapter,
+        label: &'static str,
+        removed: wgpu::Features,
+    ) -> wgpu::DeviceDescriptor<'static> {
+        let features = Self::wanted_features(adapter) - removed;
+        let experimental = if features.intersects(wgpu::Features::all_experimental_mask()) {
+            // SAFETY: only the experimental features techniques declare are requested, and
+            // their paths are compared with the portable ones where both exist (the
+            // ray-tracing library's tests).
+            unsafe { wgpu::ExperimentalFeatures::enabled() }
+        } else {
+            wgpu::ExperimentalFeatures::disabled()
+        };
+        wgpu::DeviceDescriptor {
+            label: Some(label),
+            required_features: features,
+            required_limits: adapter.limits(),
+            experimental_features: experimental,
+            ..Default::default()
+        }
     }
 
     /// Wraps objects created elsewhere (the viewer's eframe device, for example).

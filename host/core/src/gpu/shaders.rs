@@ -1,7 +1,9 @@
 //! WGSL sources: embedded at build time, optionally read from disk, composed with `#import`.
 //!
 //! A line `#import "common/frame.wgsl"` is replaced by that file's text (each file is included
-//! once per module). Errors are reported against the original file, line and column.
+//! once per module); `enable` directives of any file (`enable wgpu_ray_query;`) move to the
+//! top, where WGSL requires them. Errors are reported against the original file, line and
+//! column.
 
 use std::collections::HashSet;
 use std::path::PathBuf;
@@ -47,6 +49,38 @@ pub struct ComposedShader {
 }
 
 impl ComposedShader {
+    /// Moves `enable` directives (each once) before every declaration, keeping their origins.
+    fn hoist_enable_directives(&mut self) {
+        let mut enables: Vec<(&str, (Arc<str>, usize))> = Vec::new();
+        let mut body = String::with_capacity(self.source.len());
+        let mut body_map = Vec::with_capacity(self.line_map.len());
+        for (line, origin) in self.source.lines().zip(&self.line_map) {
+            if line.trim_start().starts_with("enable ") {
+                if !enables.iter().any(|(e, _)| e.trim() == line.trim()) {
+                    enables.push((line, origin.clone()));
+                }
+            } else {
+                body.push_str(line);
+                body.push('\n');
+                body_map.push(origin.clone());
+            }
+        }
+        if enables.is_empty() {
+            return;
+        }
+        let mut source = String::with_capacity(self.source.len());
+        let mut line_map = Vec::with_capacity(self.line_map.len());
+        for (line, origin) in enables {
+            source.push_str(line);
+            source.push('\n');
+            line_map.push(origin);
+        }
+        source.push_str(&body);
+        line_map.extend(body_map);
+        self.source = source;
+        self.line_map = line_map;
+    }
+
     /// Maps a 1-based line of the composed source back to (file, line).
     pub fn origin(&self, line: usize) -> (String, usize) {
         self.line_map
@@ -146,6 +180,7 @@ impl ShaderLibrary {
         };
         let mut seen = HashSet::from([name.to_string()]);
         self.append_text(name, text, &mut out, &mut seen, &mut Vec::new())?;
+        out.hoist_enable_directives();
         Ok(out)
     }
 
@@ -204,6 +239,17 @@ impl ShaderLibrary {
     /// Composes and validates `name` with naga, reporting errors at their original location.
     pub fn validate(&self, name: &str) -> Result<(ComposedShader, naga::Module), ShaderError> {
         let (composed, module, _) = Self::validated(self.compose(name)?)?;
+        Ok((composed, module))
+    }
+
+    /// Composes and validates WGSL `text` that is not a file of the library (see
+    /// [`Self::compose_source`]).
+    pub fn validate_source(
+        &self,
+        name: &str,
+        text: &str,
+    ) -> Result<(ComposedShader, naga::Module), ShaderError> {
+        let (composed, module, _) = Self::validated(self.compose_source(name, text)?)?;
         Ok((composed, module))
     }
 
@@ -351,5 +397,37 @@ mod tests {
             err,
             "shaders/missing.wgsl:2: cannot import `common/nope.wgsl`: no such shader"
         );
+    }
+
+    #[test]
+    fn enable_directives_of_imports_go_first_once_and_errors_still_point_home() {
+        let dir = std::env::temp_dir().join(format!("zoo-enable-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("lib")).unwrap();
+        std::fs::write(
+            dir.join("lib/half.wgsl"),
+            "enable f16;\nfn half() -> f16 { return 1.0h; }\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("main.wgsl"),
+            "// main\nconst one: f32 = 1.0;\n#import \"lib/half.wgsl\"\nenable f16;\n\
+             @compute @workgroup_size(1) fn main() { let x = half() + missing; }\n",
+        )
+        .unwrap();
+        let library = ShaderLibrary::from_disk(dir);
+        let composed = library.compose("main.wgsl").unwrap();
+        let lines: Vec<&str> = composed.source.lines().collect();
+        assert_eq!(lines[0], "enable f16;");
+        assert_eq!(lines.iter().filter(|l| l.starts_with("enable")).count(), 1);
+        assert_eq!(composed.origin(1), ("lib/half.wgsl".to_string(), 1));
+        assert_eq!(composed.origin(2), ("main.wgsl".to_string(), 1));
+        // The module parses (the directive is before every declaration) and its error is
+        // reported where it was written.
+        match library.validate("main.wgsl").unwrap_err() {
+            ShaderError::Compile { file, line, .. } => {
+                assert_eq!((file.as_str(), line), ("main.wgsl", 5))
+            }
+            other => panic!("unexpected {other}"),
+        }
     }
 }

@@ -1,0 +1,134 @@
+//! The live reference: while it is on, the view is judged against visibility traced on the
+//! GPU by the GPU judge's tracer (`rt-shadows`, in a renderer of its own) whenever it changes:
+//! hard visibility in the frame of the change, then [`RAYS_PER_FRAME`] area rays a pixel and
+//! light added each frame up to the GPU judge's [`MAX_SAMPLES`], the technique scored against
+//! it each time. Which pixels a light reaches comes from the G-buffer's surfaces ("Judge view"
+//! runs the CPU judge, the arbiter, which locates them on the exact triangles).
+
+use std::time::Instant;
+
+use zoo_host::judge::Metrics;
+use zoo_host::judging::error_map;
+use zoo_host::scene::shading::contributes;
+use zoo_host::technique::counter;
+use zoo_host::{Renderer, View};
+
+use super::reference::{JudgedView, Judgement};
+use crate::gpu_judge::{MAX_SAMPLES, TRACER, check_traceable, light_reference, tracer_values};
+
+/// Area rays a pixel and light each frame adds.
+pub const RAYS_PER_FRAME: u32 = 4;
+
+/// The tracer and what it has traced of the current view.
+#[derive(Default)]
+pub struct LiveReference {
+    tracer: Option<Renderer>,
+    view: Option<JudgedView>,
+    /// Per light: the pixels it reaches, and their hard visibility.
+    contributing: Vec<Vec<bool>>,
+    hard: Vec<Vec<f32>>,
+    /// Area rays a pixel traced for the current view (0: hard visibility only).
+    samples: u32,
+    /// Tracing time spent on the current view.
+    seconds: f64,
+}
+
+impl LiveReference {
+    /// Area rays a pixel traced so far for the current view.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Traces more of the reference of what `renderer` shows (rendered this frame) and judges
+    /// its technique against it: the new judgement, or `None` once the view has all its
+    /// samples.
+    pub fn update(&mut self, renderer: &Renderer) -> anyhow::Result<Option<Judgement>> {
+        check_traceable(renderer.scene(), "live judge", "Judge view")?;
+        let view = JudgedView::of(renderer);
+        let start = Instant::now();
+        let area = if self.view.as_ref() != Some(&view) {
+            self.restart(renderer, &view)?;
+            self.hard.clone()
+        } else if self.samples < MAX_SAMPLES {
+            let tracer = self.tracer.as_mut().expect("a view was traced");
+            if self.samples == 0 {
+                let frames = MAX_SAMPLES / RAYS_PER_FRAME;
+                tracer.set_technique(TRACER, &tracer_values(RAYS_PER_FRAME, frames)?)?;
+            }
+            tracer.render(&View::Final)?;
+            self.samples += RAYS_PER_FRAME;
+            (0..view.lights.len())
+                .map(|light| tracer.read_visibility(light))
+                .collect()
+        } else {
+            return Ok(None);
+        };
+        self.seconds += start.elapsed().as_secs_f64();
+        Ok(Some(self.judge(renderer, view, area)))
+    }
+
+    /// Traces the hard visibility of `view` and which pixels each light reaches.
+    fn restart(&mut self, renderer: &Renderer, view: &JudgedView) -> anyhow::Result<()> {
+        let tracer = match &mut self.tracer {
+            Some(tracer) => tracer,
+            empty => empty.insert(Renderer::new(
+                renderer.gpu().clone(),
+                renderer.scene().clone(),
+                view.size,
+            )?),
+        };
+        tracer.set_size(view.size)?;
+        tracer.set_camera(view.camera);
+        tracer.set_lights(view.lights.clone());
+        tracer.set_technique(TRACER, &tracer_values(1, 1)?)?;
+        tracer.render(&View::Final)?;
+        let gbuffer = tracer.read_gbuffer();
+        self.contributing = (view.lights.iter())
+            .map(|light| {
+                (gbuffer.positions.iter().zip(&gbuffer.normals))
+                    .map(|(p, n)| p.w > 0.5 && contributes(light, p.truncate(), *n))
+                    .collect()
+            })
+            .collect();
+        self.hard = (0..view.lights.len())
+            .map(|light| tracer.read_visibility(light))
+            .collect();
+        self.view = Some(view.clone());
+        self.samples = 0;
+        self.seconds = 0.0;
+        Ok(())
+    }
+
+    /// Scores `renderer`'s technique against the reference traced so far.
+    fn judge(&self, renderer: &Renderer, view: JudgedView, area: Vec<Vec<f32>>) -> Judgement {
+        let image = renderer.read_output();
+        let (width, height) = (view.size.x as usize, view.size.y as usize);
+        let mut metrics = Vec::new();
+        let mut error_maps = Vec::new();
+        for (i, area) in area.into_iter().enumerate() {
+            let reference = light_reference(
+                self.contributing[i].clone(),
+                self.hard[i].clone(),
+                area,
+                self.samples.max(1),
+            );
+            let visibility = renderer.read_visibility(i);
+            let supported = renderer.technique().supports(view.lights[i].kind);
+            metrics.push(
+                supported.then(|| Metrics::compute(&reference, &visibility, width, height, None)),
+            );
+            error_maps.push(error_map(&reference, &visibility, &image));
+        }
+        let counters = (self.tracer.as_ref()).map(|t| t.technique_instance().counters());
+        let triangles = counters
+            .and_then(|c| counter(&c, "BVH triangles"))
+            .unwrap_or(0.0);
+        Judgement {
+            view,
+            metrics,
+            error_maps,
+            occluder_triangles: triangles as usize,
+            seconds: self.seconds,
+        }
+    }
+}
