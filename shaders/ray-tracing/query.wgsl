@@ -1,12 +1,15 @@
 // Any-hit shadow rays by hardware ray queries against the scene's acceleration structure
 // (`zoo_ray_tracing`, tracer `RayQuery`): the same `rt_occluded` as `ray-tracing/trace.wgsl`,
 // which a shader imports; the library swaps this module in where the device has ray queries.
-// Bind group 3. Opaque casters are decided by the hardware; masked ones are a non-opaque
-// geometry whose candidate hits pass the shared alpha test before they count.
+// Bind group 3. Two instances: the blocking casters (mask `RT_BLOCKING`: opaque ones decided by
+// the hardware, masked ones a non-opaque geometry whose candidate hits pass the shared alpha
+// test before they count) and the translucent ones (mask `RT_TRANSLUCENT`, a non-opaque
+// geometry per object, its geometry index the object's record).
 
 enable wgpu_ray_query;
 
 #import "common/alpha_test.wgsl"
+#import "ray-tracing/translucent.wgsl"
 
 // Mirrors `GpuMaskedTriangle`: a masked caster's corners' texture coordinates and alpha test,
 // indexed by its primitive index in the masked geometry.
@@ -20,11 +23,17 @@ struct RtMaskedTriangle {
 @group(3) @binding(1) var<storage, read> rt_masked: array<RtMaskedTriangle>;
 @group(3) @binding(2) var rt_textures: texture_2d_array<f32>;
 @group(3) @binding(3) var rt_sampler: sampler;
+@group(3) @binding(4) var<storage, read> rt_translucent: array<RtTranslucent>;
 
-// Whether any caster lies on the segment from `origin` along unit `dir` up to `tmax`.
+// Instance masks (`zoo_ray_tracing`'s `BLOCKING_MASK` and `TRANSLUCENT_MASK`).
+const RT_BLOCKING: u32 = 1u;
+const RT_TRANSLUCENT: u32 = 2u;
+
+// Whether an opaque or masked caster lies on the segment from `origin` along unit `dir` up to
+// `tmax` (translucent casters do not block).
 fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
     var query: ray_query;
-    let ray = RayDesc(RAY_FLAG_TERMINATE_ON_FIRST_HIT, 0xffu, 0.0, tmax, origin, dir);
+    let ray = RayDesc(RAY_FLAG_TERMINATE_ON_FIRST_HIT, RT_BLOCKING, 0.0, tmax, origin, dir);
     rayQueryInitialize(&query, rt_scene, ray);
     while rayQueryProceed(&query) {
         // Only the masked geometry is non-opaque, so every candidate is a masked triangle.
@@ -37,4 +46,21 @@ fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
         }
     }
     return rayQueryGetCommittedIntersection(&query).kind != RAY_QUERY_INTERSECTION_NONE;
+}
+
+// The colour fraction of light the translucent casters on the segment let through (1 without
+// any); blocking casters are `rt_occluded`'s.
+fn rt_transmittance(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec3<f32> {
+    var crossing = rt_filter_new();
+    if rt_translucent[0].hierarchy == RT_NO_HIERARCHY {
+        return crossing.light;
+    }
+    var query: ray_query;
+    rayQueryInitialize(&query, rt_scene, RayDesc(RAY_FLAG_NONE, RT_TRANSLUCENT, 0.0, tmax, origin, dir));
+    // Every candidate filters the ray once per object; none is committed, so all are seen.
+    while rayQueryProceed(&query) {
+        let object = rayQueryGetCandidateIntersection(&query).geometry_index;
+        rt_filter_cross(&crossing, object, rt_translucent[object].transmittance);
+    }
+    return crossing.light;
 }

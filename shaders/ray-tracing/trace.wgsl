@@ -1,8 +1,10 @@
 // Any-hit shadow rays against the scene's shadow casters in a bounding volume hierarchy
 // (`zoo_ray_tracing`: the judge's own build, boxes grown by the triangle test's rounding).
-// Bind group 3. Alpha-masked casters let rays through their holes.
+// Bind group 3. Alpha-masked casters let rays through their holes; translucent ones, in a
+// hierarchy of their own, filter them (`rt_transmittance`).
 
 #import "common/alpha_test.wgsl"
+#import "ray-tracing/translucent.wgsl"
 
 // Mirrors `GpuNode`: children `first` and `first + 1`, or triangles `first..first + count`.
 struct RtNode {
@@ -12,10 +14,11 @@ struct RtNode {
     count: u32,
 }
 
-// Mirrors `GpuTriangle`: a corner, the edges from it and its alpha test.
+// Mirrors `GpuTriangle`: a corner, the edges from it, its translucent object (in the
+// translucent hierarchy) and its alpha test.
 struct RtTriangle {
     v0: vec3<f32>,
-    _pad: u32,
+    translucent: u32,
     e1: vec3<f32>,
     mask_layer: i32,
     e2: vec3<f32>,
@@ -33,6 +36,7 @@ struct RtTexcoords {
 @group(3) @binding(2) var<storage, read> rt_texcoords: array<RtTexcoords>;
 @group(3) @binding(3) var rt_textures: texture_2d_array<f32>;
 @group(3) @binding(4) var rt_sampler: sampler;
+@group(3) @binding(5) var<storage, read> rt_translucent: array<RtTranslucent>;
 
 // Nodes a traversal can hold pending (`zoo_ray_tracing::STACK_SIZE`, which refuses deeper
 // hierarchies).
@@ -73,14 +77,23 @@ fn rt_blocks(index: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
     return alpha_covers(rt_textures, rt_sampler, at, tri.mask_layer, tri.alpha_cutoff);
 }
 
-// Whether any caster lies on the segment from `origin` along unit `dir` up to `tmax`.
-fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+// Walks the hierarchy from node `root` along the segment from `origin` along unit `dir` up to
+// `tmax`: whether a triangle stops the ray, or, when `filtering`, every triangle the ray
+// crosses filters it (`crossing`) and the walk goes on.
+fn rt_walk(
+    root: u32,
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+    tmax: f32,
+    filtering: bool,
+    crossing: ptr<function, RtFilter>,
+) -> bool {
     // Reciprocals kept finite, as the judge's: no 0 x inf in the slab test.
     let huge = vec3<f32>(1e30);
     let inv_dir = clamp(select(1.0 / dir, huge, dir == vec3<f32>(0.0)), -huge, huge);
     var stack: array<u32, RT_STACK_SIZE>;
     var top = 1u;
-    stack[0] = 0u;
+    stack[0] = root;
     while top > 0u {
         top -= 1u;
         let node = rt_nodes[stack[top]];
@@ -89,9 +102,14 @@ fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
         }
         if node.count > 0u {
             for (var i = node.first; i < node.first + node.count; i++) {
-                if rt_blocks(i, origin, dir, tmax) {
+                if !rt_blocks(i, origin, dir, tmax) {
+                    continue;
+                }
+                if !filtering {
                     return true;
                 }
+                let object = rt_triangles[i].translucent;
+                rt_filter_cross(crossing, object, rt_translucent[object].transmittance);
             }
         } else if top + 2u <= RT_STACK_SIZE {
             stack[top] = node.first;
@@ -100,4 +118,22 @@ fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
         }
     }
     return false;
+}
+
+// Whether an opaque or masked caster lies on the segment from `origin` along unit `dir` up to
+// `tmax` (translucent casters do not block).
+fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+    var unused = rt_filter_new();
+    return rt_walk(0u, origin, dir, tmax, false, &unused);
+}
+
+// The colour fraction of light the translucent casters on the segment let through (1 without
+// any); blocking casters are `rt_occluded`'s.
+fn rt_transmittance(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec3<f32> {
+    var crossing = rt_filter_new();
+    let root = rt_translucent[0].hierarchy;
+    if root != RT_NO_HIERARCHY {
+        rt_walk(root, origin, dir, tmax, true, &crossing);
+    }
+    return crossing.light;
 }

@@ -1,9 +1,10 @@
-// Ray-traced shadows: from each pixel's surface, any-hit rays through the casters' hierarchy
-// (`ray-tracing/trace.wgsl`) to the light: one to its centre (hard), or several to points of
-// its disk (soft), the disk and its orientation those of the judge's area reference (a disk
-// of the light's radius facing the point; for the sun, a cone of its angular radius). Hard
-// lights go straight into their slots; soft ones into a history averaged over frames, which
-// the filter (`rt-shadows/denoise.wgsl`) resolves into their slots.
+// Ray-traced shadows: from each pixel's surface, any-hit rays through the casters
+// (`ray-tracing/trace.wgsl`, or ray queries) to the light: one to its centre (hard), or
+// several to points of its disk (soft), the disk and its orientation those of the judge's area
+// reference (a disk of the light's radius facing the point; for the sun, a cone of its angular
+// radius). Translucent casters filter the rays no blocking caster stops (`fs_transmittance`).
+// Hard lights go straight into their slots; soft ones into a history averaged over frames,
+// which the filter (`rt-shadows/denoise.wgsl`) resolves into their slots.
 
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
@@ -50,14 +51,22 @@ fn pixel_rotation(pixel: vec2<u32>) -> vec2<f32> {
     return vec2<f32>(f32(a >> 8u), f32(b >> 8u)) / 16777216.0;
 }
 
-// The light's visibility from the surface at `pixel` (1 where there is none or the light does
-// not reach).
-fn trace(pixel: vec2<i32>) -> f32 {
+// What the rays from a surface bring back: the fraction of the light no blocking caster stops
+// (`visibility`), and the colour translucent casters let through of that (`transmittance`;
+// white without them), so that their product is the colour fraction that arrives.
+struct Traced {
+    visibility: f32,
+    transmittance: vec3<f32>,
+}
+
+// The light's visibility and transmittance from the surface at `pixel` (1 where there is none
+// or the light does not reach).
+fn trace(pixel: vec2<i32>) -> Traced {
     let s = load_surface(pixel);
     let light = lights[rt_light.light];
     let toward = light_vector(light, s.position);
     if !s.valid || light_falloff(light, s.position) <= 0.0 {
-        return 1.0;
+        return Traced(1.0, vec3<f32>(1.0));
     }
     // Off the surface, on the light's side, by more than the reconstruction's error.
     let side = select(-s.normal, s.normal, dot(s.normal, toward) >= 0.0);
@@ -72,6 +81,9 @@ fn trace(pixel: vec2<i32>) -> f32 {
     var lit = 0u;
     var arrived = 0.0;
     var total = 0.0;
+    // The colour the unblocked rays bring, counted as `lit` and as `arrived`.
+    var colour_lit = vec3<f32>(0.0);
+    var colour_arrived = vec3<f32>(0.0);
     for (var i = 0u; i < rays; i++) {
         // The rotated R2 sequence, continued frame after frame.
         var offset = vec2<f32>(0.0);
@@ -91,14 +103,17 @@ fn trace(pixel: vec2<i32>) -> f32 {
         let weight = max(dot(s.normal, direction), 0.0);
         total += weight;
         if !rt_occluded(origin, direction, reach) {
+            let colour = rt_transmittance(origin, direction, reach);
             lit += 1u;
             arrived += weight;
+            colour_lit += colour;
+            colour_arrived += weight * colour;
         }
     }
     if rays == 1u || total <= 0.0 {
-        return f32(lit) / f32(rays);
+        return Traced(f32(lit) / f32(rays), select(vec3<f32>(1.0), colour_lit / f32(lit), lit > 0u));
     }
-    return arrived / total;
+    return Traced(arrived / total, select(vec3<f32>(1.0), colour_arrived / arrived, arrived > 0.0));
 }
 
 // Hard lights, into their slots (which hold 1, lit, until written).
@@ -107,7 +122,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     if rt_light.soft == 1u {
         discard;
     }
-    let visibility = trace(vec2<i32>(in.position.xy));
+    let visibility = trace(vec2<i32>(in.position.xy)).visibility;
     if visibility >= 1.0 {
         discard;
     }
@@ -119,5 +134,16 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
 // before (and keeps only this light's channel).
 @fragment
 fn fs_accumulate(in: FullscreenOut) -> @location(0) vec4<f32> {
-    return vec4<f32>(trace(vec2<i32>(in.position.xy)));
+    return vec4<f32>(trace(vec2<i32>(in.position.xy)).visibility);
+}
+
+// Every light's transmittance, into its transmittance slot (white until written), in scenes
+// with translucent casters. Soft lights' colour is this frame's rays' alone (not averaged).
+@fragment
+fn fs_transmittance(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let transmittance = trace(vec2<i32>(in.position.xy)).transmittance;
+    if all(transmittance >= vec3<f32>(1.0)) {
+        discard;
+    }
+    return vec4<f32>(transmittance, 1.0);
 }

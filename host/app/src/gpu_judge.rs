@@ -1,38 +1,26 @@
 //! `compare --judge gpu`: the reference visibility traced on the GPU by the ray-tracing library,
 //! through the `rt-shadows` technique: one ray to each light's centre for hard visibility, and
-//! `samples` rays over its disk, cosine-weighted and unfiltered, for area visibility. Which
-//! pixels each light reaches comes from the CPU judge's own located surfaces, so both judges
-//! score the same pixels. The CPU judge stays the arbiter (`tests/zoo/gpu_judge.rs` measures
-//! their agreement).
+//! `samples` rays over its disk, cosine-weighted and unfiltered, for area visibility, filtered
+//! by translucent casters as the CPU judge's. Which pixels each light reaches comes from the
+//! CPU judge's own located surfaces, so both judges score the same pixels. The CPU judge stays
+//! the arbiter (`tests/zoo/gpu_judge.rs` measures their agreement).
 
 use std::time::Instant;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
+use zoo_host::glam::Vec3;
 use zoo_host::judge::{LightReference, Surfaces};
 use zoo_host::judging::{SceneReference, surface_points};
 use zoo_host::params::{ParamValue, ParamValues, defaults};
 use zoo_host::render::View;
 use zoo_host::scene::shading::contributes;
-use zoo_host::{Renderer, Scene, find_technique};
+use zoo_host::{Renderer, find_technique};
 
 /// The technique that traces the GPU reference.
 pub const TRACER: &str = "rt-shadows";
 
 /// Most area rays per pixel the tracer takes.
 pub const MAX_SAMPLES: u32 = 64;
-
-/// An error, from `caller` and pointing to `instead`, when `scene` has translucent casters
-/// (the tracer does not filter light through them yet).
-pub fn check_traceable(scene: &Scene, caller: &str, instead: &str) -> anyhow::Result<()> {
-    if scene.has_translucent_casters() {
-        bail!(
-            "{caller}: scene {} has translucent casters, which the GPU tracer does not filter \
-             light through yet; use {instead}",
-            scene.name
-        );
-    }
-    Ok(())
-}
 
 /// The tracer's parameters for reference rays: `rays` a pixel and light each frame,
 /// unfiltered, averaged over `frames` frames of a still view (1: each frame on its own).
@@ -45,33 +33,57 @@ pub fn tracer_values(rays: u32, frames: u32) -> anyhow::Result<ParamValues> {
     Ok(values)
 }
 
-/// A light's reference from traced `hard` and `area` visibility (`samples` area rays a
-/// pixel), counted where `contributing` and 1 elsewhere, as the CPU judge's.
+/// What the tracer in `renderer` traced in its last frame, per light: the colour fraction of
+/// the light that arrives (its visibility times its transmittance colour, white without
+/// translucent casters).
+pub fn read_traced(renderer: &Renderer) -> Vec<Vec<Vec3>> {
+    let coloured = (renderer.technique_instance()).writes_transmittance(renderer.scene());
+    (0..renderer.lights().len())
+        .map(|light| {
+            let visibility = renderer.read_visibility(light);
+            match coloured.then(|| renderer.read_transmittance(light)) {
+                Some(colour) => (visibility.iter().zip(&colour))
+                    .map(|(v, c)| *v * *c)
+                    .collect(),
+                None => visibility.iter().map(|v| Vec3::splat(*v)).collect(),
+            }
+        })
+        .collect()
+}
+
+/// A light's reference from traced `hard` and `area` colour fractions ([`read_traced`];
+/// `samples` area rays a pixel), counted where `contributing` and 1 elsewhere, as the CPU
+/// judge's: visibility is the mean over the colour channels, and scenes with translucent
+/// casters (`coloured`) keep the area colour too.
 pub fn light_reference(
     contributing: Vec<bool>,
-    hard: Vec<f32>,
-    area: Vec<f32>,
+    hard: &[Vec3],
+    area: &[Vec3],
     samples: u32,
+    coloured: bool,
 ) -> LightReference {
-    let keep = |values: Vec<f32>| -> Vec<f32> {
-        (values.into_iter().zip(&contributing))
-            .map(|(v, &c)| if c { v } else { 1.0 })
+    let keep = |values: &[Vec3]| -> Vec<f32> {
+        (values.iter().zip(&contributing))
+            .map(|(v, &c)| if c { (v.x + v.y + v.z) / 3.0 } else { 1.0 })
             .collect()
     };
+    let color = coloured.then(|| {
+        (area.iter().zip(&contributing))
+            .map(|(v, &c)| if c { *v } else { Vec3::ONE })
+            .collect()
+    });
     LightReference {
         hard: keep(hard),
         area: keep(area),
         contributing,
-        color: None,
+        color,
         samples,
     }
 }
 
 /// Traces the reference of `renderer`'s current view on the GPU with `samples` area rays per
-/// pixel (at most [`MAX_SAMPLES`]). Scenes with translucent casters are refused: the tracer
-/// does not filter light through them yet.
+/// pixel (at most [`MAX_SAMPLES`]).
 pub fn trace_reference(renderer: &mut Renderer, samples: u32) -> anyhow::Result<SceneReference> {
-    check_traceable(renderer.scene(), "--judge gpu", "--judge cpu")?;
     // Any technique leaves the G-buffer the same; render one frame to fill it.
     renderer.render(&View::Final)?;
     let gbuffer = renderer.read_gbuffer();
@@ -79,33 +91,30 @@ pub fn trace_reference(renderer: &mut Renderer, samples: u32) -> anyhow::Result<
 
     let start = Instant::now();
     let samples = samples.clamp(1, MAX_SAMPLES);
-    let traced = |renderer: &mut Renderer, rays: u32| -> anyhow::Result<Vec<Vec<f32>>> {
+    let traced = |renderer: &mut Renderer, rays: u32| -> anyhow::Result<Vec<Vec<Vec3>>> {
         // One frame of unfiltered rays: the reference's samples, nothing averaged in.
         renderer.set_technique(TRACER, &tracer_values(rays, 1)?)?;
         renderer.render(&View::Final)?;
-        Ok((0..renderer.lights().len())
-            .map(|light| renderer.read_visibility(light))
-            .collect())
+        Ok(read_traced(renderer))
     };
     let hard = traced(renderer, 1)?;
     let area = traced(renderer, samples)?;
     let seconds = start.elapsed().as_secs_f64();
 
+    let coloured = renderer.scene().has_translucent_casters();
     let lights = renderer
         .lights()
         .iter()
-        .zip(hard.into_iter().zip(area))
+        .zip(hard.iter().zip(&area))
         .map(|(light, (hard, area))| {
             let contributing: Vec<bool> = points
                 .iter()
                 .map(|p| p.is_some_and(|p| contributes(light, p.position, p.normal)))
                 .collect();
-            light_reference(contributing, hard, area, samples)
+            light_reference(contributing, hard, area, samples, coloured)
         })
         .collect();
-    let casters = zoo_ray_tracing::CasterGeometry::of(renderer.scene())
-        .triangles
-        .len();
+    let casters = zoo_ray_tracing::CasterGeometry::of(renderer.scene()).caster_count();
     Ok(SceneReference::from_traced(
         gbuffer, lights, casters, seconds,
     ))

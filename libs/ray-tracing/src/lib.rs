@@ -9,7 +9,10 @@
 //!   `EXPERIMENTAL_RAY_QUERY`.
 //!
 //! Alpha-masked casters are tested at the hit with the alpha test every pass shares
-//! (`common/alpha_test.wgsl`); translucent casters block like opaque ones.
+//! (`common/alpha_test.wgsl`). Translucent casters (opacity below 1) do not block
+//! (`rt_occluded`); `rt_transmittance` filters a ray by the transmittance colour of each
+//! translucent object it crosses, once per object however many of its surfaces it passes, as
+//! the judge does (`ray-tracing/translucent.wgsl`).
 //!
 //! A shader imports `ray-tracing/trace.wgsl`; [`shader_source`] swaps the import for the
 //! chosen tracer. The bindings are one group: bind [`RayTracing::bind_group`] as group
@@ -129,23 +132,81 @@ pub fn shader_source(
 /// One shadow-casting triangle as both traversals store it.
 pub(crate) struct CasterTriangle {
     pub corners: [Vec3; 3],
+    /// Its alpha mask (never on a translucent one: translucency wins, as in the judge).
     pub mask: Option<AlphaMask>,
     pub uv: [Vec2; 3],
+    /// For a translucent caster, its object's index in [`Casters::transmittance`].
+    pub translucent: Option<u32>,
 }
 
-/// Every shadow-casting triangle of `scene`, in object order.
-pub(crate) fn caster_triangles(scene: &Scene) -> Vec<CasterTriangle> {
-    let mut casters = Vec::new();
-    for o in scene.objects.iter().filter(|o| o.casts_shadows) {
-        for tri in scene.triangle_indices(o) {
-            casters.push(CasterTriangle {
-                corners: tri.map(|i| scene.mesh.positions[i]),
-                mask: o.alpha_mask,
-                uv: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
+/// The scene's shadow casters as both traversals store them.
+pub(crate) struct Casters {
+    pub triangles: Vec<CasterTriangle>,
+    /// The colour each translucent object lets through ([`zoo_host::scene::SceneObject::transmittance`]),
+    /// in object order.
+    pub transmittance: Vec<Vec3>,
+}
+
+impl Casters {
+    /// Every shadow-casting triangle of `scene`, in object order.
+    pub fn of(scene: &Scene) -> Casters {
+        let mut triangles = Vec::new();
+        let mut transmittance = Vec::new();
+        for o in scene.objects.iter().filter(|o| o.casts_shadows) {
+            let translucent = o.transmittance().map(|t| {
+                transmittance.push(t);
+                transmittance.len() as u32 - 1
             });
+            for tri in scene.triangle_indices(o) {
+                triangles.push(CasterTriangle {
+                    corners: tri.map(|i| scene.mesh.positions[i]),
+                    mask: o.alpha_mask.filter(|_| translucent.is_none()),
+                    uv: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
+                    translucent,
+                });
+            }
+        }
+        Casters {
+            triangles,
+            transmittance,
         }
     }
-    casters
+}
+
+/// `RtTranslucent` in `ray-tracing/translucent.wgsl`: a translucent object's transmittance
+/// colour, and where the portable traversal's hierarchy of translucent casters starts (the
+/// same in every record; [`NO_HIERARCHY`] without one).
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub struct GpuTranslucent {
+    pub transmittance: [f32; 3],
+    pub hierarchy: u32,
+}
+
+/// [`GpuTranslucent::hierarchy`] where there is no hierarchy of translucent casters
+/// (`RT_NO_HIERARCHY` in `ray-tracing/translucent.wgsl`).
+pub const NO_HIERARCHY: u32 = u32::MAX;
+
+/// Distinct translucent objects one ray is filtered by (`RT_MAX_CROSSED` in
+/// `ray-tracing/translucent.wgsl`); further ones let it through unfiltered.
+pub const MAX_CROSSED: u32 = 8;
+
+/// The records of `casters`' translucent objects (one record, of no object, without any).
+pub(crate) fn translucent_records(casters: &Casters, hierarchy: u32) -> Vec<GpuTranslucent> {
+    let records: Vec<GpuTranslucent> = (casters.transmittance.iter())
+        .map(|t| GpuTranslucent {
+            transmittance: t.to_array(),
+            hierarchy,
+        })
+        .collect();
+    if records.is_empty() {
+        vec![GpuTranslucent {
+            transmittance: [1.0; 3],
+            hierarchy: NO_HIERARCHY,
+        }]
+    } else {
+        records
+    }
 }
 
 /// A read-only storage buffer holding `contents`.
@@ -245,6 +306,21 @@ impl RayTracing {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn translucent_records_and_numbers_match_the_shader() {
+        use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror, wgsl_integer_constant};
+        let record = zoo_host::mirror_fields!(GpuTranslucent {
+            transmittance,
+            hierarchy
+        });
+        let module = "ray-tracing/translucent.wgsl";
+        check_embedded_mirror(module, "RtTranslucent", record, SizeRule::Equal).unwrap();
+        let source = ShaderLibrary::embedded().compose(module).unwrap().source;
+        let constant = |name| wgsl_integer_constant(&source, name);
+        assert_eq!(constant("RT_NO_HIERARCHY"), Ok(i64::from(NO_HIERARCHY)));
+        assert_eq!(constant("RT_MAX_CROSSED"), Ok(i64::from(MAX_CROSSED)));
+    }
 
     #[test]
     fn the_query_variant_of_a_tracing_shader_validates_and_errors_point_home() {

@@ -2,13 +2,14 @@
 //! traversed by ray queries (`ray-tracing/query.wgsl`), on adapters with
 //! `EXPERIMENTAL_RAY_QUERY`. Opaque casters are one geometry the hardware answers alone;
 //! alpha-masked ones are a second, non-opaque geometry whose candidate hits the shader tests
-//! with the shared alpha test before it commits them.
+//! with the shared alpha test before it commits them. Translucent casters are a second
+//! instance (its own mask), a non-opaque geometry per object, whose candidates filter the ray.
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
 
-use crate::{BuildStats, CasterTriangle, Tracer, or_one_zeroed, storage_buffer};
+use crate::{BuildStats, CasterTriangle, Casters, Tracer, or_one_zeroed, storage_buffer};
 
 /// `RtMaskedTriangle` in `ray-tracing/query.wgsl`: a masked caster's corners' texture
 /// coordinates and its alpha test, in the masked geometry's primitive order.
@@ -47,15 +48,103 @@ pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 wgpu::TextureViewDimension::D2Array,
             ),
             sampler(3, stages, wgpu::SamplerBindingType::Filtering),
+            storage(4, stages, true),
         ],
     )
 }
 
-/// One geometry of the acceleration structure: its corners, three a triangle, and whether the
-/// hardware may decide its hits alone.
+/// Instance mask of the blocking casters (`RT_BLOCKING` in `ray-tracing/query.wgsl`).
+pub const BLOCKING_MASK: u8 = 1;
+/// Instance mask of the translucent casters (`RT_TRANSLUCENT` in `ray-tracing/query.wgsl`).
+pub const TRANSLUCENT_MASK: u8 = 2;
+
+/// One geometry of a bottom level: its corners, three a triangle, and whether the hardware
+/// may decide its hits alone.
 struct Geometry {
     corners: Vec<[f32; 3]>,
     opaque: bool,
+}
+
+impl Geometry {
+    fn of(triangles: &[&CasterTriangle], opaque: bool) -> Geometry {
+        let corners = triangles.iter().flat_map(|t| t.corners);
+        Geometry {
+            corners: corners.map(|p| p.to_array()).collect(),
+            opaque,
+        }
+    }
+}
+
+/// A bottom level over `geometries` (empty ones left out; `None` if all are), its build
+/// recorded in `encoder`.
+fn bottom_level(
+    device: &wgpu::Device,
+    label: &str,
+    geometries: &[Geometry],
+    encoder: &mut wgpu::CommandEncoder,
+) -> Option<wgpu::Blas> {
+    let geometries: Vec<&Geometry> = geometries
+        .iter()
+        .filter(|g| !g.corners.is_empty())
+        .collect();
+    if geometries.is_empty() {
+        return None;
+    }
+    let sizes: Vec<wgpu::BlasTriangleGeometrySizeDescriptor> = geometries
+        .iter()
+        .map(|g| wgpu::BlasTriangleGeometrySizeDescriptor {
+            vertex_format: wgpu::VertexFormat::Float32x3,
+            vertex_count: g.corners.len() as u32,
+            index_format: None,
+            index_count: None,
+            flags: if g.opaque {
+                wgpu::AccelerationStructureGeometryFlags::OPAQUE
+            } else {
+                wgpu::AccelerationStructureGeometryFlags::NO_DUPLICATE_ANY_HIT_INVOCATION
+            },
+        })
+        .collect();
+    let blas = device.create_blas(
+        &wgpu::CreateBlasDescriptor {
+            label: Some(label),
+            flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
+            update_mode: wgpu::AccelerationStructureUpdateMode::Build,
+        },
+        wgpu::BlasGeometrySizeDescriptors::Triangles {
+            descriptors: sizes.clone(),
+        },
+    );
+    let vertices: Vec<wgpu::Buffer> = geometries
+        .iter()
+        .map(|g| {
+            use zoo_host::wgpu::util::DeviceExt;
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&format!("{label} vertices")),
+                contents: bytemuck::cast_slice(&g.corners),
+                usage: wgpu::BufferUsages::BLAS_INPUT,
+            })
+        })
+        .collect();
+    let triangles = sizes
+        .iter()
+        .zip(&vertices)
+        .map(|(size, vertex_buffer)| wgpu::BlasTriangleGeometry {
+            size,
+            vertex_buffer,
+            first_vertex: 0,
+            vertex_stride: size_of::<[f32; 3]>() as wgpu::BufferAddress,
+            index_buffer: None,
+            first_index: None,
+            transform_buffer: None,
+            transform_buffer_offset: None,
+        })
+        .collect();
+    let entry = wgpu::BlasBuildEntry {
+        blas: &blas,
+        geometry: wgpu::BlasGeometries::TriangleGeometries(triangles),
+    };
+    encoder.build_acceleration_structures([&entry], []);
+    Some(blas)
 }
 
 /// Builds the acceleration structure of `ctx`'s scene (submitted to the queue) and its bind
@@ -64,30 +153,16 @@ pub(crate) fn upload(
     ctx: &RenderContext<'_>,
     layout: &wgpu::BindGroupLayout,
 ) -> TechniqueResult<(wgpu::BindGroup, BuildStats)> {
-    let casters = crate::caster_triangles(ctx.scene);
-    let (masked, opaque): (Vec<&CasterTriangle>, Vec<&CasterTriangle>) =
-        casters.iter().partition(|c| c.mask.is_some());
-    let corners = |triangles: &[&CasterTriangle]| -> Vec<[f32; 3]> {
-        let corners = triangles.iter().flat_map(|t| t.corners);
-        corners.map(|p| p.to_array()).collect()
+    let casters = Casters::of(ctx.scene);
+    let of_kind = |keep: &dyn Fn(&CasterTriangle) -> bool| -> Vec<&CasterTriangle> {
+        casters.triangles.iter().filter(|c| keep(c)).collect()
     };
-    let geometries: Vec<Geometry> = [
-        Geometry {
-            corners: corners(&opaque),
-            opaque: true,
-        },
-        Geometry {
-            corners: corners(&masked),
-            opaque: false,
-        },
-    ]
-    .into_iter()
-    .filter(|g| !g.corners.is_empty())
-    .collect();
+    let opaque = of_kind(&|c| c.translucent.is_none() && c.mask.is_none());
+    let masked = of_kind(&|c| c.mask.is_some());
     let records: Vec<GpuMaskedTriangle> = masked
         .iter()
         .map(|t| {
-            let mask = t.mask.expect("partitioned by mask");
+            let mask = t.mask.expect("kept for its mask");
             GpuMaskedTriangle {
                 uv: t.uv.map(|uv| uv.to_array()),
                 mask_layer: mask.layer as i32,
@@ -95,87 +170,60 @@ pub(crate) fn upload(
             }
         })
         .collect();
+    // One geometry per translucent object: its index is the object's record.
+    let translucent: Vec<Geometry> = (0..casters.transmittance.len() as u32)
+        .map(|object| Geometry::of(&of_kind(&|c| c.translucent == Some(object)), false))
+        .collect();
 
     let device = &ctx.gpu.device;
-    let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
-        label: Some("ray tracing scene (top level)"),
-        max_instances: 1,
-        flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
-        update_mode: wgpu::AccelerationStructureUpdateMode::Build,
-    });
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("ray tracing acceleration structure build"),
     });
-    if geometries.is_empty() {
-        // No casters: a top level without instances, which no ray hits.
-        encoder.build_acceleration_structures([], [&tlas]);
-    } else {
-        let sizes: Vec<wgpu::BlasTriangleGeometrySizeDescriptor> = geometries
-            .iter()
-            .map(|g| wgpu::BlasTriangleGeometrySizeDescriptor {
-                vertex_format: wgpu::VertexFormat::Float32x3,
-                vertex_count: g.corners.len() as u32,
-                index_format: None,
-                index_count: None,
-                flags: if g.opaque {
-                    wgpu::AccelerationStructureGeometryFlags::OPAQUE
-                } else {
-                    wgpu::AccelerationStructureGeometryFlags::NO_DUPLICATE_ANY_HIT_INVOCATION
-                },
-            })
-            .collect();
-        let blas = device.create_blas(
-            &wgpu::CreateBlasDescriptor {
-                label: Some("ray tracing casters (bottom level)"),
-                flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
-                update_mode: wgpu::AccelerationStructureUpdateMode::Build,
-            },
-            wgpu::BlasGeometrySizeDescriptors::Triangles {
-                descriptors: sizes.clone(),
-            },
-        );
-        let vertices: Vec<wgpu::Buffer> = geometries
-            .iter()
-            .map(|g| {
-                use zoo_host::wgpu::util::DeviceExt;
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(if g.opaque {
-                        "ray tracing opaque casters"
-                    } else {
-                        "ray tracing masked casters"
-                    }),
-                    contents: bytemuck::cast_slice(&g.corners),
-                    usage: wgpu::BufferUsages::BLAS_INPUT,
-                })
-            })
-            .collect();
-        let triangles = sizes
-            .iter()
-            .zip(&vertices)
-            .map(|(size, vertex_buffer)| wgpu::BlasTriangleGeometry {
-                size,
-                vertex_buffer,
-                first_vertex: 0,
-                vertex_stride: size_of::<[f32; 3]>() as wgpu::BufferAddress,
-                index_buffer: None,
-                first_index: None,
-                transform_buffer: None,
-                transform_buffer_offset: None,
-            })
-            .collect();
-        tlas[0] = Some(wgpu::TlasInstance::new(&blas, IDENTITY, 0, 0xff));
-        let entry = wgpu::BlasBuildEntry {
-            blas: &blas,
-            geometry: wgpu::BlasGeometries::TriangleGeometries(triangles),
-        };
-        encoder.build_acceleration_structures([&entry], [&tlas]);
+    let blocking = [Geometry::of(&opaque, true), Geometry::of(&masked, false)];
+    let levels = [
+        (
+            bottom_level(
+                device,
+                "ray tracing blocking casters",
+                &blocking,
+                &mut encoder,
+            ),
+            BLOCKING_MASK,
+        ),
+        (
+            bottom_level(
+                device,
+                "ray tracing translucent casters",
+                &translucent,
+                &mut encoder,
+            ),
+            TRANSLUCENT_MASK,
+        ),
+    ];
+    let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
+        label: Some("ray tracing scene (top level)"),
+        max_instances: levels.len() as u32,
+        flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
+        update_mode: wgpu::AccelerationStructureUpdateMode::Build,
+    });
+    // A missing level (no casters of its kind) is an empty instance, which no ray hits.
+    for (index, (blas, mask)) in levels.iter().enumerate() {
+        tlas[index] = blas
+            .as_ref()
+            .map(|blas| wgpu::TlasInstance::new(blas, IDENTITY, 0, *mask));
     }
+    encoder.build_acceleration_structures([], [&tlas]);
     ctx.gpu.queue.submit([encoder.finish()]);
 
     let masked_records = storage_buffer(
         device,
         "ray tracing masked casters' alpha tests",
         &or_one_zeroed::<GpuMaskedTriangle>(&records),
+    );
+    let translucent_records = storage_buffer(
+        device,
+        "ray tracing translucent objects",
+        bytemuck::cast_slice(&crate::translucent_records(&casters, 0)),
     );
     let materials = &ctx.scene_buffers.materials;
     let bind_group = bind_group(
@@ -187,11 +235,12 @@ pub(crate) fn upload(
             masked_records.as_entire_binding(),
             wgpu::BindingResource::TextureView(&materials.textures),
             wgpu::BindingResource::Sampler(&materials.sampler),
+            translucent_records.as_entire_binding(),
         ],
     );
     let stats = BuildStats {
         tracer: Tracer::RayQuery,
-        triangles: casters.len(),
+        triangles: casters.triangles.len(),
         hierarchy: None,
         milliseconds: 0.0,
     };
@@ -217,5 +266,15 @@ mod tests {
             SizeRule::Equal,
         )
         .unwrap();
+    }
+
+    #[test]
+    fn instance_masks_match_the_shader() {
+        let composed = zoo_host::ShaderLibrary::embedded()
+            .compose("ray-tracing/query.wgsl")
+            .unwrap();
+        let constant = |name| zoo_host::gpu::layout::wgsl_integer_constant(&composed.source, name);
+        assert_eq!(constant("RT_BLOCKING"), Ok(i64::from(BLOCKING_MASK)));
+        assert_eq!(constant("RT_TRANSLUCENT"), Ok(i64::from(TRANSLUCENT_MASK)));
     }
 }

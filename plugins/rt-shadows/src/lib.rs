@@ -6,13 +6,15 @@
 //! give soft ones, averaged over the frames of a still view ([`history`]) and smoothed by an
 //! edge-aware spatial filter guided by the G-buffer's depth and normals.
 
-use zoo_host::ResourceInfo;
 use zoo_host::prelude::*;
+use zoo_host::{ResourceInfo, Scene};
 use zoo_ray_tracing::{RayTracing, Tracer, Traversal};
 
 mod history;
+mod transmittance;
 
 use history::{Accumulation, History};
+use transmittance::TransmittancePass;
 
 zoo_host::technique_params! {
     /// Parameters of ray-traced shadows.
@@ -61,6 +63,7 @@ struct Gpu {
     history_layout: wgpu::BindGroupLayout,
     accumulation: Accumulation,
     denoise: FullscreenLightPass<RtLight>,
+    transmittance: TransmittancePass,
     tracing: Option<RayTracing>,
     history: Option<History>,
 }
@@ -93,6 +96,13 @@ impl Gpu {
         )?;
         let denoise =
             FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[&history_layout])?;
+        let transmittance = TransmittancePass::new(
+            ctx,
+            TRACE_SHADER,
+            &trace_text,
+            "fs_transmittance",
+            &tracing_layout,
+        )?;
         Ok(Gpu {
             tracer,
             tracing_layout,
@@ -100,6 +110,7 @@ impl Gpu {
             history_layout,
             accumulation,
             denoise,
+            transmittance,
             tracing: None,
             history: None,
         })
@@ -189,7 +200,15 @@ impl ShadowTechnique for RtShadows {
                 });
             self.frames = self.frames.saturating_add(1);
         }
+        if ctx.transmittance.in_use {
+            let tracing = &tracing.bind_group;
+            gpu.transmittance.record(ctx, rec, tracing, per_light);
+        }
         Ok(())
+    }
+
+    fn writes_transmittance(&self, scene: &Scene) -> bool {
+        scene.has_translucent_casters()
     }
 
     fn frames_to_converge(&self) -> u32 {
@@ -240,9 +259,10 @@ zoo_host::register_technique! {
     source: "ray tracing (the judge's visibility on the GPU)",
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
-    // The frame's lights and objects and the hierarchy's three buffers, in fragment shaders.
+    // The frame's lights and objects and the hierarchy's four buffers (nodes, triangles,
+    // texture coordinates, translucent objects), in fragment shaders.
     required_limits: || wgpu::Limits {
-        max_storage_buffers_per_shader_stage: 5,
+        max_storage_buffers_per_shader_stage: 6,
         ..wgpu::Limits::downlevel_defaults()
     },
     // Hardware ray queries where the adapter has them (`traversal` Auto or RayQuery).

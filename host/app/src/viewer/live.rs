@@ -7,14 +7,15 @@
 
 use std::time::Instant;
 
+use zoo_host::glam::Vec3;
 use zoo_host::judge::Metrics;
-use zoo_host::judging::error_map;
+use zoo_host::judging::{error_map, scored_visibility};
 use zoo_host::scene::shading::contributes;
 use zoo_host::technique::counter;
 use zoo_host::{Renderer, View};
 
 use super::reference::{JudgedView, Judgement};
-use crate::gpu_judge::{MAX_SAMPLES, TRACER, check_traceable, light_reference, tracer_values};
+use crate::gpu_judge::{MAX_SAMPLES, TRACER, light_reference, read_traced, tracer_values};
 
 /// Area rays a pixel and light each frame adds.
 pub const RAYS_PER_FRAME: u32 = 4;
@@ -24,9 +25,10 @@ pub const RAYS_PER_FRAME: u32 = 4;
 pub struct LiveReference {
     tracer: Option<Renderer>,
     view: Option<JudgedView>,
-    /// Per light: the pixels it reaches, and their hard visibility.
+    /// Per light: the pixels it reaches, and the colour fraction of it that arrives there from
+    /// its centre.
     contributing: Vec<Vec<bool>>,
-    hard: Vec<Vec<f32>>,
+    hard: Vec<Vec<Vec3>>,
     /// Area rays a pixel traced for the current view (0: hard visibility only).
     samples: u32,
     /// Tracing time spent on the current view.
@@ -43,7 +45,6 @@ impl LiveReference {
     /// its technique against it: the new judgement, or `None` once the view has all its
     /// samples.
     pub fn update(&mut self, renderer: &Renderer) -> anyhow::Result<Option<Judgement>> {
-        check_traceable(renderer.scene(), "live judge", "Judge view")?;
         let view = JudgedView::of(renderer);
         let start = Instant::now();
         let area = if self.view.as_ref() != Some(&view) {
@@ -57,9 +58,7 @@ impl LiveReference {
             }
             tracer.render(&View::Final)?;
             self.samples += RAYS_PER_FRAME;
-            (0..view.lights.len())
-                .map(|light| tracer.read_visibility(light))
-                .collect()
+            read_traced(tracer)
         } else {
             return Ok(None);
         };
@@ -90,9 +89,7 @@ impl LiveReference {
                     .collect()
             })
             .collect();
-        self.hard = (0..view.lights.len())
-            .map(|light| tracer.read_visibility(light))
-            .collect();
+        self.hard = read_traced(tracer);
         self.view = Some(view.clone());
         self.samples = 0;
         self.seconds = 0.0;
@@ -100,19 +97,21 @@ impl LiveReference {
     }
 
     /// Scores `renderer`'s technique against the reference traced so far.
-    fn judge(&self, renderer: &Renderer, view: JudgedView, area: Vec<Vec<f32>>) -> Judgement {
+    fn judge(&self, renderer: &Renderer, view: JudgedView, area: Vec<Vec<Vec3>>) -> Judgement {
         let image = renderer.read_output();
         let (width, height) = (view.size.x as usize, view.size.y as usize);
         let mut metrics = Vec::new();
         let mut error_maps = Vec::new();
-        for (i, area) in area.into_iter().enumerate() {
+        let coloured = renderer.scene().has_translucent_casters();
+        for (i, area) in area.iter().enumerate() {
             let reference = light_reference(
                 self.contributing[i].clone(),
-                self.hard[i].clone(),
+                &self.hard[i],
                 area,
                 self.samples.max(1),
+                coloured,
             );
-            let visibility = renderer.read_visibility(i);
+            let (visibility, _) = scored_visibility(renderer, i);
             let supported = renderer.technique().supports(view.lights[i].kind);
             metrics.push(
                 supported.then(|| Metrics::compute(&reference, &visibility, width, height, None)),

@@ -280,20 +280,9 @@ pub fn judge_technique(
     let (width, height) = reference.size();
     let mut scores = Vec::new();
     let mut visibility = Vec::new();
-    let colored = renderer
-        .technique_instance()
-        .writes_transmittance(renderer.scene());
     let mut transmittance = Vec::new();
     for (i, light) in renderer.lights().iter().enumerate() {
-        let mut v = renderer.read_visibility(i);
-        // Behind translucent casters the judge scores the light that arrives: visibility
-        // times the mean of the transmittance colour, as its reference does.
-        let t = colored.then(|| renderer.read_transmittance(i));
-        if let Some(t) = &t {
-            for (v, t) in v.iter_mut().zip(t) {
-                *v *= (t.x + t.y + t.z) / 3.0;
-            }
-        }
+        let (v, t) = scored_visibility(renderer, i);
         transmittance.push(t);
         let metrics = registration
             .supports(light.kind)
@@ -318,6 +307,23 @@ pub fn judge_technique(
         indirect: registration.adds_light.then(|| renderer.read_indirect()),
         masks_opaque: registration.masks_opaque_in(renderer.scene()),
     })
+}
+
+/// What the judge scores of light `light` in `renderer`'s last frame: the technique's
+/// visibility, times the mean of its transmittance colour where it writes one (behind
+/// translucent casters the light that arrives, as the reference's), and that colour.
+pub fn scored_visibility(renderer: &Renderer, light: usize) -> (Vec<f32>, Option<Vec<glam::Vec3>>) {
+    let mut v = renderer.read_visibility(light);
+    let colored = renderer
+        .technique_instance()
+        .writes_transmittance(renderer.scene());
+    let t = colored.then(|| renderer.read_transmittance(light));
+    if let Some(t) = &t {
+        for (v, t) in v.iter_mut().zip(t) {
+            *v *= (t.x + t.y + t.z) / 3.0;
+        }
+    }
+    (v, t)
 }
 
 /// The error map of one light: red where the technique shadows a lit pixel, blue where it

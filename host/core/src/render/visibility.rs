@@ -295,6 +295,14 @@ impl TransmittanceTargets {
         }
     }
 
+    /// The view light `light`'s transmittance is written to under `slots` (the slot of its
+    /// visibility channel, `layer * 4 + channel`, as the lighting pass reads it); `None` when
+    /// not in use.
+    pub fn slot_view(&self, slots: &SlotAssignment, light: usize) -> Option<&wgpu::TextureView> {
+        let (layer, channel) = slots.slot(light);
+        self.slot_views.get((layer * 4 + channel) as usize)
+    }
+
     /// Whether this storage fits `slots` at `size` for a technique that does (or does not)
     /// write transmittance.
     pub fn fits(&self, size: UVec2, slots: &SlotAssignment, in_use: bool) -> bool {
