@@ -9,6 +9,7 @@
 enable wgpu_ray_query;
 
 #import "common/alpha_test.wgsl"
+#import "ray-tracing/hit.wgsl"
 #import "ray-tracing/translucent.wgsl"
 
 // Mirrors `GpuMaskedTriangle`: a masked caster's corners' texture coordinates and alpha test,
@@ -29,12 +30,11 @@ struct RtMaskedTriangle {
 const RT_BLOCKING: u32 = 1u;
 const RT_TRANSLUCENT: u32 = 2u;
 
-// Whether an opaque or masked caster lies on the segment from `origin` along unit `dir` up to
-// `tmax` (translucent casters do not block).
-fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+// A query against the blocking casters with ray `flags`, run to its end: masked candidates
+// that pass the alpha test are committed (opaque ones the hardware commits alone).
+fn rt_query_blocking(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, flags: u32) -> RayIntersection {
     var query: ray_query;
-    let ray = RayDesc(RAY_FLAG_TERMINATE_ON_FIRST_HIT, RT_BLOCKING, 0.0, tmax, origin, dir);
-    rayQueryInitialize(&query, rt_scene, ray);
+    rayQueryInitialize(&query, rt_scene, RayDesc(flags, RT_BLOCKING, 0.0, tmax, origin, dir));
     while rayQueryProceed(&query) {
         // Only the masked geometry is non-opaque, so every candidate is a masked triangle.
         let candidate = rayQueryGetCandidateIntersection(&query);
@@ -45,7 +45,24 @@ fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
             rayQueryConfirmIntersection(&query);
         }
     }
-    return rayQueryGetCommittedIntersection(&query).kind != RAY_QUERY_INTERSECTION_NONE;
+    return rayQueryGetCommittedIntersection(&query);
+}
+
+// Whether an opaque or masked caster lies on the segment from `origin` along unit `dir` up to
+// `tmax` (translucent casters do not block): an any-hit shadow ray.
+fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
+    let hit = rt_query_blocking(origin, dir, tmax, RAY_FLAG_TERMINATE_ON_FIRST_HIT);
+    return hit.kind != RAY_QUERY_INTERSECTION_NONE;
+}
+
+// The nearest opaque or masked caster on the segment from `origin` along unit `dir` up to
+// `tmax`: a closest-hit ray.
+fn rt_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> RtHit {
+    let hit = rt_query_blocking(origin, dir, tmax, RAY_FLAG_NONE);
+    if hit.kind == RAY_QUERY_INTERSECTION_NONE {
+        return RtHit(false, tmax, vec2<f32>(0.0));
+    }
+    return RtHit(true, hit.t, hit.barycentrics);
 }
 
 // The colour fraction of light the translucent casters on the segment let through (1 without

@@ -59,6 +59,14 @@ struct Traced {
     transmittance: vec3<f32>,
 }
 
+// Where rays from surface `s` toward `toward` start: off the surface, on the light's side, by
+// more than the reconstruction's error.
+fn ray_origin(s: Surface, toward: vec3<f32>) -> vec3<f32> {
+    let side = select(-s.normal, s.normal, dot(s.normal, toward) >= 0.0);
+    let magnitude = max(max(abs(s.position.x), abs(s.position.y)), abs(s.position.z));
+    return s.position + side * (distance(s.position, camera.position) * 1e-4 + magnitude * 1e-6);
+}
+
 // The light's visibility and transmittance from the surface at `pixel` (1 where there is none
 // or the light does not reach).
 fn trace(pixel: vec2<i32>) -> Traced {
@@ -68,10 +76,7 @@ fn trace(pixel: vec2<i32>) -> Traced {
     if !s.valid || light_falloff(light, s.position) <= 0.0 {
         return Traced(1.0, vec3<f32>(1.0));
     }
-    // Off the surface, on the light's side, by more than the reconstruction's error.
-    let side = select(-s.normal, s.normal, dot(s.normal, toward) >= 0.0);
-    let magnitude = max(max(abs(s.position.x), abs(s.position.y)), abs(s.position.z));
-    let origin = s.position + side * (distance(s.position, camera.position) * 1e-4 + magnitude * 1e-6);
+    let origin = ray_origin(s, toward);
 
     let rays = select(rt_light.rays, 1u, light.radius <= 0.0);
     let disk = basis(toward);
@@ -146,4 +151,27 @@ fn fs_transmittance(in: FullscreenOut) -> @location(0) vec4<f32> {
         discard;
     }
     return vec4<f32>(transmittance, 1.0);
+}
+
+// The distance from the surface to the nearest blocking caster toward the light's centre (a
+// closest-hit ray; 0 where nothing blocks it or the light does not reach), for the `blocker
+// distance` debug view.
+@fragment
+fn fs_blocker_distance(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let s = load_surface(vec2<i32>(in.position.xy));
+    let light = lights[rt_light.light];
+    let toward = light_vector(light, s.position);
+    if !s.valid || light_falloff(light, s.position) <= 0.0 {
+        discard;
+    }
+    let origin = ray_origin(s, toward);
+    var reach = 3.0e38;
+    if light.kind != LIGHT_DIRECTIONAL {
+        reach = distance(light.position, origin);
+    }
+    let hit = rt_closest(origin, normalize(toward), reach);
+    if !hit.found {
+        discard;
+    }
+    return vec4<f32>(hit.t, 0.0, 0.0, 1.0);
 }

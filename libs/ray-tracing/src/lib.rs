@@ -1,5 +1,8 @@
-//! Ray tracing on any adapter: any-hit shadow rays against the scene's shadow casters, uploaded
-//! once per scene. Two traversals give the same answers (`rt_occluded(origin, dir, tmax)`):
+//! Ray tracing on any adapter: rays against the scene's shadow casters, uploaded once per
+//! scene: any-hit shadow rays (`rt_occluded(origin, dir, tmax)`), closest-hit rays
+//! (`rt_closest`, the nearest caster's distance and barycentric coordinates,
+//! `ray-tracing/hit.wgsl`) and translucent filtering (`rt_transmittance`). Two traversals give
+//! the same answers:
 //!
 //! - [`Tracer::Compute`]: the judge's own bounding volume hierarchy
 //!   ([`zoo_host::judge::FlatBvh`]) walked in WGSL (`ray-tracing/trace.wgsl`), on every
@@ -15,7 +18,7 @@
 //! the judge does (`ray-tracing/translucent.wgsl`).
 //!
 //! A shader imports `ray-tracing/trace.wgsl`; [`shader_source`] swaps the import for the
-//! chosen tracer. The bindings are one group: bind [`RayTracing::bind_group`] as group
+//! chosen tracer (both define the same three functions). The bindings are one group: bind [`RayTracing::bind_group`] as group
 //! [`GROUP`] (a [`zoo_host::kit::FullscreenLightPass`]'s first own group).
 
 use bytemuck::Pod;

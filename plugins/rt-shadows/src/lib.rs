@@ -10,11 +10,15 @@ use zoo_host::prelude::*;
 use zoo_host::{ResourceInfo, Scene};
 use zoo_ray_tracing::{RayTracing, Tracer, Traversal};
 
+mod blocker;
 mod history;
-mod transmittance;
+mod trace_pass;
 
+use blocker::BlockerView;
 use history::{Accumulation, History};
-use transmittance::TransmittancePass;
+use trace_pass::TracePass;
+use zoo_host::render::visibility::VISIBILITY_FORMAT;
+use zoo_host::technique::DebugImage;
 
 zoo_host::technique_params! {
     /// Parameters of ray-traced shadows.
@@ -31,6 +35,11 @@ zoo_host::technique_params! {
         /// How rays find casters: hardware ray queries where the device has them (`Auto`), the
         /// portable BVH walk (`Compute`), or ray queries only (`RayQuery`).
         traversal: Traversal = Traversal::Auto, flags(rebuild);
+        /// Trace the `blocker distance` debug view of `debug_light`: the distance to the
+        /// nearest caster toward its centre (a closest-hit ray a pixel).
+        blocker_distance: bool = false;
+        /// Light whose blocker distance the debug view shows.
+        debug_light: u32 = 0, range(0, 1023), step(1);
     }
 }
 
@@ -63,7 +72,8 @@ struct Gpu {
     history_layout: wgpu::BindGroupLayout,
     accumulation: Accumulation,
     denoise: FullscreenLightPass<RtLight>,
-    transmittance: TransmittancePass,
+    transmittance: TracePass,
+    blocker: BlockerView,
     tracing: Option<RayTracing>,
     history: Option<History>,
 }
@@ -96,13 +106,14 @@ impl Gpu {
         )?;
         let denoise =
             FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[&history_layout])?;
-        let transmittance = TransmittancePass::new(
+        let transmittance = TracePass::new(
             ctx,
-            TRACE_SHADER,
-            &trace_text,
-            "fs_transmittance",
+            "Transmittance",
+            (TRACE_SHADER, &trace_text, "fs_transmittance"),
+            VISIBILITY_FORMAT,
             &tracing_layout,
         )?;
+        let blocker = BlockerView::new(ctx, TRACE_SHADER, &trace_text, &tracing_layout)?;
         Ok(Gpu {
             tracer,
             tracing_layout,
@@ -111,6 +122,7 @@ impl Gpu {
             accumulation,
             denoise,
             transmittance,
+            blocker,
             tracing: None,
             history: None,
         })
@@ -200,9 +212,19 @@ impl ShadowTechnique for RtShadows {
                 });
             self.frames = self.frames.saturating_add(1);
         }
+        let tracing = &tracing.bind_group;
         if ctx.transmittance.in_use {
-            let tracing = &tracing.bind_group;
-            gpu.transmittance.record(ctx, rec, tracing, per_light);
+            // Each light's colour into its transmittance slot (white until written).
+            let slot = |light| {
+                let view = ctx.transmittance.slot_view(&ctx.visibility.slots, light);
+                view.map(|view| (view, wgpu::LoadOp::Load))
+            };
+            gpu.transmittance.record(ctx, rec, tracing, per_light, slot);
+        }
+        let debug_light = p.debug_light as usize;
+        if p.blocker_distance && debug_light < ctx.lights.len() {
+            gpu.blocker
+                .record(ctx, rec, tracing, per_light, debug_light);
         }
         Ok(())
     }
@@ -235,10 +257,19 @@ impl ShadowTechnique for RtShadows {
     }
 
     fn resources(&self) -> Vec<ResourceInfo> {
-        let history = self.gpu.built().and_then(|g| g.history.as_ref());
-        (history.into_iter())
-            .map(|h| ResourceInfo::texture("soft lights' history", &h.texture, false))
-            .collect()
+        let Some(gpu) = self.gpu.built() else {
+            return Vec::new();
+        };
+        let history = (gpu.history.iter())
+            .map(|h| ResourceInfo::texture("soft lights' history", &h.texture, false));
+        history.chain(gpu.blocker.resource()).collect()
+    }
+
+    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
+        let gpu = self.gpu.built()?;
+        (resource == blocker::VIEW)
+            .then(|| gpu.blocker.debug_image())
+            .flatten()
     }
 }
 

@@ -206,3 +206,79 @@ fn a_camera_move_starts_the_accumulation_again() {
         "the judge waits for the default frames"
     );
 }
+
+/// Closest-hit rays: under a floating slab lit from above, every shadowed pixel of the floor has
+/// its blocker distance end on the slab's surface (where the ray enters it), and every lit
+/// pixel has none; from both traversals where the adapter has ray queries.
+#[test]
+fn blocker_distances_end_on_the_blocker() {
+    use zoo_host::glam::{Vec3, Vec4Swizzles};
+    use zoo_host::gpu::readback::{f32s, read_texture};
+    use zoo_host::test_support::{gpu, scene_from_ron};
+    use zoo_host::{Renderer, View};
+    let scene = scene_from_ron(
+        "slab.ron",
+        r#"(camera: (position: (0, 6, 7), target: (0, 0, 0)),
+            lights: [Point(position: (0.3, 5, 0.2))],
+            objects: [
+                (mesh: Plane(size: 10)),
+                (mesh: Box(size: (2, 0.2, 2)), transform: (translation: (0, 1.5, 0))),
+            ])"#,
+    );
+    let (slab_min, slab_max) = (Vec3::new(-1.0, 1.4, -1.0), Vec3::new(1.0, 1.6, 1.0));
+    let on_slab = |p: Vec3| {
+        let inside = p.cmpge(slab_min - 0.01).all() && p.cmple(slab_max + 0.01).all();
+        let to_face = (p - slab_min).abs().min((p - slab_max).abs()).min_element();
+        inside && to_face < 0.01
+    };
+    let light = Vec3::new(0.3, 5.0, 0.2);
+    let gpu = gpu();
+    let mut traversals = vec!["Compute"];
+    if zoo_ray_tracing::Tracer::has_ray_queries(&gpu.device) {
+        traversals.push("RayQuery");
+    }
+    for traversal in traversals {
+        let mut renderer = Renderer::new(gpu.clone(), scene.clone(), UVec2::new(96, 72)).unwrap();
+        let values = ParamValues::from([
+            ("traversal".into(), ParamValue::Choice(traversal.into())),
+            ("rays_per_pixel".into(), ParamValue::Int(1)),
+            ("blocker_distance".into(), ParamValue::Bool(true)),
+        ]);
+        renderer.set_technique("rt-shadows", &values).unwrap();
+        renderer.render(&View::Final).unwrap();
+        let visibility = renderer.read_visibility(0);
+        let gbuffer = renderer.read_gbuffer();
+        let technique = renderer.technique_instance();
+        let image = technique.debug_view("blocker distance").expect("traced");
+        let texture = image.view.texture();
+        let distances = f32s(&read_texture(
+            &gpu,
+            texture,
+            0,
+            zoo_host::wgpu::TextureAspect::All,
+            4,
+        ));
+        let (mut shadowed, mut lit) = (0, 0);
+        for ((p, v), d) in gbuffer.positions.iter().zip(&visibility).zip(&distances) {
+            if p.w < 0.5 || p.y.abs() > 1e-3 {
+                continue; // Background, or not the floor.
+            }
+            let p = p.xyz();
+            if *v < 0.5 {
+                let end = p + (light - p).normalize() * *d;
+                assert!(
+                    on_slab(end),
+                    "{traversal}: from {p} the blocker is {d} away, ending at {end}"
+                );
+                shadowed += 1;
+            } else {
+                assert_eq!(*d, 0.0, "{traversal}: a lit pixel at {p} has a blocker");
+                lit += 1;
+            }
+        }
+        assert!(
+            shadowed > 100 && lit > 100,
+            "{traversal}: {shadowed} shadowed, {lit} lit"
+        );
+    }
+}

@@ -1,77 +1,80 @@
-//! The transmittance pass: in scenes with translucent casters, each light's colour fraction
-//! that the translucent casters let through, traced into the host's transmittance slot of
-//! that light (`fs_transmittance`), which the lighting multiplies with its visibility.
+//! A per-light trace into targets of the technique's choosing: the transmittance pass (in
+//! scenes with translucent casters, each light's colour fraction that translucent casters let
+//! through, into the host's transmittance slot of that light, which the lighting multiplies
+//! with its visibility) and the blocker-distance debug view.
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::prelude::*;
-use zoo_host::render::visibility::VISIBILITY_FORMAT;
 
 use crate::RtLight;
 
-/// Base name of the per-light passes.
-const PASS: &str = "Transmittance";
-
-/// The pipeline and its per-light uniforms.
-pub struct TransmittancePass {
+/// The pipeline of one fragment entry of the tracing shader, and its per-light uniforms.
+pub struct TracePass {
+    label: &'static str,
     pipeline: wgpu::RenderPipeline,
     uniforms: kit::UniformSlots<RtLight>,
 }
 
-impl TransmittancePass {
+impl TracePass {
     /// The pipeline of fragment `entry` in WGSL `text` (library shader `shader` as composed
-    /// for the tracer), after the frame and G-buffer groups: the per-light uniform (2) and the
-    /// ray-tracing group (3).
+    /// for the tracer) writing `format`, after the frame and G-buffer groups: the per-light
+    /// uniform (2) and the ray-tracing group (3). `label` names it and its passes.
     pub fn new(
         ctx: &RenderContext<'_>,
-        shader: &str,
-        text: &str,
-        entry: &str,
+        label: &'static str,
+        (shader, text, entry): (&str, &str, &str),
+        format: wgpu::TextureFormat,
         tracing: &wgpu::BindGroupLayout,
-    ) -> TechniqueResult<TransmittancePass> {
+    ) -> TechniqueResult<TracePass> {
         let module = (ctx.shaders).create_module_from_source(&ctx.gpu.device, shader, text)?;
         let uniforms = kit::UniformSlots::new(
             ctx.gpu,
-            "rt-shadows transmittance",
+            &format!("rt-shadows {label}"),
             ctx.lights.len(),
             wgpu::ShaderStages::FRAGMENT,
         );
         let groups = [uniforms.layout(), tracing];
-        let layout = kit::pipeline_layout(ctx, "rt-shadows transmittance layout", &groups);
+        let layout = kit::pipeline_layout(ctx, &format!("rt-shadows {label} layout"), &groups);
         let target = wgpu::ColorTargetState {
-            format: VISIBILITY_FORMAT,
+            format,
             blend: None,
             write_mask: wgpu::ColorWrites::ALL,
         };
         let pipeline = zoo_host::gpu::fullscreen_pipeline(
             &ctx.gpu.device,
-            "rt-shadows transmittance",
+            &format!("rt-shadows {label}"),
             Some(&layout),
             &module,
             entry,
             target,
         );
-        Ok(TransmittancePass { pipeline, uniforms })
+        Ok(TracePass {
+            label,
+            pipeline,
+            uniforms,
+        })
     }
 
-    /// Records one pass per light (named `"Transmittance: light {l}"`) into its transmittance
-    /// slot, with the frame's per-light uniforms `per_light`.
-    pub fn record(
+    /// Records one pass (named `"{label}: light {l}"`) for each light `target` gives a view
+    /// to (loaded or cleared as it says), with the frame's per-light uniforms `per_light`.
+    pub fn record<'t>(
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         tracing: &wgpu::BindGroup,
         per_light: impl Fn(usize) -> RtLight,
+        target: impl Fn(usize) -> Option<(&'t wgpu::TextureView, wgpu::LoadOp<wgpu::Color>)>,
     ) {
         let values: Vec<RtLight> = (0..ctx.lights.len()).map(per_light).collect();
         self.uniforms.write(ctx.gpu, &values);
         for light in 0..ctx.lights.len() {
-            let Some(slot) = ctx.transmittance.slot_view(&ctx.visibility.slots, light) else {
+            let Some((view, load)) = target(light) else {
                 continue;
             };
-            let label = kit::light_pass_name(PASS, light);
+            let label = kit::light_pass_name(self.label, light);
             let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(&label),
-                color_attachments: &[zoo_host::gpu::color_attachment(slot, wgpu::LoadOp::Load)],
+                color_attachments: &[zoo_host::gpu::color_attachment(view, load)],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,
                 occlusion_query_set: None,
