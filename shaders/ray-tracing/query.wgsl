@@ -1,5 +1,6 @@
-// Any-hit shadow rays by hardware ray queries against the scene's acceleration structure
-// (`zoo_ray_tracing`, tracer `RayQuery`): the same `rt_occluded` as `ray-tracing/trace.wgsl`,
+// Shadow rays by hardware ray queries against the scene's acceleration structure
+// (`zoo_ray_tracing`, tracer `RayQuery`): the same `rt_occluded` (any hit), `rt_closest`
+// (closest hit) and `rt_transmittance` (translucent filtering) as `ray-tracing/trace.wgsl`,
 // which a shader imports; the library swaps this module in where the device has ray queries.
 // Bind group 3. Two instances: the blocking casters (mask `RT_BLOCKING`: opaque ones decided by
 // the hardware, masked ones a non-opaque geometry whose candidate hits pass the shared alpha

@@ -67,9 +67,9 @@ fn ray_origin(s: Surface, toward: vec3<f32>) -> vec3<f32> {
     return s.position + side * (distance(s.position, camera.position) * 1e-4 + magnitude * 1e-6);
 }
 
-// The light's visibility and transmittance from the surface at `pixel` (1 where there is none
-// or the light does not reach).
-fn trace(pixel: vec2<i32>) -> Traced {
+// The light's visibility, and its transmittance when `coloured` (white otherwise), from the
+// surface at `pixel` (1 where there is none or the light does not reach).
+fn trace(pixel: vec2<i32>, coloured: bool) -> Traced {
     let s = load_surface(pixel);
     let light = lights[rt_light.light];
     let toward = light_vector(light, s.position);
@@ -108,7 +108,10 @@ fn trace(pixel: vec2<i32>) -> Traced {
         let weight = max(dot(s.normal, direction), 0.0);
         total += weight;
         if !rt_occluded(origin, direction, reach) {
-            let colour = rt_transmittance(origin, direction, reach);
+            var colour = vec3<f32>(1.0);
+            if coloured {
+                colour = rt_transmittance(origin, direction, reach);
+            }
             lit += 1u;
             arrived += weight;
             colour_lit += colour;
@@ -127,7 +130,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     if rt_light.soft == 1u {
         discard;
     }
-    let visibility = trace(vec2<i32>(in.position.xy)).visibility;
+    let visibility = trace(vec2<i32>(in.position.xy), false).visibility;
     if visibility >= 1.0 {
         discard;
     }
@@ -139,14 +142,14 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
 // before (and keeps only this light's channel).
 @fragment
 fn fs_accumulate(in: FullscreenOut) -> @location(0) vec4<f32> {
-    return vec4<f32>(trace(vec2<i32>(in.position.xy)).visibility);
+    return vec4<f32>(trace(vec2<i32>(in.position.xy), false).visibility);
 }
 
 // Every light's transmittance, into its transmittance slot (white until written), in scenes
 // with translucent casters. Soft lights' colour is this frame's rays' alone (not averaged).
 @fragment
 fn fs_transmittance(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let transmittance = trace(vec2<i32>(in.position.xy)).transmittance;
+    let transmittance = trace(vec2<i32>(in.position.xy), true).transmittance;
     if all(transmittance >= vec3<f32>(1.0)) {
         discard;
     }

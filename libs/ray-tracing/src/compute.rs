@@ -84,12 +84,13 @@ impl CasterGeometry {
             geometry.triangles.push(GpuTriangle::zeroed());
             geometry.texcoords.push(GpuTexcoords::zeroed());
         }
-        if !translucent.is_empty() {
-            geometry.translucent_root = Some(geometry.nodes.len() as u32);
-            geometry.append_hierarchy(&translucent);
-        }
+        let first_translucent = geometry.nodes.len() as u32;
+        geometry.append_hierarchy(&translucent);
+        // (None where every translucent triangle is degenerate and left out.)
+        geometry.translucent_root =
+            (geometry.nodes.len() as u32 > first_translucent).then_some(first_translucent);
         let root = geometry.translucent_root.unwrap_or(crate::NO_HIERARCHY);
-        geometry.translucent = crate::translucent_records(&casters, root);
+        geometry.translucent = crate::translucent_records(&casters.transmittance, root);
         geometry
     }
 

@@ -194,9 +194,10 @@ pub const NO_HIERARCHY: u32 = u32::MAX;
 /// `ray-tracing/translucent.wgsl`); further ones let it through unfiltered.
 pub const MAX_CROSSED: u32 = 8;
 
-/// The records of `casters`' translucent objects (one record, of no object, without any).
-pub(crate) fn translucent_records(casters: &Casters, hierarchy: u32) -> Vec<GpuTranslucent> {
-    let records: Vec<GpuTranslucent> = (casters.transmittance.iter())
+/// The records of translucent objects letting `transmittance` through (one record, of no
+/// object, without any).
+pub(crate) fn translucent_records(transmittance: &[Vec3], hierarchy: u32) -> Vec<GpuTranslucent> {
+    let records: Vec<GpuTranslucent> = (transmittance.iter())
         .map(|t| GpuTranslucent {
             transmittance: t.to_array(),
             hierarchy,

@@ -6,6 +6,7 @@
 //! instance (its own mask), a non-opaque geometry per object, whose candidates filter the ray.
 
 use bytemuck::{Pod, Zeroable};
+use zoo_host::glam::Vec3;
 use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
 
@@ -170,10 +171,15 @@ pub(crate) fn upload(
             }
         })
         .collect();
-    // One geometry per translucent object: its index is the object's record.
-    let translucent: Vec<Geometry> = (0..casters.transmittance.len() as u32)
-        .map(|object| Geometry::of(&of_kind(&|c| c.translucent == Some(object)), false))
-        .collect();
+    // One geometry per translucent object with triangles: its geometry index is its record's.
+    let (translucent, transmittance): (Vec<Geometry>, Vec<Vec3>) = (casters.transmittance.iter())
+        .enumerate()
+        .map(|(object, colour)| {
+            let triangles = of_kind(&|c| c.translucent == Some(object as u32));
+            (Geometry::of(&triangles, false), *colour)
+        })
+        .filter(|(geometry, _)| !geometry.corners.is_empty())
+        .unzip();
 
     let device = &ctx.gpu.device;
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -223,7 +229,7 @@ pub(crate) fn upload(
     let translucent_records = storage_buffer(
         device,
         "ray tracing translucent objects",
-        bytemuck::cast_slice(&crate::translucent_records(&casters, 0)),
+        bytemuck::cast_slice(&crate::translucent_records(&transmittance, 0)),
     );
     let materials = &ctx.scene_buffers.materials;
     let bind_group = bind_group(

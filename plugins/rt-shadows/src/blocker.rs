@@ -24,20 +24,20 @@ pub struct BlockerView {
 }
 
 impl BlockerView {
-    /// The pass of fragment `fs_blocker_distance` in `text` (`shader` composed for the tracer).
+    /// The pass of fragment `fs_blocker_distance` of the tracing `module`.
     pub fn new(
         ctx: &RenderContext<'_>,
-        shader: &str,
-        text: &str,
+        module: &wgpu::ShaderModule,
         tracing: &wgpu::BindGroupLayout,
-    ) -> TechniqueResult<BlockerView> {
-        let entry = (shader, text, "fs_blocker_distance");
-        let pass = TracePass::new(ctx, "Blocker distance", entry, FORMAT, tracing)?;
-        Ok(BlockerView {
+    ) -> BlockerView {
+        let entry = (module, "fs_blocker_distance");
+        let target = TracePass::replace(FORMAT);
+        let pass = TracePass::new(ctx, "Blocker distance", entry, target, tracing);
+        BlockerView {
             pass,
             target: None,
             far: 1.0,
-        })
+        }
     }
 
     /// Traces light `light`'s blocker distances at the output's size.
@@ -77,7 +77,9 @@ impl BlockerView {
         let view = &self.target.as_ref().expect("made above").1;
         let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
         let target = |l: usize| (l == light).then_some((view, clear));
-        self.pass.record(ctx, recorder, tracing, per_light, target);
+        let no_blend = |_| None;
+        self.pass
+            .record(ctx, recorder, tracing, per_light, target, no_blend);
     }
 
     /// The distances as a viewable resource, once traced.

@@ -15,7 +15,7 @@ mod history;
 mod trace_pass;
 
 use blocker::BlockerView;
-use history::{Accumulation, History};
+use history::History;
 use trace_pass::TracePass;
 use zoo_host::render::visibility::VISIBILITY_FORMAT;
 use zoo_host::technique::DebugImage;
@@ -70,7 +70,7 @@ struct Gpu {
     tracing_layout: wgpu::BindGroupLayout,
     trace: FullscreenLightPass<RtLight>,
     history_layout: wgpu::BindGroupLayout,
-    accumulation: Accumulation,
+    accumulation: TracePass,
     denoise: FullscreenLightPass<RtLight>,
     transmittance: TracePass,
     blocker: BlockerView,
@@ -97,23 +97,24 @@ impl Gpu {
                 wgpu::TextureViewDimension::D2Array,
             )],
         );
-        let accumulation = Accumulation::new(
+        let module = (ctx.shaders).create_module_from_source(device, TRACE_SHADER, &trace_text)?;
+        let accumulation = TracePass::new(
             ctx,
-            TRACE_SHADER,
-            &trace_text,
-            "fs_accumulate",
+            "Accumulate",
+            (&module, "fs_accumulate"),
+            history::accumulation_target(),
             &tracing_layout,
-        )?;
+        );
         let denoise =
             FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[&history_layout])?;
         let transmittance = TracePass::new(
             ctx,
             "Transmittance",
-            (TRACE_SHADER, &trace_text, "fs_transmittance"),
-            VISIBILITY_FORMAT,
+            (&module, "fs_transmittance"),
+            TracePass::replace(VISIBILITY_FORMAT),
             &tracing_layout,
-        )?;
-        let blocker = BlockerView::new(ctx, TRACE_SHADER, &trace_text, &tracing_layout)?;
+        );
+        let blocker = BlockerView::new(ctx, &module, &tracing_layout);
         Ok(Gpu {
             tracer,
             tracing_layout,
@@ -201,10 +202,11 @@ impl ShadowTechnique for RtShadows {
                 pass.set_bind_group(zoo_ray_tracing::GROUP, &tracing.bind_group, &[]);
             });
         if let Some(history) = &gpu.history {
-            gpu.accumulation.write(ctx, per_light);
-            let weight = new_frame_weight;
-            let accumulation = &gpu.accumulation;
-            accumulation.record(ctx, rec, history, &tracing.bind_group, &soft_lights, weight);
+            let layer =
+                |light: usize| (soft_lights.contains(&light)).then(|| history.target(ctx, light));
+            let blend = |light| Some(History::blend(ctx, light, new_frame_weight));
+            let tracing = &tracing.bind_group;
+            (gpu.accumulation).record(ctx, rec, tracing, per_light, layer, blend);
             let group = &history.group;
             gpu.denoise
                 .record_with(ctx, rec, DENOISE_PASS, per_light, |_, pass| {
@@ -219,7 +221,8 @@ impl ShadowTechnique for RtShadows {
                 let view = ctx.transmittance.slot_view(&ctx.visibility.slots, light);
                 view.map(|view| (view, wgpu::LoadOp::Load))
             };
-            gpu.transmittance.record(ctx, rec, tracing, per_light, slot);
+            let no_blend = |_| None;
+            (gpu.transmittance).record(ctx, rec, tracing, per_light, slot, no_blend);
         }
         let debug_light = p.debug_light as usize;
         if p.blocker_distance && debug_light < ctx.lights.len() {
@@ -262,12 +265,14 @@ impl ShadowTechnique for RtShadows {
         };
         let history = (gpu.history.iter())
             .map(|h| ResourceInfo::texture("soft lights' history", &h.texture, false));
-        history.chain(gpu.blocker.resource()).collect()
+        let blocker = (gpu.blocker.resource()).filter(|_| self.params.blocker_distance);
+        history.chain(blocker).collect()
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
         let gpu = self.gpu.built()?;
-        (resource == blocker::VIEW)
+        // Only while it is traced: a view left from before would be stale.
+        (resource == blocker::VIEW && self.params.blocker_distance)
             .then(|| gpu.blocker.debug_image())
             .flatten()
     }

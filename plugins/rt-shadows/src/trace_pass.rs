@@ -1,7 +1,8 @@
-//! A per-light trace into targets of the technique's choosing: the transmittance pass (in
-//! scenes with translucent casters, each light's colour fraction that translucent casters let
-//! through, into the host's transmittance slot of that light, which the lighting multiplies
-//! with its visibility) and the blocker-distance debug view.
+//! A per-light trace into targets of the technique's choosing: the accumulation of soft lights
+//! into the history, the transmittance pass (in scenes with translucent casters, each light's
+//! colour fraction that translucent casters let through, into the host's transmittance slot of
+//! that light, which the lighting multiplies with its visibility) and the blocker-distance
+//! debug view.
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::prelude::*;
@@ -16,17 +17,16 @@ pub struct TracePass {
 }
 
 impl TracePass {
-    /// The pipeline of fragment `entry` in WGSL `text` (library shader `shader` as composed
-    /// for the tracer) writing `format`, after the frame and G-buffer groups: the per-light
-    /// uniform (2) and the ray-tracing group (3). `label` names it and its passes.
+    /// The pipeline of fragment `entry` of the tracing `module` writing `target`, after the
+    /// frame and G-buffer groups: the per-light uniform (2) and the ray-tracing group (3).
+    /// `label` names it and its passes.
     pub fn new(
         ctx: &RenderContext<'_>,
         label: &'static str,
-        (shader, text, entry): (&str, &str, &str),
-        format: wgpu::TextureFormat,
+        (module, entry): (&wgpu::ShaderModule, &str),
+        target: wgpu::ColorTargetState,
         tracing: &wgpu::BindGroupLayout,
-    ) -> TechniqueResult<TracePass> {
-        let module = (ctx.shaders).create_module_from_source(&ctx.gpu.device, shader, text)?;
+    ) -> TracePass {
         let uniforms = kit::UniformSlots::new(
             ctx.gpu,
             &format!("rt-shadows {label}"),
@@ -35,28 +35,33 @@ impl TracePass {
         );
         let groups = [uniforms.layout(), tracing];
         let layout = kit::pipeline_layout(ctx, &format!("rt-shadows {label} layout"), &groups);
-        let target = wgpu::ColorTargetState {
-            format,
-            blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
-        };
         let pipeline = zoo_host::gpu::fullscreen_pipeline(
             &ctx.gpu.device,
             &format!("rt-shadows {label}"),
             Some(&layout),
-            &module,
+            module,
             entry,
             target,
         );
-        Ok(TracePass {
+        TracePass {
             label,
             pipeline,
             uniforms,
-        })
+        }
+    }
+
+    /// A target state writing `format` as it is (no blend).
+    pub fn replace(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
+        wgpu::ColorTargetState {
+            format,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        }
     }
 
     /// Records one pass (named `"{label}: light {l}"`) for each light `target` gives a view
-    /// to (loaded or cleared as it says), with the frame's per-light uniforms `per_light`.
+    /// to (loaded or cleared as it says), with the frame's per-light uniforms `per_light` and
+    /// the blend constant `blend` gives, if any.
     pub fn record<'t>(
         &mut self,
         ctx: &RenderContext<'_>,
@@ -64,6 +69,7 @@ impl TracePass {
         tracing: &wgpu::BindGroup,
         per_light: impl Fn(usize) -> RtLight,
         target: impl Fn(usize) -> Option<(&'t wgpu::TextureView, wgpu::LoadOp<wgpu::Color>)>,
+        blend: impl Fn(usize) -> Option<wgpu::Color>,
     ) {
         let values: Vec<RtLight> = (0..ctx.lights.len()).map(per_light).collect();
         self.uniforms.write(ctx.gpu, &values);
@@ -80,6 +86,9 @@ impl TracePass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
+            if let Some(constant) = blend(light) {
+                pass.set_blend_constant(constant);
+            }
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
             pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);

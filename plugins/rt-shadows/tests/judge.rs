@@ -10,6 +10,19 @@ use zoo_host::test_support::judge;
 
 const SIZE: UVec2 = UVec2::new(192, 144);
 
+/// Whether the test adapter has hardware ray queries; with `ZOO_REQUIRE_RAY_QUERY` set (as
+/// `tests/ray-query-driver.sh` sets it) a missing one fails instead of skipping.
+fn has_ray_queries(gpu: &zoo_host::GpuContext) -> bool {
+    let has = zoo_ray_tracing::Tracer::has_ray_queries(&gpu.device);
+    if !has && std::env::var_os("ZOO_REQUIRE_RAY_QUERY").is_some() {
+        panic!(
+            "ZOO_REQUIRE_RAY_QUERY is set but {} has no ray queries",
+            gpu.describe()
+        );
+    }
+    has
+}
+
 /// One ray to each light's centre agrees with the judge's hard visibility: the core error (the
 /// one-pixel band around the reference's shadow edges left out) is at most 0.0005 of the
 /// pixels each light reaches, on scenes of every kind (curved receivers, thin casters,
@@ -104,7 +117,7 @@ fn ray_queries_agree_with_the_portable_traversal() {
     use zoo_host::test_support::{gpu, scene_from_ron, standard_scenes};
     use zoo_host::{Renderer, Scene, View};
     let gpu = gpu();
-    if !zoo_ray_tracing::Tracer::has_ray_queries(&gpu.device) {
+    if !has_ray_queries(&gpu) {
         eprintln!(
             "skipped: {} has no hardware ray queries (EXPERIMENTAL_RAY_QUERY)",
             gpu.describe()
@@ -234,7 +247,7 @@ fn blocker_distances_end_on_the_blocker() {
     let light = Vec3::new(0.3, 5.0, 0.2);
     let gpu = gpu();
     let mut traversals = vec!["Compute"];
-    if zoo_ray_tracing::Tracer::has_ray_queries(&gpu.device) {
+    if has_ray_queries(&gpu) {
         traversals.push("RayQuery");
     }
     for traversal in traversals {

@@ -48,6 +48,8 @@ pub struct Judgement {
     pub error_maps: Vec<RgbaImage>,
     pub occluder_triangles: usize,
     pub seconds: f64,
+    /// For the live judge's, the area rays a pixel it had traced; `None` for the CPU judge's.
+    pub live_samples: Option<u32>,
 }
 
 /// A judgement being computed.
@@ -128,6 +130,7 @@ impl ReferenceOverlay {
                     error_maps,
                     occluder_triangles: occluders.len(),
                     seconds: start.elapsed().as_secs_f64(),
+                    live_samples: None,
                 }
             })?;
         self.running = Some(Running {
@@ -281,7 +284,7 @@ impl ReferenceOverlay {
                 "stale: the view changed since it was judged (map hidden)",
             );
         }
-        let traced = match self.live_samples() {
+        let traced = match result.live_samples {
             Some(0) => "live on the GPU, hard visibility".to_string(),
             Some(samples) => format!("live on the GPU, {samples} area rays a pixel"),
             None => "by the CPU judge".to_string(),

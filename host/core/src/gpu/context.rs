@@ -110,9 +110,9 @@ impl GpuContext {
     ) -> wgpu::DeviceDescriptor<'static> {
         let features = Self::wanted_features(adapter) - removed;
         let experimental = if features.intersects(wgpu::Features::all_experimental_mask()) {
-            // SAFETY: only the experimental features techniques declare are requested, and
-            // their paths are compared with the portable ones where both exist (the
-            // ray-tracing library's tests).
+            // SAFETY: wgpu's opt-in to features it marks experimental; only those techniques
+            // declare are requested, and only where the adapter has them. (The hardware ray
+            // query path is checked against the portable one by rt-shadows' tests.)
             unsafe { wgpu::ExperimentalFeatures::enabled() }
         } else {
             wgpu::ExperimentalFeatures::disabled()

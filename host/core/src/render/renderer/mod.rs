@@ -186,6 +186,11 @@ impl Renderer {
         &self.gpu
     }
 
+    /// The shader library its pipelines are built from.
+    pub fn shaders(&self) -> &ShaderLibrary {
+        &self.shaders
+    }
+
     /// The scene being rendered.
     pub fn scene(&self) -> &Scene {
         &self.scene
