@@ -12,43 +12,45 @@ use crate::trace_pass::TracePass;
 /// The debug view's (and resource's) name.
 pub const VIEW: &str = "blocker distance";
 
-/// Its format: a distance per pixel.
-const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// Its format: a distance per pixel (red), in a format every backend renders to (GL cannot
+/// render to `R32Float`).
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// The distances and the pass that traces them.
+/// The distances and the pass that traces them, both made when first asked for.
 pub struct BlockerView {
-    pass: TracePass,
+    module: wgpu::ShaderModule,
+    pass: Option<TracePass>,
     target: Option<(wgpu::Texture, wgpu::TextureView)>,
     /// The farthest distance shown white (the scene's diagonal).
     far: f32,
 }
 
 impl BlockerView {
-    /// The pass of fragment `fs_blocker_distance` of the tracing `module`.
-    pub fn new(
-        ctx: &RenderContext<'_>,
-        module: &wgpu::ShaderModule,
-        tracing: &wgpu::BindGroupLayout,
-    ) -> BlockerView {
-        let entry = (module, "fs_blocker_distance");
-        let target = TracePass::replace(FORMAT);
-        let pass = TracePass::new(ctx, "Blocker distance", entry, target, tracing);
+    /// The view of fragment `fs_blocker_distance` of the tracing `module`.
+    pub fn new(module: &wgpu::ShaderModule) -> BlockerView {
         BlockerView {
-            pass,
+            module: module.clone(),
+            pass: None,
             target: None,
             far: 1.0,
         }
     }
 
-    /// Traces light `light`'s blocker distances at the output's size.
+    /// Traces light `light`'s blocker distances at the output's size, with the ray-tracing
+    /// group `tracing` (of layout `tracing_layout`).
     pub fn record(
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-        tracing: &wgpu::BindGroup,
+        (tracing, tracing_layout): (&wgpu::BindGroup, &wgpu::BindGroupLayout),
         per_light: impl Fn(usize) -> RtLight,
         light: usize,
     ) {
+        let pass = self.pass.get_or_insert_with(|| {
+            let entry = (&self.module, "fs_blocker_distance");
+            let target = TracePass::replace(FORMAT);
+            TracePass::new(ctx, "Blocker distance", entry, target, tracing_layout)
+        });
         let size = ctx.visibility.texture.size();
         let fits = |(texture, _): &(wgpu::Texture, wgpu::TextureView)| {
             texture.width() == size.width && texture.height() == size.height
@@ -78,8 +80,7 @@ impl BlockerView {
         let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
         let target = |l: usize| (l == light).then_some((view, clear));
         let no_blend = |_| None;
-        self.pass
-            .record(ctx, recorder, tracing, per_light, target, no_blend);
+        pass.record(ctx, recorder, tracing, per_light, target, no_blend);
     }
 
     /// The distances as a viewable resource, once traced.

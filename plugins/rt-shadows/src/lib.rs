@@ -114,7 +114,7 @@ impl Gpu {
             TracePass::replace(VISIBILITY_FORMAT),
             &tracing_layout,
         );
-        let blocker = BlockerView::new(ctx, &module, &tracing_layout);
+        let blocker = BlockerView::new(&module);
         Ok(Gpu {
             tracer,
             tracing_layout,
@@ -226,6 +226,7 @@ impl ShadowTechnique for RtShadows {
         }
         let debug_light = p.debug_light as usize;
         if p.blocker_distance && debug_light < ctx.lights.len() {
+            let tracing = (tracing, &gpu.tracing_layout);
             gpu.blocker
                 .record(ctx, rec, tracing, per_light, debug_light);
         }

@@ -226,7 +226,7 @@ fn a_camera_move_starts_the_accumulation_again() {
 #[test]
 fn blocker_distances_end_on_the_blocker() {
     use zoo_host::glam::{Vec3, Vec4Swizzles};
-    use zoo_host::gpu::readback::{f32s, read_texture};
+    use zoo_host::gpu::readback::{f16s, read_texture};
     use zoo_host::test_support::{gpu, scene_from_ron};
     use zoo_host::{Renderer, View};
     let scene = scene_from_ron(
@@ -264,13 +264,14 @@ fn blocker_distances_end_on_the_blocker() {
         let technique = renderer.technique_instance();
         let image = technique.debug_view("blocker distance").expect("traced");
         let texture = image.view.texture();
-        let distances = f32s(&read_texture(
+        let texels = f16s(&read_texture(
             &gpu,
             texture,
             0,
             zoo_host::wgpu::TextureAspect::All,
-            4,
+            8,
         ));
+        let distances: Vec<f32> = texels.chunks_exact(4).map(|rgba| rgba[0]).collect();
         let (mut shadowed, mut lit) = (0, 0);
         for ((p, v), d) in gbuffer.positions.iter().zip(&visibility).zip(&distances) {
             if p.w < 0.5 || p.y.abs() > 1e-3 {
