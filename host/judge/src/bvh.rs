@@ -108,13 +108,16 @@ impl TriangleBvh {
     pub(crate) fn new(triangles: &[[Vec3; 3]]) -> TriangleBvh {
         let (sources, kept): (Vec<usize>, Vec<Triangle>) = triangles
             .iter()
-            .map(|[a, b, c]| Triangle {
-                v0: (*a).into(),
-                v1: (*b).into(),
-                v2: (*c).into(),
-            })
             .enumerate()
-            .filter(|(_, t)| !is_degenerate(t))
+            .filter(|(_, t)| !has_no_area(t))
+            .map(|(i, [a, b, c])| {
+                let triangle = Triangle {
+                    v0: (*a).into(),
+                    v1: (*b).into(),
+                    v2: (*c).into(),
+                };
+                (i, triangle)
+            })
             .unzip();
         if kept.is_empty() {
             return TriangleBvh {
@@ -316,12 +319,13 @@ fn enters(aabb: &Aabb, ray: &Ray) -> Option<f32> {
     (near <= far && near <= ray.tmax).then_some(near)
 }
 
-/// Whether a triangle has no area at f32 precision: its height over its longest edge is below
-/// 1e-6 of that edge (whatever the vertex order). Such a triangle cannot occlude anything, but
-/// the ray-triangle test divides by its vanishing normal and reports hits far outside it.
-fn is_degenerate(t: &Triangle) -> bool {
-    let twice_area = (t.v1 - t.v0).cross(t.v2 - t.v0).length();
-    let longest = [t.v1 - t.v0, t.v2 - t.v1, t.v0 - t.v2]
+/// Whether a triangle has no area at f32 precision (the triangles every hierarchy of the judge,
+/// and the GPU tracer, leaves out): its height over its longest edge is below 1e-6 of that
+/// edge (whatever the vertex order). Such a triangle cannot occlude anything, but the
+/// ray-triangle test divides by its vanishing normal and reports hits far outside it.
+pub fn has_no_area([v0, v1, v2]: &[Vec3; 3]) -> bool {
+    let twice_area = (*v1 - *v0).cross(*v2 - *v0).length();
+    let longest = [*v1 - *v0, *v2 - *v1, *v0 - *v2]
         .map(|e| e.length_squared())
         .into_iter()
         .fold(0.0f32, f32::max);

@@ -19,7 +19,7 @@ mod robust;
 mod sampling;
 mod surfaces;
 
-pub use bvh::{FlatBvh, FlatNode};
+pub use bvh::{FlatBvh, FlatNode, has_no_area};
 pub use indirect::{ReflectorHit, Reflectors, one_bounce, reflected_direct, relative_rmse};
 pub use leak::{leak, lit_points, unlit_by_one_bounce};
 pub use metrics::{ErrorClass, Metrics, edge_band, error_class, percentile};

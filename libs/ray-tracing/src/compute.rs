@@ -162,24 +162,25 @@ impl CasterGeometry {
 
 /// The layout of the compute traversal's group.
 pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    bind_group_layout(device, "ray tracing layout (compute)", &entries())
+}
+
+/// The group's entries, binding by binding as `ray-tracing/trace.wgsl` declares them.
+pub(crate) fn entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let stages = crate::STAGES;
-    bind_group_layout(
-        device,
-        "ray tracing layout (compute)",
-        &[
-            storage(0, stages, true),
-            storage(1, stages, true),
-            storage(2, stages, true),
-            texture(
-                3,
-                stages,
-                wgpu::TextureSampleType::Float { filterable: true },
-                wgpu::TextureViewDimension::D2Array,
-            ),
-            sampler(4, stages, wgpu::SamplerBindingType::Filtering),
-            storage(5, stages, true),
-        ],
-    )
+    vec![
+        storage(0, stages, true),
+        storage(1, stages, true),
+        storage(2, stages, true),
+        texture(
+            3,
+            stages,
+            wgpu::TextureSampleType::Float { filterable: true },
+            wgpu::TextureViewDimension::D2Array,
+        ),
+        sampler(4, stages, wgpu::SamplerBindingType::Filtering),
+        storage(5, stages, true),
+    ]
 }
 
 /// Builds and uploads the hierarchy of `ctx`'s scene: its bind group and its size (without

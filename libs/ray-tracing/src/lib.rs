@@ -119,7 +119,9 @@ pub fn shader_source(
         return Err(zoo_host::gpu::ShaderError::Import {
             file: shader.to_string(),
             line: 1,
-            message: format!("a ray-tracing shader imports `{TRACE_MODULE}`"),
+            message: format!(
+                "no line `#import \"{TRACE_MODULE}\"`, which the chosen traversal replaces"
+            ),
         });
     };
     Ok(match tracer {
@@ -151,7 +153,8 @@ pub(crate) struct Casters {
 }
 
 impl Casters {
-    /// Every shadow-casting triangle of `scene`, in object order.
+    /// Every shadow-casting triangle of `scene` with an area (the judge's rule,
+    /// [`zoo_host::judge::has_no_area`]), in object order.
     pub fn of(scene: &Scene) -> Casters {
         let mut triangles = Vec::new();
         let mut transmittance = Vec::new();
@@ -161,8 +164,12 @@ impl Casters {
                 transmittance.len() as u32 - 1
             });
             for tri in scene.triangle_indices(o) {
+                let corners = tri.map(|i| scene.mesh.positions[i]);
+                if zoo_host::judge::has_no_area(&corners) {
+                    continue;
+                }
                 triangles.push(CasterTriangle {
-                    corners: tri.map(|i| scene.mesh.positions[i]),
+                    corners,
                     mask: o.alpha_mask.filter(|_| translucent.is_none()),
                     uv: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
                     translucent,
@@ -324,6 +331,55 @@ mod tests {
         let constant = |name| wgsl_integer_constant(&source, name);
         assert_eq!(constant("RT_NO_HIERARCHY"), Ok(i64::from(NO_HIERARCHY)));
         assert_eq!(constant("RT_MAX_CROSSED"), Ok(i64::from(MAX_CROSSED)));
+    }
+
+    /// Each traversal's layout has the shader's bindings of group [`GROUP`], in number and
+    /// kind, and read-only storage where the shader reads.
+    #[test]
+    fn layouts_match_the_shaders_bindings() {
+        use naga::{AddressSpace, StorageAccess, TypeInner};
+        for (tracer, module, entries) in [
+            (Tracer::Compute, TRACE_MODULE, compute::entries()),
+            (Tracer::RayQuery, QUERY_MODULE, query::entries()),
+        ] {
+            let composed = ShaderLibrary::embedded().compose(module).unwrap();
+            let parsed = naga::front::wgsl::parse_str(&composed.source).unwrap();
+            let mut declared: Vec<(u32, String)> = (parsed.global_variables.iter())
+                .filter_map(|(_, var)| {
+                    let binding = var.binding.as_ref().filter(|b| b.group == GROUP)?;
+                    let kind = match (&parsed.types[var.ty].inner, var.space) {
+                        (_, AddressSpace::Storage { access }) => {
+                            format!(
+                                "storage read-only {}",
+                                !access.contains(StorageAccess::STORE)
+                            )
+                        }
+                        (TypeInner::Image { .. }, _) => "texture".to_string(),
+                        (TypeInner::Sampler { .. }, _) => "sampler".to_string(),
+                        (TypeInner::AccelerationStructure { .. }, _) => "scene".to_string(),
+                        (other, _) => format!("{other:?}"),
+                    };
+                    Some((binding.binding, kind))
+                })
+                .collect();
+            declared.sort();
+            let laid_out: Vec<(u32, String)> = (entries.iter())
+                .map(|e| {
+                    let kind = match e.ty {
+                        wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Storage { read_only },
+                            ..
+                        } => format!("storage read-only {read_only}"),
+                        wgpu::BindingType::Texture { .. } => "texture".to_string(),
+                        wgpu::BindingType::Sampler(_) => "sampler".to_string(),
+                        wgpu::BindingType::AccelerationStructure { .. } => "scene".to_string(),
+                        ref other => format!("{other:?}"),
+                    };
+                    (e.binding, kind)
+                })
+                .collect();
+            assert_eq!(declared, laid_out, "{tracer:?} ({module})");
+        }
     }
 
     #[test]

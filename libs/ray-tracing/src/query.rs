@@ -27,6 +27,11 @@ const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1
 
 /// The layout of the hardware traversal's group.
 pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    bind_group_layout(device, "ray tracing layout (ray queries)", &entries())
+}
+
+/// The group's entries, binding by binding as `ray-tracing/query.wgsl` declares them.
+pub(crate) fn entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     let stages = crate::STAGES;
     let scene = wgpu::BindGroupLayoutEntry {
         binding: 0,
@@ -36,22 +41,18 @@ pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         },
         count: None,
     };
-    bind_group_layout(
-        device,
-        "ray tracing layout (ray queries)",
-        &[
-            scene,
-            storage(1, stages, true),
-            texture(
-                2,
-                stages,
-                wgpu::TextureSampleType::Float { filterable: true },
-                wgpu::TextureViewDimension::D2Array,
-            ),
-            sampler(3, stages, wgpu::SamplerBindingType::Filtering),
-            storage(4, stages, true),
-        ],
-    )
+    vec![
+        scene,
+        storage(1, stages, true),
+        texture(
+            2,
+            stages,
+            wgpu::TextureSampleType::Float { filterable: true },
+            wgpu::TextureViewDimension::D2Array,
+        ),
+        sampler(3, stages, wgpu::SamplerBindingType::Filtering),
+        storage(4, stages, true),
+    ]
 }
 
 /// Instance mask of the blocking casters (`RT_BLOCKING` in `ray-tracing/query.wgsl`).
