@@ -365,3 +365,78 @@ fn shadow_volumes_declare_and_show_masks_as_opaque() {
         assert!(m.false_shadow_core > 0.005, "{m:?}");
     }
 }
+
+/// A third-party model's own texture coordinates: `spot` (from `../shared/models`, with the
+/// UVs its authors laid out) masked by the lattice texture over a floor. Its shadow has the
+/// mask's holes: the reference shadows clearly less of the floor than for the unmasked model,
+/// ray tracing matches it exactly and shadow maps within the foliage scene's bounds.
+#[test]
+fn a_masked_third_party_model_casts_the_shadow_of_its_holes() {
+    use zoo_host::test_support::{judge_scene, scene_from_ron, shared_models};
+    let Some(models) = shared_models() else {
+        return;
+    };
+    let spot = models.join("spot.obj");
+    let scene = |mask: &str| {
+        scene_from_ron(
+            "masked-spot.ron",
+            &format!(
+                r#"(camera: (position: (0, 5.5, 3), target: (0, 0, 0)),
+                    lights: [Directional(direction: (-1, -0.9, -0.2))],
+                    objects: [
+                        (mesh: Plane(size: 6)),
+                        (mesh: Obj("{}"), transform: (translation: (1.3, 1.2, 0.3), scale: (1.5, 1.5, 1.5)){mask}),
+                    ])"#,
+                spot.display()
+            ),
+        )
+    };
+    let size = UVec2::new(192, 144);
+    let masked = judge_scene(
+        scene(r#", alpha_mask: Some("textures/lattice.png")"#),
+        "rt-shadows",
+        &[("rays_per_pixel", "1")],
+        size,
+    );
+    let whole = judge_scene(scene(""), "rt-shadows", &[("rays_per_pixel", "1")], size);
+    // The floor both views see (the masked model hides less of it): how much of it is in
+    // the model's shadow.
+    let floor = |run: &zoo_host::test_support::JudgeRun, i: usize| {
+        let p = run.reference.gbuffer.positions[i];
+        p.w > 0.5 && p.y.abs() < 1e-3
+    };
+    let common: Vec<usize> = (0..masked.reference.gbuffer.positions.len())
+        .filter(|&i| floor(&masked, i) && floor(&whole, i))
+        .collect();
+    let shadowed = |run: &zoo_host::test_support::JudgeRun| {
+        let hard = &run.reference.lights[0].hard;
+        common.iter().filter(|&&i| hard[i] < 0.5).count() as f64 / common.len() as f64
+    };
+    let (holed, solid) = (shadowed(&masked), shadowed(&whole));
+    let exact = masked.metrics(0);
+    eprintln!(
+        "spot: shadowed {holed:.4} masked against {solid:.4} whole; rt-shadows core {:.5}/{:.5}",
+        exact.false_shadow_core, exact.false_lit_core
+    );
+    assert!(solid > 0.05, "the model shadows the floor ({solid})");
+    assert!(holed < 0.9 * solid, "the mask's holes let light through");
+    assert!(
+        exact.false_shadow_core + exact.false_lit_core <= 0.0005,
+        "{exact:?}"
+    );
+    let mapped = judge_scene(
+        scene(r#", alpha_mask: Some("textures/lattice.png")"#),
+        "sm-pcf",
+        &[],
+        size,
+    );
+    let m = mapped.metrics(0);
+    eprintln!(
+        "spot: sm-pcf core {:.5}/{:.5} mae {:.4}",
+        m.false_shadow_core, m.false_lit_core, m.mae
+    );
+    assert!(
+        m.false_shadow_core <= 0.01 && m.false_lit_core <= 0.01,
+        "{m:?}"
+    );
+}

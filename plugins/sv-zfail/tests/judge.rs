@@ -3,7 +3,7 @@
 // Link the plugin so its technique registers.
 use zoo_plugin_sv_zfail as _;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use zoo_host::glam::UVec2;
 use zoo_host::params::ParamValues;
@@ -116,23 +116,11 @@ fn gpu_silhouette_counts_match_the_cpu_mirror() {
     }
 }
 
-/// The real meshes in `../shared/models` (not part of the repository).
-fn shared_models() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
-    if dir.is_dir() {
-        Some(dir.canonicalize().unwrap())
-    } else {
-        eprintln!(
-            "SKIPPED: {} is absent; the open-mesh shadow-volume test needs the shared models folder",
-            dir.display()
-        );
-        None
-    }
-}
-
 #[test]
 fn open_real_meshes_do_not_leak_light() {
-    let Some(dir) = shared_models() else { return };
+    let Some(dir) = zoo_host::test_support::shared_models() else {
+        return;
+    };
     for (file, transform) in [
         // The bunny's bottom is open; the teapot has gaps and non-manifold edges.
         (
