@@ -1,5 +1,6 @@
 //! Helpers for plugin and integration tests: one shared headless GPU context per test binary.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
@@ -115,7 +116,41 @@ pub struct JudgeRun {
 /// every light with the default number of area samples.
 pub fn judge(scene: &str, technique: &str, params: &[(&str, &str)], size: glam::UVec2) -> JudgeRun {
     let loaded = crate::scene::Scene::load(&scene_path(scene)).unwrap_or_else(|e| panic!("{e}"));
-    judge_scene(loaded, technique, params, size)
+    judge_with(gpu(), loaded, technique, params, size, Some(scene))
+}
+
+/// What the reference of a scene file holds (a [`crate::judging::SceneReference`] without its
+/// lazily traced parts).
+type TracedReference = (
+    crate::render::GBufferData,
+    Vec<zoo_judge::LightReference>,
+    usize,
+    f64,
+);
+
+/// The reference of scene file `scene` at `size` on the shared context, traced by `trace` the
+/// first time a test of this binary asks for it: a scene judged with several techniques or
+/// parameters is traced once.
+fn cached_reference(
+    scene: &str,
+    size: glam::UVec2,
+    trace: impl FnOnce() -> crate::judging::SceneReference,
+) -> crate::judging::SceneReference {
+    type Cache = std::sync::Mutex<HashMap<(String, glam::UVec2), Arc<OnceLock<TracedReference>>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let slot = {
+        let mut cache = (CACHE.get_or_init(Default::default).lock())
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        cache.entry((scene.to_string(), size)).or_default().clone()
+    };
+    // Another test tracing the same scene waits here for its result.
+    let (gbuffer, lights, triangles, seconds) = slot
+        .get_or_init(|| {
+            let r = trace();
+            (r.gbuffer, r.lights, r.occluder_triangles, r.seconds)
+        })
+        .clone();
+    crate::judging::SceneReference::from_traced(gbuffer, lights, triangles, seconds)
 }
 
 /// Every scene of `scenes/` (sorted) but the many-lamp benchmark plazas (`lights-*`, hundreds
@@ -189,6 +224,19 @@ pub fn judge_scene_on(
     params: &[(&str, &str)],
     size: glam::UVec2,
 ) -> JudgeRun {
+    judge_with(gpu, loaded, technique, params, size, None)
+}
+
+/// Judges `technique` on `loaded`; the reference of scene file `file` (on the shared context)
+/// is traced once per test binary.
+fn judge_with(
+    gpu: Arc<GpuContext>,
+    loaded: crate::scene::Scene,
+    technique: &str,
+    params: &[(&str, &str)],
+    size: glam::UVec2,
+    file: Option<&str>,
+) -> JudgeRun {
     let scene = loaded.name.clone();
     let registration = crate::find_technique(technique).unwrap_or_else(|e| panic!("{e}"));
     let schema = (registration.params)();
@@ -201,12 +249,15 @@ pub fn judge_scene_on(
         .unwrap_or_else(|e| panic!("{technique}: {e}"));
     let mut renderer =
         crate::Renderer::new(gpu, loaded.clone(), size).unwrap_or_else(|e| panic!("{e}"));
-    let reference = crate::judging::SceneReference::compute(
-        &mut renderer,
-        crate::judging::DEFAULT_SAMPLES,
-        |_| {},
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let mut trace = || {
+        let samples = crate::judging::DEFAULT_SAMPLES;
+        crate::judging::SceneReference::compute(&mut renderer, samples, |_| {})
+            .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let reference = match file {
+        Some(file) => cached_reference(file, size, trace),
+        None => trace(),
+    };
     let judged = crate::judging::judge_technique(&mut renderer, &reference, technique, &values)
         .unwrap_or_else(|e| panic!("{technique} on {scene}: {e}"));
     JudgeRun {
