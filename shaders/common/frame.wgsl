@@ -37,15 +37,47 @@ struct Light {
 }
 
 struct Object {
-    model: mat4x4<f32>,
+    // Takes the object's stored vertices to world space (`SceneObject::placement`).
+    placement: mat4x4<f32>,
     // rgb albedo, a specular strength.
     color: vec4<f32>,
     // x shininess, y casts shadows (0 or 1).
     material: vec4<f32>,
     // Translucent casters: rgb the colour they let through, w = 1; opaque casters: all 0.
     transmittance: vec4<f32>,
+    // Its first drawn triangle (instances counted, in object order), its first stored
+    // triangle, its triangle count.
+    drawn: vec4<u32>,
 }
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
 @group(0) @binding(2) var<storage, read> objects: array<Object>;
+
+// Stored vertex `position` of `object` in world space.
+fn object_world(object: u32, position: vec3<f32>) -> vec3<f32> {
+    return (objects[object].placement * vec4<f32>(position, 1.0)).xyz;
+}
+
+// The drawn index of `object`'s stored triangle `triangle`: one number per triangle drawn,
+// instances counted.
+fn drawn_triangle_id(object: u32, triangle: u32) -> u32 {
+    return objects[object].drawn.x + triangle - objects[object].drawn.y;
+}
+
+// The object and stored triangle of drawn triangle `id` (`drawn_triangle_id`'s inverse).
+fn drawn_triangle(id: u32) -> vec2<u32> {
+    // The last object whose first drawn triangle is at most `id` (an object without triangles
+    // starts where the next one does, so that one holds it).
+    var lo = 0u;
+    var hi = arrayLength(&objects);
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if objects[mid].drawn.x <= id {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return vec2<u32>(lo, objects[lo].drawn.y + id - objects[lo].drawn.x);
+}

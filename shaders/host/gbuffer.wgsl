@@ -2,6 +2,7 @@
 
 #import "common/frame.wgsl"
 #import "common/materials.wgsl"
+#import "common/vertices.wgsl"
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -19,12 +20,12 @@ struct VertexOut {
 }
 
 @vertex
-fn vs_main(v: VertexIn) -> VertexOut {
-    // Scene vertices are stored in world space.
+fn vs_main(v: VertexIn, placement: Placement) -> VertexOut {
+    let world = placed_position(placement, v.position);
     var out: VertexOut;
-    out.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
-    out.world = v.position;
-    out.normal = v.normal;
+    out.clip = camera.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.normal = placed_normal(placement, v.normal);
     out.object = v.object;
     out.uv = v.uv;
     return out;

@@ -92,9 +92,13 @@ const EDGE: u32 = 3u;
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
 
-fn vertex_position(index: u32) -> vec3<f32> {
-    let base = index * VERTEX_FLOATS;
-    return vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
+// Corner `k` of drawn triangle `id` (the maps hold drawn indices: `drawn_triangle_id`), in
+// world space.
+fn drawn_corner(id: u32, k: u32) -> vec3<f32> {
+    let triangle = drawn_triangle(id);
+    let base = scene_indices[3u * triangle.y + k] * VERTEX_FLOATS;
+    let stored = vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
+    return object_world(triangle.x, stored);
 }
 
 // How far towards the light a surface moves before it meets the coverage map's triangle, in
@@ -140,7 +144,7 @@ fn plane_depth(id: u32, m: MapPoint) -> f32 {
     let camera = layer_cameras[m.layer].camera;
     var corners: array<vec3<f32>, 3>;
     for (var k = 0u; k < 3u; k++) {
-        let clip = camera.view_proj * vec4<f32>(vertex_position(scene_indices[3u * id + k]), 1.0);
+        let clip = camera.view_proj * vec4<f32>(drawn_corner(id, k), 1.0);
         if clip.w <= 1e-6 {
             return 0.0;
         }
@@ -240,9 +244,9 @@ fn fs_band(in: FullscreenOut) -> BandOut {
 // Whether triangle `id` crosses the ray origin + t·direction for t in (0, t_max)
 // (Möller–Trumbore).
 fn ray_hits(id: u32, origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
-    let a = vertex_position(scene_indices[3u * id]);
-    let b = vertex_position(scene_indices[3u * id + 1u]);
-    let c = vertex_position(scene_indices[3u * id + 2u]);
+    let a = drawn_corner(id, 0u);
+    let b = drawn_corner(id, 1u);
+    let c = drawn_corner(id, 2u);
     let e1 = b - a;
     let e2 = c - a;
     let h = cross(direction, e2);

@@ -50,18 +50,15 @@ fn meet(e: vec3<f32>, f: vec3<f32>) -> vec2<f32> {
 }
 
 @vertex
-fn vs_coverage(@builtin(vertex_index) vertex: u32) -> CoverageVertex {
+fn vs_coverage(@builtin(vertex_index) vertex: u32, @builtin(instance_index) object: u32) -> CoverageVertex {
     var out: CoverageVertex;
     out.clip = OUTSIDE_CLIP;
     let triangle = vertex / 3u;
-    out.triangle = triangle;
-    if !casts_shadows(triangle) {
-        return out;
-    }
+    out.triangle = drawn_triangle_id(object, triangle);
     let corner = vertex % 3u;
     var clip: array<vec4<f32>, 3>;
     for (var k = 0u; k < 3u; k++) {
-        clip[k] = layer_camera.view_proj * vec4<f32>(triangle_corner(triangle, k), 1.0);
+        clip[k] = layer_camera.view_proj * vec4<f32>(triangle_corner(object, triangle, k), 1.0);
     }
     // A triangle that reaches behind a perspective layer's eye is drawn as it is (clipped by
     // the rasteriser, not grown).

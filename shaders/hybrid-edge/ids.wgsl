@@ -1,6 +1,7 @@
 // Hybrid shadows, pass 1 with triangle ids: every caster triangle rendered from one shadow-map
 // layer, writing depth and the id of the front-most triangle in each texel. Vertices are
-// pulled from the scene's storage buffers, so the id is simply the triangle's index.
+// pulled from the scene's storage buffers; the id is the triangle's drawn index
+// (`drawn_triangle_id`: instances counted).
 
 #import "hybrid-edge/casters.wgsl"
 
@@ -10,13 +11,11 @@ struct IdVertex {
 }
 
 @vertex
-fn vs_ids(@builtin(vertex_index) vertex: u32) -> IdVertex {
+fn vs_ids(@builtin(vertex_index) vertex: u32, @builtin(instance_index) object: u32) -> IdVertex {
+    let triangle = vertex / 3u;
     var out: IdVertex;
-    out.triangle = vertex / 3u;
-    out.clip = OUTSIDE_CLIP;
-    if casts_shadows(out.triangle) {
-        out.clip = layer_camera.view_proj * vec4<f32>(triangle_corner(out.triangle, vertex % 3u), 1.0);
-    }
+    out.triangle = drawn_triangle_id(object, triangle);
+    out.clip = layer_camera.view_proj * vec4<f32>(triangle_corner(object, triangle, vertex % 3u), 1.0);
     return out;
 }
 

@@ -10,6 +10,7 @@
 
 #import "common/frame.wgsl"
 #import "common/lighting.wgsl"
+#import "common/vertices.wgsl"
 #import "common/materials.wgsl"
 
 struct RsmCamera {
@@ -43,11 +44,13 @@ fn vs_rsm(
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @builtin(instance_index) object: u32,
+    placement: Placement,
 ) -> RsmVertex {
+    let world = placed_position(placement, position);
     var out: RsmVertex;
-    out.clip = rsm_camera.view_proj * vec4<f32>(position, 1.0);
-    out.world = position;
-    out.normal = normal;
+    out.clip = rsm_camera.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.normal = placed_normal(placement, normal);
     out.object = object;
     out.uv = uv;
     return out;

@@ -4,10 +4,11 @@
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
 #import "planar/projection.wgsl"
+#import "common/vertices.wgsl"
 
 @vertex
-fn vs_mark(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
-    return camera.view_proj * vec4<f32>(position, 1.0);
+fn vs_mark(@location(0) position: vec3<f32>, placement: Placement) -> @builtin(position) vec4<f32> {
+    return camera.view_proj * vec4<f32>(placed_position(placement, position), 1.0);
 }
 
 // Marks pixels whose G-buffer surface is this plane (the depth test already rejected pixels

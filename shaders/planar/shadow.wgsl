@@ -5,6 +5,7 @@
 #import "common/frame.wgsl"
 #import "common/materials.wgsl"
 #import "planar/projection.wgsl"
+#import "common/vertices.wgsl"
 
 struct ShadowOut {
     @builtin(position) clip: vec4<f32>,
@@ -20,10 +21,12 @@ fn vs_shadow(
     @location(0) position: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @builtin(instance_index) object: u32,
+    placement: Placement,
 ) -> ShadowOut {
+    let world = placed_position(placement, position);
     var out: ShadowOut;
-    out.clip = camera.view_proj * (projection.shadow_matrix * vec4<f32>(position, 1.0));
-    out.world = position;
+    out.clip = camera.view_proj * (projection.shadow_matrix * vec4<f32>(world, 1.0));
+    out.world = world;
     out.uv = uv;
     out.object = object;
     return out;

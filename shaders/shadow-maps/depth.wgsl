@@ -3,12 +3,13 @@
 // a colour map (moments, for example: see `light_depth`).
 
 #import "shadow-maps/layers.wgsl"
+#import "common/vertices.wgsl"
 
 @group(0) @binding(0) var<uniform> layer_camera: LayerCamera;
 
 @vertex
-fn vs_depth(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
-    return layer_camera.view_proj * vec4<f32>(position, 1.0);
+fn vs_depth(@location(0) position: vec3<f32>, placement: Placement) -> @builtin(position) vec4<f32> {
+    return layer_camera.view_proj * vec4<f32>(placed_position(placement, position), 1.0);
 }
 
 struct DepthVertex {
@@ -17,9 +18,10 @@ struct DepthVertex {
 }
 
 @vertex
-fn vs_depth_world(@location(0) position: vec3<f32>) -> DepthVertex {
+fn vs_depth_world(@location(0) position: vec3<f32>, placement: Placement) -> DepthVertex {
+    let world = placed_position(placement, position);
     var out: DepthVertex;
-    out.clip = layer_camera.view_proj * vec4<f32>(position, 1.0);
-    out.world = position;
+    out.clip = layer_camera.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
     return out;
 }

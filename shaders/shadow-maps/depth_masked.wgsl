@@ -17,10 +17,12 @@ fn vs_depth_masked(
     @location(0) position: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @builtin(instance_index) object: u32,
+    placement: Placement,
 ) -> MaskedVertex {
+    let world = placed_position(placement, position);
     var out: MaskedVertex;
-    out.clip = layer_camera.view_proj * vec4<f32>(position, 1.0);
-    out.world = position;
+    out.clip = layer_camera.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
     out.uv = uv;
     out.object = object;
     return out;

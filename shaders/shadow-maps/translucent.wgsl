@@ -6,6 +6,7 @@
 
 #import "common/frame.wgsl"
 #import "shadow-maps/layers.wgsl"
+#import "common/vertices.wgsl"
 
 @group(1) @binding(0) var<uniform> layer_camera: LayerCamera;
 
@@ -19,10 +20,12 @@ struct TranslucentVertex {
 fn vs_translucent(
     @location(0) position: vec3<f32>,
     @builtin(instance_index) object: u32,
+    placement: Placement,
 ) -> TranslucentVertex {
+    let world = placed_position(placement, position);
     var out: TranslucentVertex;
-    out.clip = layer_camera.view_proj * vec4<f32>(position, 1.0);
-    out.world = position;
+    out.clip = layer_camera.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
     out.object = object;
     return out;
 }

@@ -7,12 +7,16 @@
 // `edges`: each edge emits |m| side quads, m = sum over its faces of weight x traversal sign,
 // so sides shared by two emitting triangles cancel and boundary or non-manifold edges close
 // the volume exactly as per-triangle volumes would.
+// Both run once per part of the scene (`Part`): the triangles stored in world space, then each
+// instance's shared triangles under its placement.
 
 #import "common/vertices.wgsl"
 #import "common/frame.wgsl"
 
 const FLAG_CASTS: u32 = 1u;
 const FLAG_CLOSED: u32 = 2u;
+// The triangle is an instance's (shared): the world-space part leaves it out.
+const FLAG_PLACED: u32 = 4u;
 // `EdgeRecord::info` (host scene crate): the face count below bit 24, the edge kind above.
 const EDGE_FACE_COUNT_MASK: u32 = 0x00ffffffu;
 const MODE_PER_TRIANGLE: u32 = 1u;
@@ -22,12 +26,19 @@ const WORKGROUP_SIZE: u32 = 64u;
 struct Params {
     light: u32,
     mode: u32,
-    triangle_count: u32,
-    edge_count: u32,
     capacity: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+}
+
+// One dispatch's triangles and edges, and what takes their stored vertices to world space.
+struct Part {
+    to_world: mat4x4<f32>,
+    first_triangle: u32,
+    triangle_count: u32,
+    first_edge: u32,
+    edge_count: u32,
+    // 1 for an instance, 0 for the world-space part.
+    instance: u32,
 }
 
 struct DrawArgs {
@@ -47,10 +58,12 @@ struct DrawArgs {
 @group(1) @binding(6) var<storage, read_write> volume: array<vec4<f32>>;
 @group(1) @binding(7) var<storage, read_write> draw: DrawArgs;
 @group(1) @binding(8) var<uniform> params: Params;
+@group(1) @binding(9) var<uniform> part: Part;
 
 fn position(index: u32) -> vec3<f32> {
     let base = index * VERTEX_FLOATS;
-    return vec3<f32>(vertices[base], vertices[base + 1u], vertices[base + 2u]);
+    let stored = vec3<f32>(vertices[base], vertices[base + 1u], vertices[base + 2u]);
+    return (part.to_world * vec4<f32>(stored, 1.0)).xyz;
 }
 
 fn directional() -> bool {
@@ -104,11 +117,16 @@ fn invocation(id: vec3<u32>, groups: vec3<u32>) -> u32 {
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn triangles(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let t = invocation(id, groups);
-    if t >= params.triangle_count {
+    let i = invocation(id, groups);
+    if i >= part.triangle_count {
         return;
     }
+    let t = part.first_triangle + i;
     let flags = triangle_flags[t];
+    if part.instance == 0u && (flags & FLAG_PLACED) != 0u {
+        weights[t] = 0;
+        return;
+    }
     var a = position(indices[3u * t]);
     var b = position(indices[3u * t + 1u]);
     var c = position(indices[3u * t + 2u]);
@@ -156,10 +174,11 @@ fn triangles(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn edges_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let e = invocation(id, groups);
-    if e >= params.edge_count || params.mode == MODE_PER_TRIANGLE {
+    let i = invocation(id, groups);
+    if i >= part.edge_count || params.mode == MODE_PER_TRIANGLE {
         return;
     }
+    let e = part.first_edge + i;
     let edge = edges[e];
     let count = edge.w & EDGE_FACE_COUNT_MASK;
     var m = 0;

@@ -12,6 +12,7 @@ mod foliage;
 mod gl_backend;
 mod gpu_judge;
 mod indirect_light;
+mod instances;
 mod judge;
 mod kit;
 mod many_lights;

@@ -91,9 +91,9 @@ fn check_out_folder(out: &Path) -> anyhow::Result<()> {
 /// The scene's size and how long loading it took.
 fn print_scene(scene: &Scene, load_time: std::time::Duration) {
     println!(
-        "scene: {} ({} triangles, {} lights, {} objects, {} texture layers; loaded in {:.2} s)",
+        "scene: {} ({}, {} lights, {} objects, {} texture layers; loaded in {:.2} s)",
         scene.name,
-        scene.triangle_count(),
+        scene.triangle_summary(),
         scene.lights.len(),
         scene.objects.len(),
         scene.textures.layers.len(),

@@ -154,9 +154,9 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
     let adapter = gpu.describe();
     println!(
-        "scene: {} ({} triangles, {} lights); {} techniques at {}x{}, {} view{}",
+        "scene: {} ({}, {} lights); {} techniques at {}x{}, {} view{}",
         scene.name,
-        scene.triangle_count(),
+        scene.triangle_summary(),
         scene.lights.len(),
         techniques.len(),
         args.size.x,
@@ -166,7 +166,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     );
     let light_count = scene.lights.len();
     let scene_name = scene.name.clone();
-    let triangles = scene.triangle_count();
+    let triangles = scene.triangle_summary();
     let mut renderer = Renderer::with_shaders(gpu, scene, args.size, shaders)?;
 
     let bar = ProgressBar::new((times.len() * (light_count + techniques.len())) as u64);
@@ -666,7 +666,8 @@ fn judge_name(judge: Judge) -> &'static str {
 struct ReportInputs<'a> {
     scene: &'a str,
     scene_path: &'a Path,
-    triangles: usize,
+    /// [`zoo_host::Scene::triangle_summary`].
+    triangles: String,
     lights: usize,
     size: (u32, u32),
     adapter: &'a str,
@@ -717,7 +718,7 @@ fn report_md(r: &ReportInputs<'_>) -> String {
     let _ = writeln!(w, "# Shadow Zoo comparison: {}\n", r.scene);
     let _ = writeln!(
         w,
-        "- Scene: `{}` ({} triangles, {} lights)",
+        "- Scene: `{}` ({}, {} lights)",
         r.scene_path.display(),
         r.triangles,
         r.lights

@@ -26,7 +26,7 @@ use crate::robust::gamma;
 /// A ray query: origin, unit direction and the open distance range (0, `tmax`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Query {
-    ray: Ray,
+    pub(crate) ray: Ray,
 }
 
 impl Query {
@@ -83,7 +83,7 @@ impl FlatBvh {
 }
 
 /// What a leaf visit tells the traversal.
-enum Visit {
+pub(crate) enum Visit {
     /// Keep going (with the ray's `tmax` possibly shortened by the visitor).
     Continue,
     /// Stop: the answer is known.
@@ -178,6 +178,16 @@ impl TriangleBvh {
         }
     }
 
+    /// The root's box (grown by the triangle test's rounding), `None` without triangles.
+    pub(crate) fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let root = self
+            .bvh
+            .nodes
+            .first()
+            .filter(|_| !self.triangles.is_empty())?;
+        Some((root.aabb.min.into(), root.aabb.max.into()))
+    }
+
     /// Number of triangles kept.
     pub(crate) fn len(&self) -> usize {
         self.triangles.len()
@@ -185,52 +195,10 @@ impl TriangleBvh {
 
     /// Visits the leaves `query` may cross, nearer child first, calling `leaf` with each
     /// triangle range; `leaf` may shorten the ray's `tmax`.
-    fn traverse(
-        &self,
-        query: &Query,
-        mut leaf: impl FnMut(std::ops::Range<usize>, &mut Ray) -> Visit,
-    ) {
-        if self.triangles.is_empty() {
-            return;
+    fn traverse(&self, query: &Query, leaf: impl FnMut(std::ops::Range<usize>, &mut Ray) -> Visit) {
+        if !self.triangles.is_empty() {
+            STACK.with_borrow_mut(|stack| traverse_nodes(&self.bvh, query.ray, stack, leaf));
         }
-        let mut ray = query.ray;
-        let Some(root) = enters(&self.bvh.nodes[0].aabb, &ray) else {
-            return;
-        };
-        STACK.with_borrow_mut(|stack| {
-            stack.clear();
-            stack.push((0, root));
-            while let Some((index, near)) = stack.pop() {
-                // A closer hit found since the node was pushed may rule it out.
-                if near > ray.tmax {
-                    continue;
-                }
-                let node = &self.bvh.nodes[index as usize];
-                let first = node.first_index as usize;
-                if node.prim_count > 0 {
-                    let range = first..first + node.prim_count as usize;
-                    if let Visit::Stop = leaf(range, &mut ray) {
-                        return;
-                    }
-                    continue;
-                }
-                // Children are `first` and `first + 1`; the nearer one is pushed last.
-                let children = [first, first + 1]
-                    .map(|c| enters(&self.bvh.nodes[c].aabb, &ray).map(|t| (c as u32, t)));
-                match children {
-                    [Some(a), Some(b)] if a.1 <= b.1 => stack.extend([b, a]),
-                    [Some(a), Some(b)] => stack.extend([a, b]),
-                    [Some(a), None] | [None, Some(a)] => stack.push(a),
-                    [None, None] => {}
-                }
-            }
-        });
-    }
-
-    /// The nearest triangle `query` hits: its input index and distance.
-    #[cfg(test)]
-    pub(crate) fn closest(&self, query: &Query) -> Option<(usize, f32)> {
-        self.closest_where(query, |_, _| true)
     }
 
     /// The nearest hit that `accept(input index, distance)` takes (masked surfaces let rays
@@ -252,11 +220,6 @@ impl TriangleBvh {
             Visit::Continue
         });
         best
-    }
-
-    /// Whether `query` hits any triangle.
-    pub(crate) fn any_hit(&self, query: &Query) -> bool {
-        self.any_hit_where(query, |_, _| true)
     }
 
     /// Whether `query` hits a triangle that `blocks(input index, distance)` accepts (masked
@@ -306,6 +269,46 @@ impl TriangleBvh {
         self.triangles
             .iter()
             .any(|t| t.intersect(&query.ray) < f32::INFINITY)
+    }
+}
+
+/// Visits the leaves of the non-empty `bvh` that `ray` may cross, nearer child first, calling
+/// `leaf` with each primitive range; `leaf` may shorten the ray's `tmax`. `stack` is scratch
+/// space (a traversal inside a leaf visit needs a stack of its own).
+pub(crate) fn traverse_nodes(
+    bvh: &Bvh2,
+    mut ray: Ray,
+    stack: &mut Vec<(u32, f32)>,
+    mut leaf: impl FnMut(std::ops::Range<usize>, &mut Ray) -> Visit,
+) {
+    let Some(root) = enters(&bvh.nodes[0].aabb, &ray) else {
+        return;
+    };
+    stack.clear();
+    stack.push((0, root));
+    while let Some((index, near)) = stack.pop() {
+        // A closer hit found since the node was pushed may rule it out.
+        if near > ray.tmax {
+            continue;
+        }
+        let node = &bvh.nodes[index as usize];
+        let first = node.first_index as usize;
+        if node.prim_count > 0 {
+            let range = first..first + node.prim_count as usize;
+            if let Visit::Stop = leaf(range, &mut ray) {
+                return;
+            }
+            continue;
+        }
+        // Children are `first` and `first + 1`; the nearer one is pushed last.
+        let children =
+            [first, first + 1].map(|c| enters(&bvh.nodes[c].aabb, &ray).map(|t| (c as u32, t)));
+        match children {
+            [Some(a), Some(b)] if a.1 <= b.1 => stack.extend([b, a]),
+            [Some(a), Some(b)] => stack.extend([a, b]),
+            [Some(a), None] | [None, Some(a)] => stack.push(a),
+            [None, None] => {}
+        }
     }
 }
 

@@ -14,6 +14,7 @@ use zoo_scene::shading::falloff;
 use zoo_scene::{AlphaMask, Light, Scene, Textures};
 
 use crate::occluders::Occluders;
+use crate::placed::DrawnTriangle;
 use crate::robust::to_light;
 use crate::sampling::stratified_disk;
 use crate::surfaces::{SurfacePoint, Surfaces, texture_coordinates};
@@ -22,19 +23,18 @@ use crate::surfaces::{SurfacePoint, Surfaces, texture_coordinates};
 /// and alpha-tested as the G-buffer draws them.
 pub struct Reflectors {
     surfaces: Surfaces,
-    /// Per triangle: its material.
+    /// Per part of `surfaces` (an object, or one triangle of [`Reflectors::from_triangles`]):
+    /// its material.
     materials: Vec<ReflectorMaterial>,
     textures: Textures,
     /// The corners' least and greatest coordinates.
     bounds: (Vec3, Vec3),
 }
 
-/// The material of one reflecting triangle.
+/// The material of one reflecting object.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct ReflectorMaterial {
     color: Vec3,
-    /// The corners' texture coordinates, where the object has an albedo texture or a mask.
-    uvs: [Vec2; 3],
     albedo_texture: Option<u32>,
     alpha_mask: Option<AlphaMask>,
 }
@@ -53,20 +53,19 @@ impl Reflectors {
     /// as albedo, its mask's holes passed through (texels read at full resolution, as the
     /// judge's alpha test does).
     pub fn new(scene: &Scene) -> Reflectors {
-        let mut corners = Vec::new();
-        let mut materials = Vec::new();
-        for object in &scene.objects {
-            for tri in scene.triangle_indices(object) {
-                corners.push(tri.map(|i| scene.mesh.positions[i]));
-                materials.push(ReflectorMaterial {
-                    color: object.color,
-                    uvs: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
-                    albedo_texture: object.albedo_texture,
-                    alpha_mask: object.alpha_mask,
-                });
-            }
+        let materials = (scene.objects.iter())
+            .map(|object| ReflectorMaterial {
+                color: object.color,
+                albedo_texture: object.albedo_texture,
+                alpha_mask: object.alpha_mask,
+            })
+            .collect();
+        Reflectors {
+            surfaces: Surfaces::new(scene),
+            materials,
+            textures: scene.textures.clone(),
+            bounds: scene.bounds(),
         }
-        Reflectors::with_materials(corners, materials, scene.textures.clone())
     }
 
     /// Reflectors from world-space triangles and their albedo.
@@ -75,28 +74,19 @@ impl Reflectors {
             .iter()
             .map(|(_, color)| ReflectorMaterial {
                 color: *color,
-                uvs: [Vec2::ZERO; 3],
                 albedo_texture: None,
                 alpha_mask: None,
             })
             .collect();
-        let corners = triangles.iter().map(|(t, _)| *t).collect();
-        Reflectors::with_materials(corners, materials, Textures::default())
-    }
-
-    fn with_materials(
-        corners: Vec<[Vec3; 3]>,
-        materials: Vec<ReflectorMaterial>,
-        textures: Textures,
-    ) -> Reflectors {
-        let bounds = corners.iter().flatten().fold(
+        let parts: Vec<Vec<[Vec3; 3]>> = triangles.iter().map(|(t, _)| vec![*t]).collect();
+        let bounds = triangles.iter().flat_map(|(t, _)| t).fold(
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),
         );
         Reflectors {
-            surfaces: Surfaces::from_triangles(corners),
+            surfaces: Surfaces::from_parts(&parts),
             materials,
-            textures,
+            textures: Textures::default(),
             bounds,
         }
     }
@@ -113,22 +103,20 @@ impl Reflectors {
 
     /// The nearest reflector from `origin` along unit `direction` (through mask holes).
     pub fn closest(&self, origin: Vec3, direction: Vec3) -> Option<ReflectorHit> {
-        let uv_at = |triangle: usize, t: f32| {
-            let corners = self.surfaces.corners(triangle);
-            let uvs = &self.materials[triangle].uvs;
-            texture_coordinates(corners, uvs, origin + direction * t)
+        let uv_at = |triangle: &DrawnTriangle, t: f32| {
+            texture_coordinates(&triangle.corners, &triangle.uvs, origin + direction * t)
         };
-        let hit = self
-            .surfaces
-            .closest_where(origin, direction, |triangle, t| {
-                self.materials[triangle].alpha_mask.is_none_or(|mask| {
-                    self.textures.alpha(mask.layer, uv_at(triangle, t)) >= mask.cutoff
-                })
-            })?;
-        let material = &self.materials[hit.triangle];
+        let hit = self.surfaces.closest_where(origin, direction, |index, t| {
+            let triangle = self.surfaces.triangle(index);
+            self.materials[triangle.part].alpha_mask.is_none_or(|mask| {
+                self.textures.alpha(mask.layer, uv_at(&triangle, t)) >= mask.cutoff
+            })
+        })?;
+        let triangle = self.surfaces.triangle(hit.triangle);
+        let material = &self.materials[triangle.part];
         let texel = material.albedo_texture.map_or(Vec3::ONE, |layer| {
             self.textures
-                .linear_rgb(layer, uv_at(hit.triangle, hit.distance))
+                .linear_rgb(layer, uv_at(&triangle, hit.distance))
         });
         Some(ReflectorHit {
             point: hit.point,

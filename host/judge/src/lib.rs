@@ -14,6 +14,7 @@ mod indirect;
 mod leak;
 mod metrics;
 mod occluders;
+mod placed;
 mod reference;
 mod robust;
 mod sampling;

@@ -1,35 +1,34 @@
 //! Shadow-casting triangles, queried with occlusion rays.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use zoo_scene::{AlphaMask, Scene, Textures};
 
-use crate::bvh::{Query, TriangleBvh};
+use crate::bvh::Query;
+use crate::placed::PlacedTriangles;
 use crate::surfaces::texture_coordinates;
 
-/// Translucent shadow casters: their triangles, the object each belongs to, and the colour
-/// each object lets through.
+/// Translucent shadow casters: their triangles (one part per object) and the colour each
+/// object lets through.
 struct TranslucentCasters {
-    bvh: TriangleBvh,
-    /// Per input triangle: its object (an index into `transmittance`).
-    owners: Vec<usize>,
+    triangles: PlacedTriangles,
     transmittance: Vec<Vec3>,
 }
 
-/// Alpha-tested casters: their triangles with texture coordinates and each one's mask.
+/// Alpha-tested casters: their triangles (one part per object) and each object's mask.
 struct AlphaTestedCasters {
-    bvh: TriangleBvh,
-    /// Per input triangle: its corners, their texture coordinates and its mask.
-    triangles: Vec<([Vec3; 3], [Vec2; 3], AlphaMask)>,
+    triangles: PlacedTriangles,
+    masks: Vec<AlphaMask>,
     textures: Textures,
 }
 
 impl AlphaTestedCasters {
-    /// Whether the hit `t` along the ray on triangle `index` lands on the mask's coverage
-    /// (alpha at or above the cutoff), read where the hit point's barycentric coordinates put
-    /// it in the texture.
+    /// Whether the hit `t` along the ray on drawn triangle `index` lands on the mask's
+    /// coverage (alpha at or above the cutoff), read where the hit point's barycentric
+    /// coordinates put it in the texture.
     fn blocks(&self, index: usize, origin: Vec3, direction: Vec3, t: f32) -> bool {
-        let (corners, uvs, mask) = &self.triangles[index];
-        let uv = texture_coordinates(corners, uvs, origin + direction * t);
+        let triangle = self.triangles.triangle(index);
+        let mask = self.masks[triangle.part];
+        let uv = texture_coordinates(&triangle.corners, &triangle.uvs, origin + direction * t);
         self.textures.alpha(mask.layer, uv) >= mask.cutoff
     }
 }
@@ -39,11 +38,12 @@ impl AlphaTestedCasters {
 /// full resolution); and translucent ones, each of which filters a ray that crosses it once
 /// by its transmittance colour (however many of its surfaces the ray crosses).
 ///
-/// Triangles stay in world coordinates and nothing is measured against the scene's size:
-/// every hit farther than 0 from the ray origin counts (origins come off their surface by
-/// their error bound, [`crate::SurfacePoint::ray_origin`]).
+/// Triangles stay in their stored coordinates (world space, or an instance's shared mesh,
+/// which rays enter through the inverse of its placement: [`PlacedTriangles`]), and nothing is
+/// measured against the scene's size: every hit farther than 0 from the ray origin counts
+/// (origins come off their surface by their error bound, [`crate::SurfacePoint::ray_origin`]).
 pub struct Occluders {
-    opaque: TriangleBvh,
+    opaque: PlacedTriangles,
     masked: Option<AlphaTestedCasters>,
     translucent: Option<TranslucentCasters>,
 }
@@ -51,32 +51,29 @@ pub struct Occluders {
 impl Occluders {
     /// The triangles of every shadow-casting object of `scene`: opaque objects block, masked
     /// ones block where their mask covers, and translucent ones (opacity below 1) filter.
+    /// Instances share their triangles here too.
     pub fn new(scene: &Scene) -> Occluders {
-        let mut opaque = Vec::new();
-        let mut translucent = Vec::new();
-        let mut masked = Vec::new();
-        for object in scene.objects.iter().filter(|o| o.casts_shadows) {
-            let triangles: Vec<[Vec3; 3]> = scene.object_triangles(object).collect();
-            match (object.transmittance(), object.alpha_mask) {
-                (None, None) => opaque.extend(triangles),
-                (None, Some(mask)) => {
-                    let uvs =
-                        (scene.triangle_indices(object)).map(|t| t.map(|i| scene.mesh.uvs[i]));
-                    masked.extend(triangles.into_iter().zip(uvs).map(|(p, uv)| (p, uv, mask)));
-                }
-                (Some(t), _) => translucent.push((triangles, t)),
-            }
-        }
-        let mut occluders = Occluders::with_translucent(&opaque, &translucent);
-        if !masked.is_empty() {
-            let corners: Vec<[Vec3; 3]> = masked.iter().map(|(p, _, _)| *p).collect();
-            occluders.masked = Some(AlphaTestedCasters {
-                bvh: TriangleBvh::new(&corners),
-                triangles: masked,
+        let casters = || scene.objects.iter().filter(|o| o.casts_shadows);
+        let opaque = casters().filter(|o| o.transmittance().is_none() && o.alpha_mask.is_none());
+        let masked: Vec<_> = casters()
+            .filter(|o| o.transmittance().is_none() && o.alpha_mask.is_some())
+            .collect();
+        let translucent: Vec<_> = casters().filter(|o| o.transmittance().is_some()).collect();
+        Occluders {
+            opaque: PlacedTriangles::new(scene, opaque),
+            masked: (!masked.is_empty()).then(|| AlphaTestedCasters {
+                masks: masked.iter().filter_map(|o| o.alpha_mask).collect(),
+                triangles: PlacedTriangles::new(scene, masked),
                 textures: scene.textures.clone(),
-            });
+            }),
+            translucent: (!translucent.is_empty()).then(|| TranslucentCasters {
+                transmittance: translucent
+                    .iter()
+                    .filter_map(|o| o.transmittance())
+                    .collect(),
+                triangles: PlacedTriangles::new(scene, translucent),
+            }),
         }
-        occluders
     }
 
     /// Opaque occluders from world-space triangles.
@@ -84,39 +81,29 @@ impl Occluders {
         Occluders::with_translucent(triangles, &[])
     }
 
-    /// Opaque triangles and translucent objects (their triangles and the colour each lets
-    /// through).
+    /// Opaque world-space triangles, and translucent objects (their world-space triangles and
+    /// the colour each lets through).
     pub fn with_translucent(
         opaque: &[[Vec3; 3]],
         translucent: &[(Vec<[Vec3; 3]>, Vec3)],
     ) -> Occluders {
-        let translucent = (!translucent.is_empty()).then(|| {
-            let triangles: Vec<[Vec3; 3]> = translucent
-                .iter()
-                .flat_map(|(t, _)| t.iter().copied())
-                .collect();
-            TranslucentCasters {
-                bvh: TriangleBvh::new(&triangles),
-                owners: translucent
-                    .iter()
-                    .enumerate()
-                    .flat_map(|(k, (t, _))| std::iter::repeat_n(k, t.len()))
-                    .collect(),
-                transmittance: translucent.iter().map(|(_, t)| *t).collect(),
-            }
-        });
         Occluders {
-            opaque: TriangleBvh::new(opaque),
+            opaque: PlacedTriangles::from_triangles(opaque),
             masked: None,
-            translucent,
+            translucent: (!translucent.is_empty()).then(|| TranslucentCasters {
+                triangles: PlacedTriangles::from_parts(
+                    translucent.iter().map(|(t, _)| t.as_slice()),
+                ),
+                transmittance: translucent.iter().map(|(_, t)| *t).collect(),
+            }),
         }
     }
 
-    /// Number of triangles (opaque, masked and translucent).
+    /// Number of triangles (opaque, masked and translucent; an instance's each time).
     pub fn len(&self) -> usize {
         self.opaque.len()
-            + self.masked.as_ref().map_or(0, |m| m.bvh.len())
-            + self.translucent.as_ref().map_or(0, |t| t.bvh.len())
+            + self.masked.as_ref().map_or(0, |m| m.triangles.len())
+            + self.translucent.as_ref().map_or(0, |t| t.triangles.len())
     }
 
     /// Whether there are no occluders.
@@ -140,9 +127,9 @@ impl Occluders {
 
     /// Whether an opaque caster, or a masked one where its mask covers, is on `query`.
     fn blocked(&self, query: &Query, origin: Vec3, direction: Vec3) -> bool {
-        self.opaque.any_hit(query)
+        self.opaque.any_hit_where(query, |_, _| true)
             || self.masked.as_ref().is_some_and(|m| {
-                (m.bvh).any_hit_where(query, |i, t| m.blocks(i, origin, direction, t))
+                (m.triangles).any_hit_where(query, |i, t| m.blocks(i, origin, direction, t))
             })
     }
 
@@ -159,9 +146,9 @@ impl Occluders {
             return Vec3::ONE;
         };
         let mut crossed = vec![false; translucent.transmittance.len()];
-        translucent
-            .bvh
-            .each_hit(&query, |source| crossed[translucent.owners[source]] = true);
+        (translucent.triangles).each_hit(&query, |index| {
+            crossed[translucent.triangles.part(index)] = true
+        });
         crossed
             .iter()
             .zip(&translucent.transmittance)

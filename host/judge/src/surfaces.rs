@@ -4,7 +4,8 @@
 use glam::{Vec2, Vec3};
 use zoo_scene::Scene;
 
-use crate::bvh::{Query, TriangleBvh};
+use crate::bvh::Query;
+use crate::placed::{DrawnTriangle, PlacedTriangles};
 use crate::robust::{gamma, magnitude, offset_along, plane_test_error};
 
 /// How far (relative to the view distance) the surface the judge finds along a pixel's ray
@@ -61,32 +62,41 @@ pub struct SurfaceHit {
 }
 
 /// Every triangle of a scene (shadow casters or not), to find the exact surface seen through
-/// a pixel or by a ray.
+/// a pixel or by a ray. Triangles are numbered by their drawn index, one part per object (see
+/// [`PlacedTriangles`]).
 pub struct Surfaces {
-    bvh: TriangleBvh,
-    triangles: Vec<[Vec3; 3]>,
+    triangles: PlacedTriangles,
 }
 
 impl Surfaces {
-    /// Every object of `scene`.
+    /// Every object of `scene` (instances sharing their triangles).
     pub fn new(scene: &Scene) -> Surfaces {
-        let triangles = (scene.objects.iter())
-            .flat_map(|object| scene.object_triangles(object))
-            .collect();
-        Surfaces::from_triangles(triangles)
+        Surfaces {
+            triangles: PlacedTriangles::new(scene, &scene.objects),
+        }
     }
 
     /// Surfaces from world-space triangles.
     pub fn from_triangles(triangles: Vec<[Vec3; 3]>) -> Surfaces {
+        Surfaces::from_parts(&[triangles])
+    }
+
+    /// Surfaces from world-space triangles in parts (each triangle's part is its index in
+    /// `parts`).
+    pub(crate) fn from_parts(parts: &[Vec<[Vec3; 3]>]) -> Surfaces {
         Surfaces {
-            bvh: TriangleBvh::new(&triangles),
-            triangles,
+            triangles: PlacedTriangles::from_parts(parts.iter().map(Vec::as_slice)),
         }
     }
 
-    /// The corners of triangle `index`.
-    pub fn corners(&self, index: usize) -> &[Vec3; 3] {
-        &self.triangles[index]
+    /// The world-space corners of triangle `index`.
+    pub fn corners(&self, index: usize) -> [Vec3; 3] {
+        self.triangles.triangle(index).corners
+    }
+
+    /// Triangle `index`: its part, world corners and texture coordinates.
+    pub(crate) fn triangle(&self, index: usize) -> DrawnTriangle {
+        self.triangles.triangle(index)
     }
 
     /// The nearest surface from `origin` along unit `direction`.
@@ -102,8 +112,8 @@ impl Surfaces {
         accept: impl FnMut(usize, f32) -> bool,
     ) -> Option<SurfaceHit> {
         let query = Query::new(origin, direction, f32::INFINITY)?;
-        let (triangle, distance) = self.bvh.closest_where(&query, accept)?;
-        let corners = &self.triangles[triangle];
+        let (triangle, distance) = self.triangles.closest_where(&query, accept)?;
+        let corners = &self.corners(triangle);
         let (position, error) = barycentric_point(corners, origin, direction);
         let mut normal = (corners[1] - corners[0])
             .cross(corners[2] - corners[0])

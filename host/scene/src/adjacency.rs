@@ -80,13 +80,18 @@ pub struct Adjacency {
 
 impl Adjacency {
     /// Builds adjacency for `mesh`, one object per range of `object_index_ranges` (ranges into
-    /// `mesh.indices`). Vertices are welded only within an object.
+    /// `mesh.indices`). Vertices are welded only within an object. Objects with the same range
+    /// (instances sharing their triangles) share one edge range.
     pub fn build(mesh: &MeshData, object_index_ranges: &[Range<usize>]) -> Adjacency {
         let mut out = Adjacency::default();
+        let mut built = std::collections::HashMap::new();
         for range in object_index_ranges {
-            let start = out.edges.len() as u32;
-            build_object(mesh, range.clone(), &mut out);
-            out.object_edges.push(start..out.edges.len() as u32);
+            let edges = built.entry(range.clone()).or_insert_with(|| {
+                let start = out.edges.len() as u32;
+                build_object(mesh, range.clone(), &mut out);
+                start..out.edges.len() as u32
+            });
+            out.object_edges.push(edges.clone());
         }
         out
     }

@@ -136,6 +136,11 @@ pub struct ObjectDesc {
     /// Placement.
     #[serde(default)]
     pub transform: TransformDesc,
+    /// Instances: the mesh drawn once per transform (each applied after `transform`), its
+    /// triangles stored once for the renderer and the judge. Empty (the default): the object
+    /// once, at `transform`. Instances cannot mirror (every determinant must be positive).
+    #[serde(default)]
+    pub instances: Vec<TransformDesc>,
     /// Diffuse albedo (linear RGB).
     #[serde(default = "default_color")]
     pub color: Vec3,
@@ -323,6 +328,31 @@ pub struct LightKey {
 }
 
 impl SceneDescription {
+    /// The same scene with each instance an object of its own, its triangles copied (to
+    /// compare instancing with copies). `None` when an instanced object has a transform of its
+    /// own: a transform after another one is not always a translation, rotation and scale.
+    pub fn instances_copied(&self) -> Option<SceneDescription> {
+        let mut objects = Vec::new();
+        for object in &self.objects {
+            if object.instances.is_empty() {
+                objects.push(object.clone());
+                continue;
+            }
+            if object.transform != TransformDesc::default() {
+                return None;
+            }
+            objects.extend(object.instances.iter().map(|transform| ObjectDesc {
+                transform: *transform,
+                instances: Vec::new(),
+                ..object.clone()
+            }));
+        }
+        Some(SceneDescription {
+            objects,
+            ..self.clone()
+        })
+    }
+
     /// The same scene with every procedural mesh's segment, ring and subdivision counts scaled
     /// by `factor` (for triangle-count sweeps). Mesh files are unchanged.
     pub fn with_tessellation(&self, factor: f32) -> SceneDescription {

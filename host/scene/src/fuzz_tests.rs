@@ -105,7 +105,7 @@ fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// A scene of every light kind, every primitive, materials and paths.
+/// A scene of every light kind, every primitive, materials, instances and paths.
 const SCENE: &str = r#"(
     name: "fuzz",
     camera: (position: (0, 2, 5), target: (0, 0, 0), fov_y_degrees: 60, near: 0.05, far: 80),
@@ -122,6 +122,7 @@ const SCENE: &str = r#"(
         (mesh: Cylinder(radius: 0.2, height: 1, segments: 6), alpha_mask: Some("a.png"), alpha_cutoff: 0.3),
         (mesh: Torus(major_radius: 1, minor_radius: 0.2, segments: 8, rings: 4), specular: 0.5, shininess: 16),
         (mesh: Cone(radius: 0.3, height: 0.6, segments: 5), casts_shadows: false, color: (0.2, 0.3, 0.4)),
+        (mesh: Box(size: (0.2, 0.4, 0.2)), instances: [(translation: (2, 0, 0)), (rotation_degrees: (0, 45, 0), scale: (1, 2, 0.5))]),
     ],
     paths: (
         camera: [(time: 0, position: (0, 2, 5), target: (0, 0, 0)), (time: 1, position: (1, 2, 5), target: (0, 0, 0))],

@@ -187,9 +187,18 @@ impl Camera {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneObject {
     pub name: String,
-    /// Model matrix (vertices are already transformed to world space with it).
+    /// Model matrix: the object's transform, and for an instance its placement after it.
     pub transform: Mat4,
-    /// Index range in [`Scene::mesh`] indices.
+    /// What takes the stored vertices of [`Self::indices`] to world space: the identity for
+    /// an object drawn once (its vertices are stored in world space), the instance's transform
+    /// for an instance (the instances of one object share their triangles).
+    pub placement: Mat4,
+    /// For an instance, its number among its object's instances.
+    pub instance: Option<usize>,
+    /// Its world-space bounds (exact for instances too), `None` without triangles.
+    pub bounds: Option<(Vec3, Vec3)>,
+    /// Index range in [`Scene::mesh`] indices (the same range for every instance of an
+    /// object).
     pub indices: Range<usize>,
     pub color: Vec3,
     pub specular: f32,
@@ -211,6 +220,12 @@ pub struct SceneObject {
 }
 
 impl SceneObject {
+    /// Whether it is an instance: its triangles are shared with its object's other instances,
+    /// and [`Self::placement`] takes them to world space.
+    pub fn is_placed(&self) -> bool {
+        self.instance.is_some()
+    }
+
     /// The colour fraction of light a shadow ray keeps when it crosses this object, or `None`
     /// for an opaque caster (opacity 1) or one that casts no shadow.
     pub fn transmittance(&self) -> Option<Vec3> {
@@ -327,22 +342,17 @@ impl Scene {
                     .map(|w| format!("{}: {field}.mesh: {w}", path.display())),
             );
             let t = &object.transform;
-            for (v, name) in [
-                (t.translation, "translation"),
-                (t.rotation_degrees, "rotation_degrees"),
-                (t.scale, "scale"),
-            ] {
-                check_vec(v, &format!("{field}.transform.{name}"))
-                    .map_err(|(f, m)| invalid(f, m))?;
-            }
-            if t.scale.cmpeq(Vec3::ZERO).any() {
+            check_transform(t, &format!("{field}.transform")).map_err(|(f, m)| invalid(f, m))?;
+            check_material(object, &field).map_err(|(f, m)| invalid(f, m))?;
+            let placements =
+                instance_placements(object, &field).map_err(|(f, m)| invalid(f, &m))?;
+            let transform = t.matrix();
+            if object.receiver && !object.instances.is_empty() {
                 return Err(invalid(
-                    format!("{field}.transform.scale"),
-                    "scale components must be non-zero",
+                    format!("{field}.instances"),
+                    "receiver planes cannot be instanced",
                 ));
             }
-            check_material(object, &field).map_err(|(f, m)| invalid(f, m))?;
-            let transform = t.matrix();
             if object.receiver {
                 let MeshDesc::Plane { size, .. } = object.mesh else {
                     return Err(invalid(
@@ -367,6 +377,8 @@ impl Scene {
             let own = ObjectMaterial::of(object, base, &mut textures);
             let folder = mesh_folder(&object.mesh, base);
             let several = parts.len() > 1;
+            // Part-major order: an instanced part's objects are consecutive, so a pass draws
+            // them in one call.
             for (local, file_material) in parts {
                 let start = mesh.indices.len();
                 mesh.append(&local.transformed(transform));
@@ -376,24 +388,34 @@ impl Scene {
                     }
                     _ => own.clone(),
                 };
-                objects.push(SceneObject {
-                    name: match (several, &material.name) {
-                        (true, Some(part)) => format!("{name}/{part}"),
-                        _ => name.clone(),
-                    },
-                    transform,
-                    indices: start..mesh.indices.len(),
-                    color: material.color,
-                    specular: material.specular,
-                    shininess: material.shininess,
-                    casts_shadows: object.casts_shadows,
-                    opacity: material.opacity,
-                    transmission: object.transmission,
-                    albedo_texture: material.albedo_texture,
-                    alpha_mask: material.alpha_mask,
-                    double_sided: material.double_sided,
-                    report,
-                });
+                for (instance, &placement) in placements.iter().enumerate() {
+                    let part = match (several, &material.name) {
+                        (true, Some(part)) => format!("/{part}"),
+                        _ => String::new(),
+                    };
+                    let instance = (!object.instances.is_empty()).then_some(instance);
+                    objects.push(SceneObject {
+                        name: match instance {
+                            Some(k) => format!("{name}[{k}]{part}"),
+                            None => format!("{name}{part}"),
+                        },
+                        transform: placement * transform,
+                        placement,
+                        instance,
+                        bounds: placed_bounds(&mesh, start..mesh.indices.len(), placement),
+                        indices: start..mesh.indices.len(),
+                        color: material.color,
+                        specular: material.specular,
+                        shininess: material.shininess,
+                        casts_shadows: object.casts_shadows,
+                        opacity: material.opacity,
+                        transmission: object.transmission,
+                        albedo_texture: material.albedo_texture,
+                        alpha_mask: material.alpha_mask,
+                        double_sided: material.double_sided,
+                        report,
+                    });
+                }
             }
         }
         if textures.len() > material::MAX_TEXTURE_LAYERS {
@@ -456,7 +478,36 @@ impl Scene {
 
     /// World-space bounds of all geometry.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        mesh::bounds(&self.mesh.positions).unwrap_or((Vec3::ZERO, Vec3::ZERO))
+        (self.each_object_bounds().into_iter().flatten())
+            .reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
+            .unwrap_or((Vec3::ZERO, Vec3::ZERO))
+    }
+
+    /// World-space bounds of each object, in object order (none for an object without
+    /// triangles).
+    pub fn each_object_bounds(&self) -> Vec<Option<(Vec3, Vec3)>> {
+        self.objects.iter().map(|o| o.bounds).collect()
+    }
+
+    /// Triangles drawn: each object's, instances counted (at least [`Self::triangle_count`],
+    /// the triangles stored).
+    pub fn drawn_triangle_count(&self) -> usize {
+        self.objects.iter().map(|o| o.indices.len() / 3).sum()
+    }
+
+    /// "N triangles", or with instances "N triangles drawn, M stored".
+    pub fn triangle_summary(&self) -> String {
+        let (drawn, stored) = (self.drawn_triangle_count(), self.triangle_count());
+        if drawn == stored {
+            format!("{stored} triangles")
+        } else {
+            format!("{drawn} triangles drawn, {stored} stored")
+        }
+    }
+
+    /// Whether any object is placed by an instance transform ([`SceneObject::is_placed`]).
+    pub fn has_placed_objects(&self) -> bool {
+        self.objects.iter().any(SceneObject::is_placed)
     }
 
     /// The same scene uniformly scaled by `factor` about the world origin: geometry,
@@ -472,8 +523,14 @@ impl Scene {
         for p in &mut out.mesh.positions {
             *p *= factor;
         }
+        // Stored vertices scale about the origin, so a placement p becomes s p s⁻¹.
+        let unscale = Mat4::from_scale(Vec3::splat(1.0 / factor));
         for object in &mut out.objects {
             object.transform = scale * object.transform;
+            if object.is_placed() {
+                object.placement = scale * object.placement * unscale;
+            }
+            object.bounds = object.bounds.map(|(lo, hi)| (lo * factor, hi * factor));
         }
         for light in &mut out.lights {
             light.position *= factor;
@@ -514,19 +571,22 @@ impl Scene {
             .map(|t| [t[0], t[1], t[2]].map(|i| i as usize))
     }
 
-    /// The world-space corners of each of `object`'s triangles.
-    pub fn object_triangles(&self, object: &SceneObject) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+    /// The stored corners of each of `object`'s triangles (world space unless the object
+    /// [`SceneObject::is_placed`]).
+    pub fn stored_triangles(&self, object: &SceneObject) -> impl Iterator<Item = [Vec3; 3]> + '_ {
         self.triangle_indices(object)
             .map(|t| t.map(|i| self.mesh.positions[i]))
     }
 
-    /// Which object each triangle belongs to.
-    pub fn triangle_objects(&self) -> Vec<u32> {
-        let mut out = vec![0; self.triangle_count()];
-        for (i, o) in self.objects.iter().enumerate() {
-            out[o.indices.start / 3..o.indices.end / 3].fill(i as u32);
-        }
-        out
+    /// The world-space corners of each of `object`'s triangles (computed, for an instance,
+    /// from the triangles it shares).
+    pub fn object_triangles(&self, object: &SceneObject) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+        let placement = object.placement;
+        let placed = object.is_placed();
+        self.stored_triangles(object).map(move |t| match placed {
+            true => t.map(|p| placement.transform_point3(p)),
+            false => t,
+        })
     }
 }
 
@@ -549,7 +609,67 @@ pub fn read_description(path: &Path) -> Result<SceneDescription, SceneError> {
     parse_description(&text, path)
 }
 
+/// Bounds of the vertices of `indices` placed by `placement`.
+fn placed_bounds(mesh: &MeshData, indices: Range<usize>, placement: Mat4) -> Option<(Vec3, Vec3)> {
+    let points: Vec<Vec3> = (mesh.indices[indices].iter())
+        .map(|&i| placement.transform_point3(mesh.positions[i as usize]))
+        .collect();
+    mesh::bounds(&points)
+}
+
 type FieldError = (String, &'static str);
+
+/// Most instances one object may have.
+pub const MAX_INSTANCES: usize = 65536;
+
+fn check_transform(t: &TransformDesc, field: &str) -> Result<(), FieldError> {
+    for (v, name) in [
+        (t.translation, "translation"),
+        (t.rotation_degrees, "rotation_degrees"),
+        (t.scale, "scale"),
+    ] {
+        check_vec(v, &format!("{field}.{name}"))?;
+    }
+    if t.scale.cmpeq(Vec3::ZERO).any() {
+        return Err((
+            format!("{field}.scale"),
+            "scale components must be non-zero",
+        ));
+    }
+    Ok(())
+}
+
+/// Where `object`'s copies go after its transform: the identity alone for an object drawn
+/// once, else each instance's matrix.
+fn instance_placements(object: &ObjectDesc, field: &str) -> Result<Vec<Mat4>, (String, String)> {
+    if object.instances.is_empty() {
+        return Ok(vec![Mat4::IDENTITY]);
+    }
+    if object.instances.len() > MAX_INSTANCES {
+        return Err((
+            format!("{field}.instances"),
+            format!(
+                "{} instances given, at most {MAX_INSTANCES} are supported",
+                object.instances.len()
+            ),
+        ));
+    }
+    (object.instances.iter().enumerate())
+        .map(|(k, t)| {
+            let field = format!("{field}.instances[{k}]");
+            check_transform(t, &field).map_err(|(f, m)| (f, m.to_string()))?;
+            // Shared triangles keep one winding: an instance cannot turn it over.
+            if t.scale.x * t.scale.y * t.scale.z < 0.0 {
+                return Err((
+                    format!("{field}.scale"),
+                    "an instance cannot mirror (an odd number of negative scale components)"
+                        .to_string(),
+                ));
+            }
+            Ok(t.matrix())
+        })
+        .collect()
+}
 
 fn check_vec(v: Vec3, field: &str) -> Result<(), FieldError> {
     if v.is_finite() {

@@ -523,3 +523,133 @@ fn gltf_objects_take_their_materials_textures_and_sides() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+const INSTANCED: &str = r#"(
+    camera: (position: (0, 4, 9), target: (0, 0, 0)),
+    lights: [Directional(direction: (0.3, -1, 0.2))],
+    objects: [
+        (name: "floor", mesh: Plane(size: 20)),
+        (name: "post", mesh: Box(size: (0.5, 2, 0.5)), transform: (translation: (0, 1, 0)),
+         instances: [
+            (translation: (-3, 0, 0)),
+            (translation: (4, 0, 1), rotation_degrees: (0, 30, 0), scale: (1, 0.5, 2)),
+            (scale: (2, 2, 2)),
+         ]),
+    ],
+)"#;
+
+#[test]
+fn instances_share_their_triangles_and_place_them() {
+    let scene = parse(INSTANCED).unwrap();
+    assert_eq!(scene.objects.len(), 4);
+    // The box is stored once (12 triangles) and drawn three times.
+    assert_eq!(scene.triangle_count(), 2 + 12);
+    assert_eq!(scene.drawn_triangle_count(), 2 + 3 * 12);
+    assert_eq!(scene.triangle_summary(), "38 triangles drawn, 14 stored");
+    let posts = &scene.objects[1..];
+    assert!(
+        posts
+            .iter()
+            .all(|o| o.indices == posts[0].indices && o.is_placed())
+    );
+    assert!(!scene.objects[0].is_placed());
+    let names: Vec<&str> = posts.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["post[0]", "post[1]", "post[2]"]);
+    // Stored with the object's transform; each instance places that after it.
+    let (lo, hi) = crate::mesh::bounds(
+        &scene
+            .stored_triangles(&posts[0])
+            .flatten()
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    assert!(lo.abs_diff_eq(Vec3::new(-0.25, 0.0, -0.25), 1e-6), "{lo}");
+    assert!(hi.abs_diff_eq(Vec3::new(0.25, 2.0, 0.25), 1e-6), "{hi}");
+    let world = |o: &SceneObject| {
+        crate::mesh::bounds(&scene.object_triangles(o).flatten().collect::<Vec<_>>()).unwrap()
+    };
+    let (lo, hi) = world(&posts[0]);
+    assert!(
+        lo.abs_diff_eq(Vec3::new(-3.25, 0.0, -0.25), 1e-6)
+            && hi.abs_diff_eq(Vec3::new(-2.75, 2.0, 0.25), 1e-6)
+    );
+    let (lo, hi) = world(&posts[2]);
+    assert!(
+        lo.abs_diff_eq(Vec3::new(-0.5, 0.0, -0.5), 1e-6)
+            && hi.abs_diff_eq(Vec3::new(0.5, 4.0, 0.5), 1e-6)
+    );
+    // The scene's bounds hold every instance (the tallest post, 4 high).
+    let (lo, hi) = scene.bounds();
+    assert!(lo.y <= 0.0 && hi.y >= 4.0 - 1e-5 && lo.x <= -10.0 && hi.x >= 10.0);
+    for (object, bounds) in scene.objects.iter().zip(scene.each_object_bounds()) {
+        let (lo, hi) = bounds.unwrap();
+        let (wlo, whi) = world(object);
+        assert!(
+            lo.cmple(wlo + 1e-5).all() && hi.cmpge(whi - 1e-5).all(),
+            "{}",
+            object.name
+        );
+    }
+    // Instances share one edge range of the adjacency.
+    let edges = &scene.adjacency.object_edges;
+    assert!(edges[1] == edges[2] && edges[2] == edges[3]);
+}
+
+#[test]
+fn scaling_places_instances_where_the_scaled_copies_would_be() {
+    let scene = parse(INSTANCED).unwrap();
+    let big = scene.scaled(250.0);
+    for (small, large) in scene.objects.iter().zip(&big.objects) {
+        for (a, b) in scene
+            .object_triangles(small)
+            .zip(big.object_triangles(large))
+        {
+            for (p, q) in a.iter().zip(&b) {
+                assert!(
+                    (*p * 250.0).abs_diff_eq(*q, 1e-3),
+                    "{}: {p} {q}",
+                    small.name
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn bad_instances_name_the_field() {
+    let mirrored = INSTANCED.replace("scale: (1, 0.5, 2)", "scale: (-1, 0.5, 2)");
+    let err = parse(&mirrored).unwrap_err().to_string();
+    assert!(err.contains("objects[1].instances[1].scale"), "{err}");
+    assert!(err.contains("mirror"), "{err}");
+    // Two negative components turn the shape half way round without mirroring it.
+    let turned = INSTANCED.replace("scale: (1, 0.5, 2)", "scale: (-1, -0.5, 2)");
+    assert!(parse(&turned).is_ok());
+    let flat = INSTANCED.replace("(scale: (2, 2, 2))", "(scale: (2, 0, 2))");
+    let err = parse(&flat).unwrap_err().to_string();
+    assert!(
+        err.contains("objects[1].instances[2].scale") && err.contains("non-zero"),
+        "{err}"
+    );
+    let infinite = INSTANCED.replace("(translation: (-3, 0, 0))", "(translation: (-3, inf, 0))");
+    let err = parse(&infinite).unwrap_err().to_string();
+    assert!(err.contains("objects[1].instances[0].translation"), "{err}");
+    let receiver = INSTANCED.replace(
+        r#"mesh: Plane(size: 20))"#,
+        r#"mesh: Plane(size: 20), receiver: true, instances: [(translation: (0, 1, 0))])"#,
+    );
+    let err = parse(&receiver).unwrap_err().to_string();
+    assert!(
+        err.contains("objects[0].instances") && err.contains("receiver"),
+        "{err}"
+    );
+    let many = format!("[{}]", vec!["()"; MAX_INSTANCES + 1].join(","));
+    let crowd = INSTANCED.replace(
+        r#"mesh: Plane(size: 20))"#,
+        &format!("mesh: Plane(size: 20), instances: {many})"),
+    );
+    let err = parse(&crowd).unwrap_err().to_string();
+    assert!(
+        err.contains("objects[0].instances") && err.contains("65536"),
+        "{err}"
+    );
+}

@@ -154,7 +154,8 @@ pub(crate) struct Casters {
 
 impl Casters {
     /// Every shadow-casting triangle of `scene` with an area (the judge's rule,
-    /// [`zoo_host::judge::has_no_area`]), in object order.
+    /// [`zoo_host::judge::has_no_area`]), in object order, in world space: an instance's
+    /// triangles are placed here, once per instance.
     pub fn of(scene: &Scene) -> Casters {
         let mut triangles = Vec::new();
         let mut transmittance = Vec::new();
@@ -163,8 +164,8 @@ impl Casters {
                 transmittance.push(t);
                 transmittance.len() as u32 - 1
             });
-            for tri in scene.triangle_indices(o) {
-                let corners = tri.map(|i| scene.mesh.positions[i]);
+            let uvs = scene.triangle_indices(o);
+            for (corners, tri) in scene.object_triangles(o).zip(uvs) {
                 if zoo_host::judge::has_no_area(&corners) {
                     continue;
                 }

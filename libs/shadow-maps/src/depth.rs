@@ -5,7 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use zoo_host::glam::Vec4;
 use zoo_host::gpu::PassRecorder;
-use zoo_host::render::Vertex;
+use zoo_host::render::SceneBuffers;
 use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
 
 use crate::atlas::MapTile;
@@ -322,7 +322,7 @@ fn depth_pipeline(
             module,
             entry_point: Some(stages.vertex),
             compilation_options: Default::default(),
-            buffers: &[Some(Vertex::LAYOUT)],
+            buffers: &SceneBuffers::VERTEX_LAYOUTS,
         },
         primitive: wgpu::PrimitiveState {
             cull_mode: state.cull_front.then_some(wgpu::Face::Front),

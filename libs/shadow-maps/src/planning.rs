@@ -229,15 +229,7 @@ pub fn object_bounds(scene: &Scene, casters_only: bool) -> Vec<Aabb> {
 
 /// World-space bounds of each scene object, in scene order (none for an empty one).
 pub fn each_object_bounds(scene: &Scene) -> Vec<Option<Aabb>> {
-    (scene.objects.iter())
-        .map(|o| {
-            let points: Vec<Vec3> = scene.mesh.indices[o.indices.clone()]
-                .iter()
-                .map(|&i| scene.mesh.positions[i as usize])
-                .collect();
-            zoo_host::scene::mesh::bounds(&points)
-        })
-        .collect()
+    scene.each_object_bounds()
 }
 
 /// The light's size for penumbra estimates: its radius (point, spot) or the tangent of its

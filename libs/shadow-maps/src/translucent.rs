@@ -9,7 +9,7 @@
 //! however many of its surfaces the ray crosses).
 
 use zoo_host::gpu::PassRecorder;
-use zoo_host::render::Vertex;
+use zoo_host::render::SceneBuffers;
 use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
 use crate::depth::{CAMERA_STRIDE, LayerCamera};
@@ -65,7 +65,7 @@ impl TranslucentPass {
                 module: &module,
                 entry_point: Some("vs_translucent"),
                 compilation_options: Default::default(),
-                buffers: &[Some(Vertex::LAYOUT)],
+                buffers: &SceneBuffers::VERTEX_LAYOUTS,
             },
             primitive: wgpu::PrimitiveState::default(),
             // Behind the opaque depth nothing can be lit through them: test, never write.

@@ -6,6 +6,10 @@
 //! sum of its faces' weights times their traversal signs, so sides shared by two emitting
 //! triangles cancel and boundary or non-manifold edges close the volume. The vertices (w = 0 at
 //! infinity) land in one buffer drawn with indirect arguments.
+//!
+//! Both passes run once per part: the triangles stored in world space, then each shadow-casting
+//! instance's shared triangles and edges under its placement, so instances share their
+//! geometry here as in every other pass.
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::gpu::PassRecorder;
@@ -20,6 +24,7 @@ zoo_host::param_choice! {
 
 const FLAG_CASTS: u32 = 1;
 const FLAG_CLOSED: u32 = 2;
+const FLAG_PLACED: u32 = 4;
 /// Invocations per workgroup of both entry points (`@workgroup_size` in the shader).
 pub const WORKGROUP_SIZE: u32 = 64;
 /// Bytes between the per-light parameter slots (a uniform dynamic-offset slot).
@@ -33,30 +38,86 @@ pub const ARGS_BYTES: u64 = 20;
 pub struct Params {
     pub light: u32,
     pub mode: u32,
-    pub triangle_count: u32,
-    pub edge_count: u32,
     pub capacity: u32,
-    pub _pad: [u32; 59],
+    pub _pad: [u32; 61],
 }
 
-/// Per-triangle flags: casts shadows, and belongs to a closed (all edges manifold) object.
+/// `Part` in `shadow-volumes/volumes.wgsl`, in a 256-byte slot: one dispatch's triangles and
+/// edges, and the placement of their stored vertices.
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+pub struct Part {
+    pub to_world: [[f32; 4]; 4],
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+    pub first_edge: u32,
+    pub edge_count: u32,
+    pub instance: u32,
+    pub _pad: [u32; 43],
+}
+
+/// The parts volumes are built from: every stored triangle and edge in world space (instances'
+/// triangles left out by their flag), then each shadow-casting instance's.
+pub fn parts(scene: &Scene) -> Vec<Part> {
+    let part = |to_world: zoo_host::glam::Mat4,
+                triangles: std::ops::Range<usize>,
+                edges: &std::ops::Range<u32>,
+                instance| Part {
+        to_world: to_world.to_cols_array_2d(),
+        first_triangle: triangles.start as u32,
+        triangle_count: triangles.len() as u32,
+        first_edge: edges.start,
+        edge_count: edges.len() as u32,
+        instance,
+        _pad: [0; 43],
+    };
+    let everything = 0..scene.adjacency.edges.len() as u32;
+    let instances = (scene.objects.iter().enumerate())
+        .filter(|(_, o)| o.is_placed() && o.casts_shadows)
+        .map(|(i, o)| {
+            let triangles = o.indices.start / 3..o.indices.end / 3;
+            part(o.placement, triangles, &scene.adjacency.object_edges[i], 1)
+        });
+    std::iter::once(part(
+        zoo_host::glam::Mat4::IDENTITY,
+        0..scene.triangle_count(),
+        &everything,
+        0,
+    ))
+    .chain(instances)
+    .collect()
+}
+
+/// Per-triangle flags: casts shadows, belongs to a closed (all edges manifold) object, and is
+/// shared by instances.
 pub fn triangle_flags(scene: &Scene) -> Vec<u32> {
     let mut flags = vec![0; scene.triangle_count()];
     for (i, object) in scene.objects.iter().enumerate() {
         let edges = &scene.adjacency.edges[scene.adjacency.object_edges[i].start as usize
             ..scene.adjacency.object_edges[i].end as usize];
         let closed = edges.iter().all(|e| e.kind() == EdgeKind::Manifold);
-        let value = u32::from(object.casts_shadows) * FLAG_CASTS + u32::from(closed) * FLAG_CLOSED;
+        let value = u32::from(object.casts_shadows) * FLAG_CASTS
+            + u32::from(closed) * FLAG_CLOSED
+            + u32::from(object.is_placed()) * FLAG_PLACED;
         flags[object.indices.start / 3..object.indices.end / 3].fill(value);
     }
     flags
 }
 
-/// Vertex capacity of the volume buffer for `scene` (caps, plus sides for the chosen mode).
+/// Vertex capacity of the volume buffer for `scene` (caps, plus sides for the chosen mode),
+/// instances counted.
 pub fn volume_capacity(scene: &Scene, volumes: Volumes) -> u64 {
-    let triangles = scene.triangle_count() as u64;
+    let adjacency = &scene.adjacency;
+    let (mut triangles, mut incidences) = (0u64, 0u64);
+    for (i, object) in scene.objects.iter().enumerate() {
+        triangles += object.indices.len() as u64 / 3;
+        let edges = &adjacency.object_edges[i];
+        incidences += (adjacency.edges[edges.start as usize..edges.end as usize].iter())
+            .map(|e| u64::from(e.face_count()))
+            .sum::<u64>();
+    }
     let sides = match volumes {
-        Volumes::Silhouette => 6 * scene.adjacency.edge_faces.len() as u64,
+        Volumes::Silhouette => 6 * incidences,
         Volumes::PerTriangle => 18 * triangles,
     };
     (6 * triangles + sides).max(3)
@@ -76,8 +137,8 @@ struct Buffers {
     volume: wgpu::Buffer,
     args: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
-    triangles: u32,
-    edges: u32,
+    /// Each part's triangle and edge counts, in slot order.
+    parts: Vec<(u32, u32)>,
 }
 
 /// The generation pipelines and, once prepared for a scene and its lights, the buffers.
@@ -98,6 +159,16 @@ impl VolumeGenerator {
             .create_module(device, "shadow-volumes/volumes.wgsl")?;
         let stage = wgpu::ShaderStages::COMPUTE;
         let storage = |binding, read_only| zoo_host::kit::storage(binding, stage, read_only);
+        let slot = |binding, size| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: stage,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(size),
+            },
+            count: None,
+        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some(&format!("{label} generation layout")),
             entries: &[
@@ -109,16 +180,8 @@ impl VolumeGenerator {
                 storage(5, false),
                 storage(6, false),
                 storage(7, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 8,
-                    visibility: stage,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(32),
-                    },
-                    count: None,
-                },
+                slot(8, 16),
+                slot(9, 96),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -199,10 +262,8 @@ impl VolumeGenerator {
             .map(|light| Params {
                 light: light as u32,
                 mode: u32::from(volumes == Volumes::PerTriangle),
-                triangle_count: flags.len() as u32,
-                edge_count: scene.adjacency.edges.len() as u32,
                 capacity,
-                _pad: [0; 59],
+                _pad: [0; 61],
             })
             .collect();
         let params = init(
@@ -210,11 +271,31 @@ impl VolumeGenerator {
             bytemuck::cast_slice(&params),
             wgpu::BufferUsages::UNIFORM,
         );
+        let parts = parts(scene);
+        let part_slots = init(
+            "parts",
+            bytemuck::cast_slice(&parts),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let b = ctx.scene_buffers;
         fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry {
                 binding,
                 resource: buffer.as_entire_binding(),
+            }
+        }
+        fn slot_entry(
+            binding: u32,
+            buffer: &wgpu::Buffer,
+            size: usize,
+        ) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size as u64),
+                }),
             }
         }
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -229,14 +310,8 @@ impl VolumeGenerator {
                 entry(5, &weights),
                 entry(6, &volume),
                 entry(7, &args),
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(32),
-                    }),
-                },
+                slot_entry(8, &params, size_of::<Params>()),
+                slot_entry(9, &part_slots, size_of::<Part>()),
             ],
         });
         self.buffers = Some(Buffers {
@@ -245,8 +320,9 @@ impl VolumeGenerator {
             volume,
             args,
             bind_group,
-            triangles: flags.len() as u32,
-            edges: scene.adjacency.edges.len() as u32,
+            parts: (parts.iter())
+                .map(|p| (p.triangle_count, p.edge_count))
+                .collect(),
         });
     }
 
@@ -267,15 +343,20 @@ impl VolumeGenerator {
         let encoder = recorder.encoder();
         encoder.clear_buffer(&b.args, 0, Some(4));
         encoder.clear_buffer(&b.args, 16, Some(4));
-        let (tri_x, tri_y) = dispatch_size(b.triangles);
-        let (edge_x, edge_y) = dispatch_size(b.edges);
         let mut pass = recorder.compute_pass(name);
         pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-        pass.set_bind_group(1, &b.bind_group, &[(light as u64 * SLOT) as u32]);
-        pass.set_pipeline(&self.triangles);
-        pass.dispatch_workgroups(tri_x, tri_y, 1);
-        pass.set_pipeline(&self.edges);
-        pass.dispatch_workgroups(edge_x, edge_y, 1);
+        // Each part's triangles weigh in before its edges read the weights (wgpu orders the
+        // dispatches' storage accesses).
+        for (k, &(triangles, edges)) in b.parts.iter().enumerate() {
+            let offsets = [light as u64 * SLOT, k as u64 * SLOT].map(|o| o as u32);
+            pass.set_bind_group(1, &b.bind_group, &offsets);
+            let (x, y) = dispatch_size(triangles);
+            pass.set_pipeline(&self.triangles);
+            pass.dispatch_workgroups(x, y, 1);
+            let (x, y) = dispatch_size(edges);
+            pass.set_pipeline(&self.edges);
+            pass.dispatch_workgroups(x, y, 1);
+        }
         Ok(())
     }
 
@@ -320,11 +401,19 @@ mod tests {
         let (size, fields) = zoo_host::mirror_fields!(Params {
             light,
             mode,
-            triangle_count,
-            edge_count,
             capacity
         });
         check_mirror(&source, "Params", size, &fields, SizeRule::AtLeast).unwrap();
+        assert_eq!(size as u64, SLOT);
+        let (size, fields) = zoo_host::mirror_fields!(Part {
+            to_world,
+            first_triangle,
+            triangle_count,
+            first_edge,
+            edge_count,
+            instance
+        });
+        check_mirror(&source, "Part", size, &fields, SizeRule::AtLeast).unwrap();
         assert_eq!(size as u64, SLOT);
         assert_eq!(
             wgsl_struct(&source, "DrawArgs").unwrap().size as u64,
@@ -341,6 +430,7 @@ mod tests {
         let constant = |name| zoo_host::gpu::layout::wgsl_integer_constant(&source, name);
         assert_eq!(constant("FLAG_CASTS"), Ok(i64::from(FLAG_CASTS)));
         assert_eq!(constant("FLAG_CLOSED"), Ok(i64::from(FLAG_CLOSED)));
+        assert_eq!(constant("FLAG_PLACED"), Ok(i64::from(FLAG_PLACED)));
         assert_eq!(
             constant("EDGE_FACE_COUNT_MASK"),
             Ok(i64::from(EdgeRecord::FACE_COUNT_MASK))

@@ -1,9 +1,10 @@
 //! Passes that render every caster triangle from one shadow-map layer with the vertices pulled
 //! from the scene's storage buffers (`shaders/hybrid-edge/casters.wgsl`): the triangle-id maps
 //! and the coverage maps. Group 1 holds the layer camera (a dynamic offset into the map set's
-//! camera buffer) and the scene's vertices, indices and triangle objects.
+//! camera buffer) and the scene's vertices and indices.
 
 use zoo_host::kit::{bind_group, bind_group_layout, storage};
+use zoo_host::render::drawn_runs;
 use zoo_host::{RenderContext, wgpu};
 use zoo_shadow_maps::{CAMERA_STRIDE, LayerCamera, TilePass};
 
@@ -26,7 +27,6 @@ pub(crate) fn caster_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGro
             },
             storage(1, vertex, true),
             storage(2, vertex, true),
-            storage(3, vertex, true),
         ],
     )
 }
@@ -51,12 +51,12 @@ pub(crate) fn caster_group(
             }),
             buffers.vertices.as_entire_binding(),
             buffers.indices.as_entire_binding(),
-            buffers.triangle_objects.as_entire_binding(),
         ],
     )
 }
 
-/// Draws every scene triangle with `pipeline` from the camera of `tile_pass`'s layer.
+/// Draws every caster triangle with `pipeline` from the camera of `tile_pass`'s layer, each
+/// object's stored index range with the object as the instance.
 pub(crate) fn draw_casters(
     ctx: &RenderContext<'_>,
     pass: &mut wgpu::RenderPass<'_>,
@@ -68,5 +68,7 @@ pub(crate) fn draw_casters(
     pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
     let offset = (tile_pass.layer as u64 * CAMERA_STRIDE) as u32;
     pass.set_bind_group(1, group, &[offset]);
-    pass.draw(0..ctx.scene_buffers.index_count, 0..1);
+    for (indices, objects) in drawn_runs(ctx.scene, |_, o| o.casts_shadows) {
+        pass.draw(indices, objects);
+    }
 }

@@ -5,7 +5,7 @@ use zoo_host::glam::{UVec2, Vec3};
 use zoo_host::kit::{self, UniformSlots};
 use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
-use zoo_host::render::Vertex;
+use zoo_host::render::SceneBuffers;
 use zoo_shadow_maps::light_space::LightFrustum;
 
 use crate::LpvParams;
@@ -280,7 +280,7 @@ impl Rsm {
                 module: &module,
                 entry_point: Some("vs_rsm"),
                 compilation_options: Default::default(),
-                buffers: &[Some(Vertex::LAYOUT)],
+                buffers: &SceneBuffers::VERTEX_LAYOUTS,
             },
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: Some(wgpu::DepthStencilState {

@@ -13,10 +13,10 @@ pub mod matrix;
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::params::TechniqueParams;
-use zoo_host::render::Vertex;
+use zoo_host::render::SceneBuffers;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::render::visibility::VISIBILITY_FORMAT;
-use zoo_host::scene::{LightKind, Scene};
+use zoo_host::scene::LightKind;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_host::{
     Changes, GpuContext, ParamUpdate, ParamValues, PassRecorder, RenderContext, ShadowTechnique,
@@ -135,7 +135,7 @@ impl Planar {
                     module,
                     entry_point: Some(vertex),
                     compilation_options: Default::default(),
-                    buffers: &[Some(Vertex::LAYOUT)],
+                    buffers: &SceneBuffers::VERTEX_LAYOUTS,
                 },
                 primitive: wgpu::PrimitiveState {
                     cull_mode: None,
@@ -286,12 +286,6 @@ impl Planar {
     }
 }
 
-fn draw_object(pass: &mut wgpu::RenderPass<'_>, scene: &Scene, object: usize) {
-    let range = &scene.objects[object].indices;
-    let object = object as u32;
-    pass.draw_indexed(range.start as u32..range.end as u32, 0, object..object + 1);
-}
-
 fn pass_name(light: usize) -> String {
     format!("Planar shadows: light {light}")
 }
@@ -354,25 +348,19 @@ impl ShadowTechnique for Planar {
             let name = pass_name(light_pass.light);
             let mut pass =
                 ctx.light_pass_with(recorder, &name, light_pass.light, &[plane_ids], stencil);
-            pass.set_vertex_buffer(0, ctx.scene_buffers.vertices.slice(..));
-            pass.set_index_buffer(
-                ctx.scene_buffers.indices.slice(..),
-                wgpu::IndexFormat::Uint32,
-            );
+            let buffers = ctx.scene_buffers;
             for plane in &light_pass.planes {
                 let receiver = &scene.receivers[plane.receiver];
                 pass.set_bind_group(2, uniforms, &[plane.offset]);
                 pass.set_stencil_reference(plane.receiver as u32 + 1);
                 pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
                 pass.set_pipeline(&gpu.mark);
-                draw_object(&mut pass, scene, receiver.object);
-                pass.set_bind_group(1, &ctx.scene_buffers.materials.bind_group, &[]);
+                buffers.draw_objects_where(&mut pass, scene, |i, _| i == receiver.object);
+                pass.set_bind_group(1, &buffers.materials.bind_group, &[]);
                 pass.set_pipeline(&gpu.shadow);
-                for (object, o) in scene.objects.iter().enumerate() {
-                    if o.casts_shadows && object != receiver.object {
-                        draw_object(&mut pass, scene, object);
-                    }
-                }
+                buffers.draw_objects_where(&mut pass, scene, |i, o| {
+                    o.casts_shadows && i != receiver.object
+                });
             }
         }
         Ok(())

@@ -66,7 +66,8 @@ pub fn run_configuration(
         description.paths.lights.retain(|path| path.light < n);
     }
     let scene = Scene::from_description(&description, &plan.scene_path, base)?;
-    let triangles = scene.triangle_count();
+    // The work: instances counted.
+    let triangles = scene.drawn_triangle_count();
     let occluders = plan
         .flicker
         .then(|| (Occluders::new(&scene), Surfaces::new(&scene)));

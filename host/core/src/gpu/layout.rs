@@ -250,10 +250,11 @@ mod tests {
         });
         check_mirror(&source, "Light", size, &fields, SizeRule::Equal).unwrap();
         let (size, fields) = crate::mirror_fields!(GpuObject {
-            model,
+            placement,
             color,
             material,
-            transmittance
+            transmittance,
+            drawn
         });
         check_mirror(&source, "Object", size, &fields, SizeRule::Equal).unwrap();
     }

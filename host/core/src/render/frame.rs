@@ -44,11 +44,15 @@ pub struct GpuLight {
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 #[repr(C)]
 pub struct GpuObject {
-    pub model: [[f32; 4]; 4],
+    /// [`crate::scene::SceneObject::placement`]: stored vertices to world space.
+    pub placement: [[f32; 4]; 4],
     pub color: [f32; 4],
     pub material: [f32; 4],
     /// Translucent casters: the colour they let through and w = 1; opaque: (0, 0, 0, 0).
     pub transmittance: [f32; 4],
+    /// Its first drawn triangle (instances counted, in object order), its first stored
+    /// triangle, its triangle count, 0.
+    pub drawn: [u32; 4],
 }
 
 /// The view and projection of the current camera at the current size.
@@ -172,11 +176,17 @@ impl FrameBindings {
             wgpu::BufferUsages::STORAGE,
         );
         let light_capacity = scene.lights.len();
+        let mut drawn = 0;
         let objects: Vec<GpuObject> = scene
             .objects
             .iter()
             .map(|o| GpuObject {
-                model: o.transform.to_cols_array_2d(),
+                placement: o.placement.to_cols_array_2d(),
+                drawn: {
+                    let (first, count) = (o.indices.start / 3, o.indices.len() / 3);
+                    drawn += count;
+                    [(drawn - count) as u32, first as u32, count as u32, 0]
+                },
                 color: o.color.extend(o.specular).to_array(),
                 material: [o.shininess, f32::from(u8::from(o.casts_shadows)), 0.0, 0.0],
                 transmittance: o

@@ -11,7 +11,7 @@ use glam::{UVec2, Vec3};
 
 use super::frame::{CameraMatrices, FrameBindings};
 use super::materials::MaterialBindings;
-use super::scene_buffers::{SceneBuffers, Vertex};
+use super::scene_buffers::SceneBuffers;
 use crate::gpu::{GpuContext, PassRecorder, ShaderError, ShaderLibrary};
 use crate::scene::Scene;
 
@@ -186,7 +186,7 @@ impl GBufferPass {
                     module: &module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
-                    buffers: &[Some(Vertex::LAYOUT)],
+                    buffers: &SceneBuffers::VERTEX_LAYOUTS,
                 },
                 primitive: wgpu::PrimitiveState {
                     cull_mode,

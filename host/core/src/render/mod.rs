@@ -15,7 +15,7 @@ pub use frame::{CameraMatrices, FrameBindings};
 pub use gbuffer::GBuffer;
 pub use materials::MaterialBindings;
 pub use renderer::{GBufferData, MAX_OUTPUT_SIDE, Overlay, RenderError, Renderer, View};
-pub use scene_buffers::{SceneBuffers, Vertex};
+pub use scene_buffers::{Placement, SceneBuffers, Vertex, drawn_runs};
 pub use visibility::{
     IndirectTarget, SlotAssignment, SlotRequest, TransmittanceTargets, VisibilityTargets,
 };

@@ -27,6 +27,25 @@ impl Vertex {
     };
 }
 
+/// Each object's placement ([`crate::scene::SceneObject::placement`], column-major), read
+/// per instance by vertex stages (locations 3 to 6, `Placement` in `common/vertices.wgsl`).
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+pub struct Placement {
+    pub columns: [[f32; 4]; 4],
+}
+
+impl Placement {
+    /// Instance-rate buffer layout: locations 3 to 6, one column each.
+    pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+        array_stride: size_of::<Placement>() as u64,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes: &wgpu::vertex_attr_array![
+            3 => Float32x4, 4 => Float32x4, 5 => Float32x4, 6 => Float32x4
+        ],
+    };
+}
+
 /// Geometry buffers, built once per scene.
 pub struct SceneBuffers {
     /// All vertices (`VERTEX | STORAGE`).
@@ -37,8 +56,8 @@ pub struct SceneBuffers {
     pub edges: wgpu::Buffer,
     /// Edge incidences `triangle << 1 | reversed` (`STORAGE`).
     pub edge_faces: wgpu::Buffer,
-    /// Object index of each triangle (`STORAGE`).
-    pub triangle_objects: wgpu::Buffer,
+    /// Each object's [`Placement`] (`VERTEX`).
+    pub placements: wgpu::Buffer,
     /// Textures and alpha tests (`common/materials.wgsl`).
     pub materials: MaterialBindings,
     pub vertex_count: u32,
@@ -47,6 +66,11 @@ pub struct SceneBuffers {
 }
 
 impl SceneBuffers {
+    /// The vertex buffers a pass that draws objects binds: [`Vertex`] at slot 0 and
+    /// [`Placement`] at slot 1.
+    pub const VERTEX_LAYOUTS: [Option<wgpu::VertexBufferLayout<'static>>; 2] =
+        [Some(Vertex::LAYOUT), Some(Placement::LAYOUT)];
+
     /// Uploads `scene`'s geometry.
     pub fn new(gpu: &GpuContext, scene: &Scene) -> SceneBuffers {
         let vertices: Vec<Vertex> = scene
@@ -65,6 +89,11 @@ impl SceneBuffers {
                     .copied()
                     .unwrap_or_default()
                     .to_array(),
+            })
+            .collect();
+        let placements: Vec<Placement> = (scene.objects.iter())
+            .map(|o| Placement {
+                columns: o.placement.to_cols_array_2d(),
             })
             .collect();
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -105,10 +134,10 @@ impl SceneBuffers {
                 bytemuck::cast_slice(&scene.adjacency.edge_faces),
                 storage,
             ),
-            triangle_objects: init(
-                "scene triangle objects",
-                bytemuck::cast_slice(&scene.triangle_objects()),
-                storage,
+            placements: init(
+                "scene placements",
+                bytemuck::cast_slice(&placements),
+                wgpu::BufferUsages::VERTEX,
             ),
             materials: MaterialBindings::new(gpu, scene),
             vertex_count: vertices.len() as u32,
@@ -131,8 +160,9 @@ impl SceneBuffers {
         });
     }
 
-    /// Draws every object (or only shadow casters) with `first_instance` = object index, so
-    /// shaders find the object's data through `@builtin(instance_index)`.
+    /// Draws every object (or only shadow casters) with instance index = object index, so
+    /// shaders find the object's data through `@builtin(instance_index)` and its placement in
+    /// vertex buffer 1.
     pub fn draw_objects(&self, pass: &mut wgpu::RenderPass<'_>, scene: &Scene, casters_only: bool) {
         self.draw_objects_where(pass, scene, |_, o| o.casts_shadows || !casters_only);
     }
@@ -145,14 +175,33 @@ impl SceneBuffers {
         keep: impl Fn(usize, &SceneObject) -> bool,
     ) {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_vertex_buffer(1, self.placements.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        for (i, object) in scene.objects.iter().enumerate() {
-            if keep(i, object) {
-                let range = object.indices.start as u32..object.indices.end as u32;
-                pass.draw_indexed(range, 0, i as u32..i as u32 + 1);
-            }
+        for (range, objects) in drawn_runs(scene, keep) {
+            pass.draw_indexed(range, 0, objects);
         }
     }
+}
+
+/// The draws of the objects `keep` accepts: index range and object (instance) range, with
+/// consecutive objects of one range (instances) in one draw.
+pub fn drawn_runs(
+    scene: &Scene,
+    keep: impl Fn(usize, &SceneObject) -> bool,
+) -> Vec<(std::ops::Range<u32>, std::ops::Range<u32>)> {
+    let mut runs: Vec<(std::ops::Range<u32>, std::ops::Range<u32>)> = Vec::new();
+    for (i, object) in scene.objects.iter().enumerate() {
+        if !keep(i, object) {
+            continue;
+        }
+        let range = object.indices.start as u32..object.indices.end as u32;
+        let i = i as u32;
+        match runs.last_mut() {
+            Some((last, objects)) if *last == range && objects.end == i => objects.end += 1,
+            _ => runs.push((range, i..i + 1)),
+        }
+    }
+    runs
 }
 
 #[cfg(test)]

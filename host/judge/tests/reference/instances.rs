@@ -1,0 +1,120 @@
+//! Instances: the judge traces rays into each instance's shared triangles through the inverse
+//! of its placement, and must find what it finds on copies of those triangles placed in world
+//! space.
+
+use std::path::Path;
+
+use glam::Vec3;
+use zoo_judge::{Occluders, Surfaces};
+use zoo_scene::Scene;
+
+/// A scene of instanced casters (rotated, non-uniformly scaled, far from the origin and small),
+/// each object's own transform the identity.
+const INSTANCED: &str = r#"(
+    camera: (position: (0, 6, 14), target: (0, 0, 0)),
+    lights: [Directional(direction: (0.3, -1, 0.2))],
+    objects: [
+        (name: "floor", mesh: Plane(size: 30)),
+        (name: "ball", mesh: Sphere(radius: 0.8, segments: 24, rings: 12),
+         instances: [
+            (translation: (-4, 1, 0)),
+            (translation: (3, 2, -2), rotation_degrees: (20, 40, 10), scale: (1.5, 0.6, 1.0)),
+            (translation: (0.5, 0.3, 4), scale: (0.02, 0.02, 0.02)),
+         ]),
+        (name: "ring", mesh: Torus(major_radius: 1.0, minor_radius: 0.25, segments: 32, rings: 12),
+         instances: [
+            (translation: (0, 1.5, 0), rotation_degrees: (70, 0, 0)),
+            (translation: (5, 0.5, 3), rotation_degrees: (0, 45, 30), scale: (2, 1, 1)),
+            (translation: (-6, 3, -5), rotation_degrees: (90, 10, 0), scale: (0.5, 0.5, 0.5)),
+         ]),
+    ],
+)"#;
+
+fn scenes() -> (Scene, Scene) {
+    let path = Path::new("instances.ron");
+    let description = zoo_scene::parse_description(INSTANCED, path).unwrap();
+    let instanced = Scene::from_description(&description, path, Path::new(".")).unwrap();
+    let copies = description.instances_copied().unwrap();
+    let copied = Scene::from_description(&copies, path, Path::new(".")).unwrap();
+    assert_eq!(instanced.objects.len(), copied.objects.len());
+    assert!(instanced.triangle_count() < copied.triangle_count());
+    assert_eq!(instanced.drawn_triangle_count(), copied.triangle_count());
+    (instanced, copied)
+}
+
+/// Small deterministic generator.
+struct Rng(u64);
+
+impl Rng {
+    fn unit(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 40) as f32) / (1u64 << 24) as f32
+    }
+    fn point(&mut self, extent: f32) -> Vec3 {
+        Vec3::new(self.unit() - 0.5, self.unit() * 0.5, self.unit() - 0.5) * 2.0 * extent
+    }
+}
+
+#[test]
+fn instances_block_and_are_seen_where_their_copies_are() {
+    let (instanced, copied) = scenes();
+    let (a, b) = (Occluders::new(&instanced), Occluders::new(&copied));
+    assert_eq!(
+        a.len(),
+        b.len(),
+        "the instances' triangles, counted once per instance"
+    );
+    let (sa, sb) = (Surfaces::new(&instanced), Surfaces::new(&copied));
+    let mut rng = Rng(17);
+    let (mut rays, mut blocked, mut differ, mut seen) = (0, 0, 0, 0);
+    for _ in 0..40_000 {
+        let origin = rng.point(8.0);
+        let target = rng.point(8.0);
+        let length = origin.distance(target);
+        if length < 1e-3 {
+            continue;
+        }
+        let direction = (target - origin) / length;
+        rays += 1;
+        let (x, y) = (
+            a.occluded(origin, direction, length),
+            b.occluded(origin, direction, length),
+        );
+        blocked += usize::from(y);
+        differ += usize::from(x != y);
+        match (sa.closest(origin, direction), sb.closest(origin, direction)) {
+            (Some(p), Some(q)) => {
+                seen += 1;
+                let scale = 1.0 + p.distance.max(q.distance);
+                assert!(
+                    (p.distance - q.distance).abs() <= 1e-5 * scale,
+                    "{p:?} {q:?}"
+                );
+                assert!(p.point.position.abs_diff_eq(q.point.position, 1e-4 * scale));
+                assert!(
+                    p.point.normal.abs_diff_eq(q.point.normal, 1e-3),
+                    "{p:?} {q:?}"
+                );
+                let (ca, cb) = (sa.corners(p.triangle), sb.corners(q.triangle));
+                for (u, v) in ca.iter().zip(&cb) {
+                    assert!(u.abs_diff_eq(*v, 1e-4 * (1.0 + v.abs().max_element())));
+                }
+            }
+            (None, None) => {}
+            (p, q) => {
+                // Only a ray grazing an edge may fall on either side.
+                differ += 1;
+                eprintln!("one hit only: {p:?} {q:?}");
+            }
+        }
+    }
+    eprintln!("{rays} rays, {blocked} blocked, {seen} hit a surface, {differ} disagree");
+    assert!(
+        blocked > rays / 25 && seen > rays / 4,
+        "the rays meet the instances"
+    );
+    assert!(differ <= rays / 10_000, "{differ} of {rays} rays disagree");
+}
