@@ -92,13 +92,17 @@ const EDGE: u32 = 3u;
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
 
-// Corner `k` of drawn triangle `id` (the maps hold drawn indices: `drawn_triangle_id`), in
+// The corners of drawn triangle `id` (the maps hold drawn indices: `drawn_triangle_id`), in
 // world space.
-fn drawn_corner(id: u32, k: u32) -> vec3<f32> {
+fn drawn_corners(id: u32) -> array<vec3<f32>, 3> {
     let triangle = drawn_triangle(id);
-    let base = scene_indices[3u * triangle.y + k] * VERTEX_FLOATS;
-    let stored = vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
-    return object_world(triangle.x, stored);
+    var corners: array<vec3<f32>, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        let base = scene_indices[3u * triangle.y + k] * VERTEX_FLOATS;
+        let stored = vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
+        corners[k] = object_world(triangle.x, stored);
+    }
+    return corners;
 }
 
 // How far towards the light a surface moves before it meets the coverage map's triangle, in
@@ -142,9 +146,10 @@ fn face_normal(pixel: vec2<i32>, s: Surface) -> vec3<f32> {
 // range (0 where the triangle reaches behind a perspective layer's eye: it may block).
 fn plane_depth(id: u32, m: MapPoint) -> f32 {
     let camera = layer_cameras[m.layer].camera;
+    let world = drawn_corners(id);
     var corners: array<vec3<f32>, 3>;
     for (var k = 0u; k < 3u; k++) {
-        let clip = camera.view_proj * vec4<f32>(drawn_corner(id, k), 1.0);
+        let clip = camera.view_proj * vec4<f32>(world[k], 1.0);
         if clip.w <= 1e-6 {
             return 0.0;
         }
@@ -244,9 +249,10 @@ fn fs_band(in: FullscreenOut) -> BandOut {
 // Whether triangle `id` crosses the ray origin + t·direction for t in (0, t_max)
 // (Möller–Trumbore).
 fn ray_hits(id: u32, origin: vec3<f32>, direction: vec3<f32>, t_max: f32) -> bool {
-    let a = drawn_corner(id, 0u);
-    let b = drawn_corner(id, 1u);
-    let c = drawn_corner(id, 2u);
+    let corners = drawn_corners(id);
+    let a = corners[0];
+    let b = corners[1];
+    let c = corners[2];
     let e1 = b - a;
     let e2 = c - a;
     let h = cross(direction, e2);

@@ -23,14 +23,16 @@ use obvhs::triangle::Triangle;
 
 use crate::robust::gamma;
 
-/// A ray query: origin, unit direction and the open distance range (0, `tmax`].
+/// A ray query: origin, direction and the open distance range (0, `tmax`]. Directions are unit
+/// in world space; in an instance's stored space they are the world direction mapped by the
+/// inverse placement, so distances are the same in both.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Query {
     pub(crate) ray: Ray,
 }
 
 impl Query {
-    /// The segment from `origin` along unit `direction` up to `tmax` (infinite for rays to
+    /// The segment from `origin` along `direction` up to `tmax` (infinite for rays to
     /// directional lights); `None` when the origin or direction is not finite or `tmax` is NaN
     /// (callers treat such a query as unoccluded).
     pub(crate) fn new(origin: Vec3, direction: Vec3, tmax: f32) -> Option<Query> {

@@ -107,8 +107,9 @@ impl Reflectors {
             texture_coordinates(&triangle.corners, &triangle.uvs, origin + direction * t)
         };
         let hit = self.surfaces.closest_where(origin, direction, |index, t| {
-            let triangle = self.surfaces.triangle(index);
-            self.materials[triangle.part].alpha_mask.is_none_or(|mask| {
+            let part = self.surfaces.part(index);
+            self.materials[part].alpha_mask.is_none_or(|mask| {
+                let triangle = self.surfaces.triangle(index);
                 self.textures.alpha(mask.layer, uv_at(&triangle, t)) >= mask.cutoff
             })
         })?;

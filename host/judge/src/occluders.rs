@@ -22,7 +22,7 @@ struct AlphaTestedCasters {
 }
 
 impl AlphaTestedCasters {
-    /// Whether the hit `t` along the ray on drawn triangle `index` lands on the mask's
+    /// Whether the hit `t` along the ray on triangle `index` lands on the mask's
     /// coverage (alpha at or above the cutoff), read where the hit point's barycentric
     /// coordinates put it in the texture.
     fn blocks(&self, index: usize, origin: Vec3, direction: Vec3, t: f32) -> bool {

@@ -7,8 +7,9 @@
 //! both spaces (the direction is mapped, not renormalised), so hits from every part compare
 //! directly.
 //!
-//! Triangles are numbered in one sequence, the *drawn* index: the world-space parts' triangles
-//! first, in part order, then each instance's.
+//! Triangles are numbered in one sequence, the judge's triangle index: the world-space parts'
+//! triangles first, in part order, then each instance's (not the GPU's drawn order, which
+//! follows the objects).
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -23,6 +24,7 @@ use obvhs::bvh2::builder::build_bvh2;
 use zoo_scene::{Scene, SceneObject};
 
 use crate::bvh::{Query, TriangleBvh, Visit, traverse_nodes};
+use crate::robust::gamma;
 
 thread_local! {
     /// Each thread's stack for the top hierarchy (the meshes' traversals use their own).
@@ -53,7 +55,7 @@ struct Mesh {
     stored: Stored,
 }
 
-/// One instance: which mesh, where it goes, and its first drawn index.
+/// One instance: which mesh, where it goes, and its first triangle index.
 struct Instance {
     mesh: usize,
     to_world: Mat4,
@@ -61,7 +63,7 @@ struct Instance {
     first: usize,
 }
 
-/// Where a part's triangles are in the drawn sequence.
+/// Where a part's triangles are in the sequence of triangle indices.
 #[derive(Clone, Copy)]
 struct Part {
     first: usize,
@@ -83,11 +85,12 @@ pub(crate) struct PlacedTriangles {
     world_stored: Stored,
     meshes: Vec<Mesh>,
     instances: Vec<Instance>,
-    /// Over the instances' world boxes (empty without instances).
+    /// Over the world boxes of the instances `traced` lists (empty without instances).
     top: Bvh2,
+    traced: Vec<usize>,
     parts: Vec<Part>,
-    /// (first drawn index, part), sorted.
-    by_drawn: Vec<(usize, usize)>,
+    /// (first triangle index, part), sorted.
+    by_index: Vec<(usize, usize)>,
 }
 
 impl PlacedTriangles {
@@ -114,7 +117,7 @@ impl PlacedTriangles {
                 parts[part].len = world_stored.corners.len() - first;
             }
         }
-        let mut drawn = world_stored.corners.len();
+        let mut next = world_stored.corners.len();
         let mut meshes: Vec<Mesh> = Vec::new();
         let mut mesh_of: HashMap<Range<usize>, usize> = HashMap::new();
         let mut instances = Vec::new();
@@ -133,7 +136,7 @@ impl PlacedTriangles {
             });
             let len = meshes[mesh].stored.corners.len();
             parts[part] = Part {
-                first: drawn,
+                first: next,
                 len,
                 instance: Some(instances.len()),
             };
@@ -141,9 +144,9 @@ impl PlacedTriangles {
                 mesh,
                 to_world: object.placement,
                 to_local: object.placement.inverse(),
-                first: drawn,
+                first: next,
             });
-            drawn += len;
+            next += len;
         }
         PlacedTriangles::assemble(world_stored, meshes, instances, parts)
     }
@@ -177,13 +180,13 @@ impl PlacedTriangles {
         instances: Vec<Instance>,
         parts: Vec<Part>,
     ) -> Self {
-        let boxes: Vec<Aabb> = (instances.iter())
-            .map(|i| match meshes[i.mesh].bvh.bounds() {
-                Some((lo, hi)) => placed_box(i.to_world, lo, hi),
-                // An empty box no ray enters.
-                None => Aabb::INVALID,
+        // Instances of meshes without a triangle (all degenerate) are left out of the top.
+        let (traced, boxes): (Vec<usize>, Vec<Aabb>) = (instances.iter().enumerate())
+            .filter_map(|(k, i)| {
+                let (lo, hi) = meshes[i.mesh].bvh.bounds()?;
+                Some((k, placed_box(i.to_world, lo, hi)))
             })
-            .collect();
+            .unzip();
         let top = if boxes.is_empty() {
             Bvh2::default()
         } else {
@@ -193,20 +196,21 @@ impl PlacedTriangles {
                 &mut Duration::default(),
             )
         };
-        let mut by_drawn: Vec<(usize, usize)> = parts
+        let mut by_index: Vec<(usize, usize)> = parts
             .iter()
             .enumerate()
             .map(|(p, part)| (part.first, p))
             .collect();
-        by_drawn.sort_unstable();
+        by_index.sort_unstable();
         PlacedTriangles {
             world: TriangleBvh::new(&world_stored.corners),
             world_stored,
             meshes,
             instances,
             top,
+            traced,
             parts,
-            by_drawn,
+            by_index,
         }
     }
 
@@ -218,18 +222,18 @@ impl PlacedTriangles {
                 .sum::<usize>()
     }
 
-    /// The part that holds drawn triangle `index`.
+    /// The part that holds triangle `index`.
     pub(crate) fn part(&self, index: usize) -> usize {
         // The part that starts last at or before `index` and holds it (parts without
         // triangles start where the next one does).
-        let at = self.by_drawn.partition_point(|(first, _)| *first <= index);
-        (self.by_drawn[..at].iter().rev())
+        let at = self.by_index.partition_point(|(first, _)| *first <= index);
+        (self.by_index[..at].iter().rev())
             .find(|(first, part)| index < first + self.parts[*part].len)
-            .expect("a drawn index within the parts")
+            .expect("a triangle index within the parts")
             .1
     }
 
-    /// The drawn triangle `index`: its part, world corners and texture coordinates.
+    /// Triangle `index`: its part, world corners and texture coordinates.
     pub(crate) fn triangle(&self, index: usize) -> DrawnTriangle {
         let part = self.part(index);
         let (stored, local, to_world) = match self.parts[part].instance {
@@ -256,13 +260,14 @@ impl PlacedTriangles {
         query: &Query,
         mut visit: impl FnMut(&Instance, &Query) -> Option<f32>,
     ) {
-        if self.instances.is_empty() {
+        if self.traced.is_empty() {
             return;
         }
         TOP_STACK.with_borrow_mut(|stack| {
             traverse_nodes(&self.top, query.ray, stack, |range, ray| {
                 for p in range {
-                    let instance = &self.instances[self.top.primitive_indices[p] as usize];
+                    let traced = self.traced[self.top.primitive_indices[p] as usize];
+                    let instance = &self.instances[traced];
                     let origin = instance.to_local.transform_point3(Vec3::from(ray.origin));
                     let direction = instance
                         .to_local
@@ -280,7 +285,7 @@ impl PlacedTriangles {
         });
     }
 
-    /// The nearest hit that `accept(drawn index, distance)` takes.
+    /// The nearest hit that `accept(triangle index, distance)` takes.
     pub(crate) fn closest_where(
         &self,
         query: &Query,
@@ -302,7 +307,7 @@ impl PlacedTriangles {
         best
     }
 
-    /// Whether `query` hits a triangle that `blocks(drawn index, distance)` accepts.
+    /// Whether `query` hits a triangle that `blocks(triangle index, distance)` accepts.
     pub(crate) fn any_hit_where(
         &self,
         query: &Query,
@@ -321,7 +326,7 @@ impl PlacedTriangles {
         hit
     }
 
-    /// Calls `hit` with the drawn index of every triangle `query` crosses.
+    /// Calls `hit` with the triangle index of every triangle `query` crosses.
     pub(crate) fn each_hit(&self, query: &Query, mut hit: impl FnMut(usize)) {
         self.world.each_hit(query, &mut hit);
         self.each_instance(query, |instance, local| {
@@ -345,7 +350,7 @@ impl PlacedTriangles {
         Query::new(origin, direction, query.ray.tmax)
     }
 
-    /// The nearest hit: its drawn index and distance.
+    /// The nearest hit: its triangle index and distance.
     pub(crate) fn closest(&self, query: &Query) -> Option<(usize, f32)> {
         self.closest_where(query, |_, _| true)
     }
@@ -383,7 +388,7 @@ fn placed_box(to_world: Mat4, lo: Vec3, hi: Vec3) -> Aabb {
         |(a, b), c| (a.min(c), b.max(c)),
     );
     // The placement's rounding, at the box's magnitude: the slab test stays conservative.
-    let pad = Vec3::splat(crate::robust::gamma(8) * min.abs().max(max.abs()).max_element());
+    let pad = Vec3::splat(gamma(8) * min.abs().max(max.abs()).max_element());
     Aabb::new(Vec3A::from(min - pad), Vec3A::from(max + pad))
 }
 
@@ -435,7 +440,7 @@ mod tests {
             assert_eq!(placed.any_hit_brute_force(&query), found.is_some());
             if let Some((index, _)) = found {
                 hits += 1;
-                // The part of the hit holds the drawn index.
+                // The part of the hit holds the triangle index.
                 let part = &placed.parts[placed.part(index)];
                 assert!((part.first..part.first + part.len).contains(&index));
             }

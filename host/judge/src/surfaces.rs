@@ -62,7 +62,7 @@ pub struct SurfaceHit {
 }
 
 /// Every triangle of a scene (shadow casters or not), to find the exact surface seen through
-/// a pixel or by a ray. Triangles are numbered by their drawn index, one part per object (see
+/// a pixel or by a ray. Triangles are numbered by the judge's triangle index, one part per object (see
 /// [`PlacedTriangles`]).
 pub struct Surfaces {
     triangles: PlacedTriangles,
@@ -94,6 +94,11 @@ impl Surfaces {
         self.triangles.triangle(index).corners
     }
 
+    /// The part (object) that holds triangle `index`.
+    pub(crate) fn part(&self, index: usize) -> usize {
+        self.triangles.part(index)
+    }
+
     /// Triangle `index`: its part, world corners and texture coordinates.
     pub(crate) fn triangle(&self, index: usize) -> DrawnTriangle {
         self.triangles.triangle(index)
@@ -121,6 +126,9 @@ impl Surfaces {
         if normal.dot(direction) > 0.0 {
             normal = -normal;
         }
+        // (On an instance, the ray then enters its stored space through the placement's
+        // inverse; the offset along the world normal keeps it above the triangle there too,
+        // tested with instances stretched 400:1 30 km from the origin.)
         let offset = normal.abs().dot(error)
             + plane_test_error(corners, magnitude(corners.iter().chain([&position])));
         Some(SurfaceHit {

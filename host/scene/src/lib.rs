@@ -1,5 +1,6 @@
-//! Shadow Zoo scenes: the RON description, loaded and validated into world-space geometry,
-//! lights and a camera that every technique and the reference judge share. No GPU dependency.
+//! Shadow Zoo scenes: the RON description, loaded and validated into geometry (world space,
+//! or shared by instances and placed by their transforms), lights and a camera that every
+//! technique and the reference judge share. No GPU dependency.
 
 pub mod adjacency;
 pub mod description;
@@ -254,7 +255,8 @@ pub struct Scene {
     pub ambient: Vec3,
     pub lights: Vec<Light>,
     pub objects: Vec<SceneObject>,
-    /// All geometry in world space; objects own index ranges of it.
+    /// All geometry, stored once: in world space for objects drawn once, and in its object's
+    /// space for the triangles instances share. Objects own index ranges of it.
     pub mesh: MeshData,
     pub adjacency: Adjacency,
     pub receivers: Vec<ReceiverPlane>,
@@ -418,6 +420,26 @@ impl Scene {
                 }
             }
         }
+        if objects.len() > MAX_OBJECTS {
+            return Err(invalid(
+                "objects".into(),
+                &format!(
+                    "{} objects with instances and model parts, at most {MAX_OBJECTS} are supported",
+                    objects.len()
+                ),
+            ));
+        }
+        // Triangles drawn are numbered in 32 bits on the GPU, the largest number meaning none.
+        let drawn: usize = objects.iter().map(|o| o.indices.len() / 3).sum();
+        if drawn >= u32::MAX as usize {
+            return Err(invalid(
+                "objects".into(),
+                &format!(
+                    "{drawn} triangles drawn (instances counted), at most {} are supported",
+                    u32::MAX - 1
+                ),
+            ));
+        }
         if textures.len() > material::MAX_TEXTURE_LAYERS {
             return Err(invalid(
                 "objects".into(),
@@ -459,7 +481,8 @@ impl Scene {
         })
     }
 
-    /// Total triangle count.
+    /// Triangles stored (instances' shared triangles once: [`Self::drawn_triangle_count`]
+    /// counts them per instance).
     pub fn triangle_count(&self) -> usize {
         self.mesh.triangle_count()
     }
@@ -622,6 +645,10 @@ type FieldError = (String, &'static str);
 /// Most instances one object may have.
 pub const MAX_INSTANCES: usize = 65536;
 
+/// Most objects a scene may have, instances and model parts counted (each has a record on the
+/// GPU, and a caster instance a 256-byte slot for shadow volumes).
+pub const MAX_OBJECTS: usize = 1 << 18;
+
 fn check_transform(t: &TransformDesc, field: &str) -> Result<(), FieldError> {
     for (v, name) in [
         (t.translation, "translation"),
@@ -666,7 +693,15 @@ fn instance_placements(object: &ObjectDesc, field: &str) -> Result<Vec<Mat4>, (S
                         .to_string(),
                 ));
             }
-            Ok(t.matrix())
+            let matrix = t.matrix();
+            // The judge traces rays into an instance through its inverse.
+            if !matrix.inverse().is_finite() {
+                return Err((
+                    format!("{field}.scale"),
+                    "the instance's scale is too small to invert in 32-bit floats".to_string(),
+                ));
+            }
+            Ok(matrix)
         })
         .collect()
 }

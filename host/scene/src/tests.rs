@@ -630,6 +630,12 @@ fn bad_instances_name_the_field() {
         err.contains("objects[1].instances[2].scale") && err.contains("non-zero"),
         "{err}"
     );
+    let tiny = INSTANCED.replace("(scale: (2, 2, 2))", "(scale: (1e-20, 1e-20, 1e-20))");
+    let err = parse(&tiny).unwrap_err().to_string();
+    assert!(
+        err.contains("objects[1].instances[2].scale") && err.contains("invert"),
+        "{err}"
+    );
     let infinite = INSTANCED.replace("(translation: (-3, 0, 0))", "(translation: (-3, inf, 0))");
     let err = parse(&infinite).unwrap_err().to_string();
     assert!(err.contains("objects[1].instances[0].translation"), "{err}");

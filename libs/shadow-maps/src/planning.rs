@@ -222,14 +222,9 @@ pub fn object_bounds(scene: &Scene, casters_only: bool) -> Vec<Aabb> {
         .objects
         .iter()
         .map(|o| o.casts_shadows || !casters_only);
-    (each_object_bounds(scene).into_iter().zip(casters))
+    (scene.each_object_bounds().into_iter().zip(casters))
         .filter_map(|(bounds, kept)| bounds.filter(|_| kept))
         .collect()
-}
-
-/// World-space bounds of each scene object, in scene order (none for an empty one).
-pub fn each_object_bounds(scene: &Scene) -> Vec<Option<Aabb>> {
-    scene.each_object_bounds()
 }
 
 /// The light's size for penumbra estimates: its radius (point, spot) or the tangent of its

@@ -288,7 +288,7 @@ impl ShadowMapSet {
         if changes.scene || !self.fitted {
             self.objects = object_bounds(ctx.scene, false);
             self.casters = object_bounds(ctx.scene, true);
-            self.object_boxes = crate::planning::each_object_bounds(ctx.scene);
+            self.object_boxes = ctx.scene.each_object_bounds();
         }
     }
 

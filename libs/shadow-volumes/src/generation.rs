@@ -27,7 +27,8 @@ const FLAG_CLOSED: u32 = 2;
 const FLAG_PLACED: u32 = 4;
 /// Invocations per workgroup of both entry points (`@workgroup_size` in the shader).
 pub const WORKGROUP_SIZE: u32 = 64;
-/// Bytes between the per-light parameter slots (a uniform dynamic-offset slot).
+/// Bytes between the per-light parameter slots and between the per-part slots (uniform
+/// dynamic-offset slots).
 const SLOT: u64 = 256;
 /// Draw arguments followed by the silhouette counter (`DrawArgs` in the shader).
 pub const ARGS_BYTES: u64 = 20;

@@ -8,7 +8,8 @@ use super::materials::MaterialBindings;
 use crate::gpu::GpuContext;
 use crate::scene::{Scene, SceneObject};
 
-/// One vertex: world-space position, normal and texture coordinates (32 bytes).
+/// One stored vertex: position, normal and texture coordinates (32 bytes); world space unless
+/// its object is an instance ([`Placement`]).
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 #[repr(C)]
 pub struct Vertex {

@@ -118,3 +118,61 @@ fn instances_block_and_are_seen_where_their_copies_are() {
     );
     assert!(differ <= rays / 10_000, "{differ} of {rays} rays disagree");
 }
+
+/// A stretched instance far from the origin, and a tiny one: every point the judge finds on
+/// a face turned to the light is lit, although its shadow ray enters the instance's space
+/// through a placement that rounds and stretches its error.
+#[test]
+fn stretched_and_distant_instances_do_not_shadow_themselves() {
+    for (placement, eye_offset) in [
+        (
+            "(translation: (10000, 5, -7000), rotation_degrees: (10, 30, 5), scale: (4, 0.5, 1))",
+            6.0,
+        ),
+        (
+            "(translation: (120, 0.02, 80), rotation_degrees: (0, 60, 8), scale: (0.01, 0.0025, 0.005))",
+            0.05,
+        ),
+        (
+            "(translation: (30000, 2, -20000), rotation_degrees: (10, 30, 5), scale: (20, 0.05, 3))",
+            25.0,
+        ),
+        (
+            "(translation: (3000, 0.2, -2000), rotation_degrees: (3, 17, 2), scale: (0.5, 0.005, 2))",
+            3.0,
+        ),
+    ] {
+        let text = format!(
+            r#"(
+                camera: (position: (0, 10, 10), target: (0, 0, 0)),
+                lights: [Directional(direction: (0.2, -1, 0.1))],
+                objects: [(mesh: Box(size: (1, 1, 1)), instances: [{placement}])],
+            )"#
+        );
+        let scene = Scene::from_ron(&text, Path::new("far.ron"), Path::new(".")).unwrap();
+        let (occluders, surfaces) = (Occluders::new(&scene), Surfaces::new(&scene));
+        let (lo, hi) = scene.bounds();
+        let centre = (lo + hi) * 0.5;
+        let to_light = -Vec3::new(0.2, -1.0, 0.1).normalize();
+        let mut rng = Rng(3);
+        let (mut lit_faces, mut shadowed) = (0, 0);
+        for _ in 0..4000 {
+            // Eyes above the instance, looking at random points of its box.
+            let eye = centre + Vec3::new(rng.unit() - 0.5, 1.0, rng.unit() - 0.5) * eye_offset;
+            let target = lo + (hi - lo) * Vec3::new(rng.unit(), rng.unit(), rng.unit());
+            let Some(hit) = surfaces.closest(eye, (target - eye).normalize()) else {
+                continue;
+            };
+            if hit.point.geometric_normal.dot(to_light) <= 0.05 {
+                continue;
+            }
+            lit_faces += 1;
+            if occluders.occluded(hit.point.ray_origin(), to_light, f32::INFINITY) {
+                shadowed += 1;
+            }
+        }
+        eprintln!("{placement}: {shadowed} of {lit_faces} points on lit faces shadowed");
+        assert!(lit_faces > 500, "{lit_faces}");
+        assert_eq!(shadowed, 0, "{placement}");
+    }
+}
