@@ -2,10 +2,13 @@
 // (`zoo_ray_tracing`, tracer `RayQuery`): the same `rt_occluded` (any hit), `rt_closest`
 // (closest hit) and `rt_transmittance` (translucent filtering) as `ray-tracing/trace.wgsl`,
 // which a shader imports; the library swaps this module in where the device has ray queries.
-// Bind group 3. Two instances: the blocking casters (mask `RT_BLOCKING`: opaque ones decided by
-// the hardware, masked ones a non-opaque geometry whose candidate hits pass the shared alpha
-// test before they count) and the translucent ones (mask `RT_TRANSLUCENT`, a non-opaque
-// geometry per object, its geometry index the object's record).
+// Bind group 3. The casters drawn once are two instances: the blocking casters (mask
+// `RT_BLOCKING`: opaque ones decided by the hardware, masked ones a non-opaque geometry whose
+// candidate hits pass the shared alpha test before they count) and the translucent ones (mask
+// `RT_TRANSLUCENT`, a non-opaque geometry per object). A mesh instances share is one bottom
+// level, an instance of it for each of theirs. An instance's custom data is where its records
+// start: a masked triangle's is that plus its primitive index, a translucent object's that
+// plus its geometry index.
 
 enable wgpu_ray_query;
 
@@ -39,7 +42,7 @@ fn rt_query_blocking(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, flags: u32) -
     while rayQueryProceed(&query) {
         // Only the masked geometry is non-opaque, so every candidate is a masked triangle.
         let candidate = rayQueryGetCandidateIntersection(&query);
-        let tri = rt_masked[candidate.primitive_index];
+        let tri = rt_masked[candidate.instance_custom_data + candidate.primitive_index];
         let b = candidate.barycentrics;
         let at = tri.uv[0] * (1.0 - b.x - b.y) + tri.uv[1] * b.x + tri.uv[2] * b.y;
         if alpha_covers(rt_textures, rt_sampler, at, tri.mask_layer, tri.alpha_cutoff) {
@@ -77,7 +80,8 @@ fn rt_transmittance(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec3<f32> {
     rayQueryInitialize(&query, rt_scene, RayDesc(RAY_FLAG_NONE, RT_TRANSLUCENT, 0.0, tmax, origin, dir));
     // Every candidate filters the ray once per object; none is committed, so all are seen.
     while rayQueryProceed(&query) {
-        let object = rayQueryGetCandidateIntersection(&query).geometry_index;
+        let candidate = rayQueryGetCandidateIntersection(&query);
+        let object = candidate.instance_custom_data + candidate.geometry_index;
         rt_filter_cross(&crossing, object, rt_translucent[object].transmittance);
     }
     return crossing.light;

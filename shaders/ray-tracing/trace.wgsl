@@ -2,6 +2,8 @@
 // (`zoo_ray_tracing`: the judge's own build, boxes grown by the triangle test's rounding).
 // Bind group 3. Alpha-masked casters let rays through their holes; translucent ones, in a
 // hierarchy of their own, filter them (`rt_transmittance`). Closest-hit rays: `rt_closest`.
+// Instances share their mesh's hierarchy (in its stored space); rays reach it through the
+// instance's inverse placement from a hierarchy over the instances' world boxes.
 
 #import "common/alpha_test.wgsl"
 #import "ray-tracing/hit.wgsl"
@@ -38,6 +40,33 @@ struct RtTexcoords {
 @group(3) @binding(3) var rt_textures: texture_2d_array<f32>;
 @group(3) @binding(4) var rt_sampler: sampler;
 @group(3) @binding(5) var<storage, read> rt_translucent: array<RtTranslucent>;
+
+// Mirrors `GpuInstance`: an instance's inverse placement (the rows of a 3x4 matrix), the root
+// node of its mesh's hierarchy, and its translucent object (`RT_NO_OBJECT` for a blocking
+// caster).
+struct RtInstance {
+    to_local: array<vec4<f32>, 3>,
+    root: u32,
+    translucent: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// Mirrors `GpuRoots`: the first nodes of the hierarchies of translucent casters drawn once, of
+// blocking instances and of translucent instances (`RT_NO_HIERARCHY` where there are none).
+// Blocking casters drawn once start at node 0.
+struct RtRoots {
+    translucent: u32,
+    blocking_instances: u32,
+    translucent_instances: u32,
+    _pad: u32,
+}
+
+@group(3) @binding(6) var<storage, read> rt_instances: array<RtInstance>;
+@group(3) @binding(7) var<storage, read> rt_roots: RtRoots;
+
+// `zoo_ray_tracing::NO_OBJECT`: each triangle names its translucent object.
+const RT_NO_OBJECT: u32 = 0xffffffffu;
 
 // Nodes a traversal can hold pending (`zoo_ray_tracing::STACK_SIZE`, which refuses deeper
 // hierarchies).
@@ -86,15 +115,18 @@ const RT_ANY_HIT: u32 = 0u;
 const RT_FILTER: u32 = 1u;
 const RT_CLOSEST: u32 = 2u;
 
-// Walks the hierarchy from node `root` along the segment from `origin` along unit `dir` up to
-// `tmax`. `RT_ANY_HIT`: whether a triangle stops the ray. `RT_FILTER`: every triangle the ray
-// crosses filters it (`crossing`). `RT_CLOSEST`: the nearest hit (`nearest`, whose `t` starts
-// at `tmax`), the segment shortened to it as the walk goes on.
+// Walks the hierarchy from node `root` along the segment from `origin` along `dir` (unit in
+// world space; an instance's inverse placement of it in its mesh's space, which keeps the
+// distances) up to `tmax`. `RT_ANY_HIT`: whether a triangle stops the ray. `RT_FILTER`: every
+// triangle the ray crosses filters it (`crossing`) as translucent object `object`, or its own
+// with `RT_NO_OBJECT`. `RT_CLOSEST`: the nearest hit (`nearest`, whose `t` starts at `tmax`),
+// the segment shortened to it as the walk goes on.
 fn rt_walk(
     root: u32,
     origin: vec3<f32>,
     dir: vec3<f32>,
     mode: u32,
+    object: u32,
     crossing: ptr<function, RtFilter>,
     nearest: ptr<function, RtHit>,
 ) -> bool {
@@ -119,8 +151,8 @@ fn rt_walk(
                 if mode == RT_ANY_HIT {
                     return true;
                 } else if mode == RT_FILTER {
-                    let object = rt_triangles[i].translucent;
-                    rt_filter_cross(crossing, object, rt_translucent[object].transmittance);
+                    let crossed = select(object, rt_triangles[i].translucent, object == RT_NO_OBJECT);
+                    rt_filter_cross(crossing, crossed, rt_translucent[crossed].transmittance);
                 } else {
                     *nearest = RtHit(true, hit.x, hit.yz);
                 }
@@ -134,12 +166,58 @@ fn rt_walk(
     return (*nearest).found;
 }
 
+// Walks the instances under the hierarchy from node `top` (`rt_walk`'s modes): each one whose
+// world box the segment enters is walked in its mesh's space.
+fn rt_walk_instances(
+    top: u32,
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+    mode: u32,
+    crossing: ptr<function, RtFilter>,
+    nearest: ptr<function, RtHit>,
+) -> bool {
+    let huge = vec3<f32>(1e30);
+    let inv_dir = clamp(select(1.0 / dir, huge, dir == vec3<f32>(0.0)), -huge, huge);
+    var stack: array<u32, RT_STACK_SIZE>;
+    var pending = 1u;
+    stack[0] = top;
+    while pending > 0u {
+        pending -= 1u;
+        let node = rt_nodes[stack[pending]];
+        if !rt_enters(node, origin, inv_dir, (*nearest).t) {
+            continue;
+        }
+        if node.count > 0u {
+            for (var i = node.first; i < node.first + node.count; i++) {
+                let instance = rt_instances[i];
+                let m = instance.to_local;
+                let o = vec4<f32>(origin, 1.0);
+                let local_origin = vec3<f32>(dot(m[0], o), dot(m[1], o), dot(m[2], o));
+                let local_dir = vec3<f32>(dot(m[0].xyz, dir), dot(m[1].xyz, dir), dot(m[2].xyz, dir));
+                let hit = rt_walk(instance.root, local_origin, local_dir, mode, instance.translucent, crossing, nearest);
+                if hit && mode == RT_ANY_HIT {
+                    return true;
+                }
+            }
+        } else if pending + 2u <= RT_STACK_SIZE {
+            stack[pending] = node.first;
+            stack[pending + 1u] = node.first + 1u;
+            pending += 2u;
+        }
+    }
+    return (*nearest).found;
+}
+
 // Whether an opaque or masked caster lies on the segment from `origin` along unit `dir` up to
 // `tmax` (translucent casters do not block): an any-hit shadow ray.
 fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
     var crossing = rt_filter_new();
     var nearest = RtHit(false, tmax, vec2<f32>(0.0));
-    return rt_walk(0u, origin, dir, RT_ANY_HIT, &crossing, &nearest);
+    if rt_walk(0u, origin, dir, RT_ANY_HIT, RT_NO_OBJECT, &crossing, &nearest) {
+        return true;
+    }
+    let top = rt_roots.blocking_instances;
+    return top != RT_NO_HIERARCHY && rt_walk_instances(top, origin, dir, RT_ANY_HIT, &crossing, &nearest);
 }
 
 // The nearest opaque or masked caster on the segment from `origin` along unit `dir` up to
@@ -147,7 +225,11 @@ fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
 fn rt_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> RtHit {
     var crossing = rt_filter_new();
     var nearest = RtHit(false, tmax, vec2<f32>(0.0));
-    rt_walk(0u, origin, dir, RT_CLOSEST, &crossing, &nearest);
+    rt_walk(0u, origin, dir, RT_CLOSEST, RT_NO_OBJECT, &crossing, &nearest);
+    let top = rt_roots.blocking_instances;
+    if top != RT_NO_HIERARCHY {
+        rt_walk_instances(top, origin, dir, RT_CLOSEST, &crossing, &nearest);
+    }
     return nearest;
 }
 
@@ -156,9 +238,11 @@ fn rt_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> RtHit {
 fn rt_transmittance(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec3<f32> {
     var crossing = rt_filter_new();
     var nearest = RtHit(false, tmax, vec2<f32>(0.0));
-    let root = rt_translucent[0].hierarchy;
-    if root != RT_NO_HIERARCHY {
-        rt_walk(root, origin, dir, RT_FILTER, &crossing, &nearest);
+    if rt_roots.translucent != RT_NO_HIERARCHY {
+        rt_walk(rt_roots.translucent, origin, dir, RT_FILTER, RT_NO_OBJECT, &crossing, &nearest);
+    }
+    if rt_roots.translucent_instances != RT_NO_HIERARCHY {
+        rt_walk_instances(rt_roots.translucent_instances, origin, dir, RT_FILTER, &crossing, &nearest);
     }
     return crossing.light;
 }

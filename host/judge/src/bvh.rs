@@ -82,6 +82,34 @@ impl FlatBvh {
     pub fn build(triangles: &[[Vec3; 3]]) -> FlatBvh {
         TriangleBvh::new(triangles).flat()
     }
+
+    /// A hierarchy over boxes (min, max): a leaf holds stored boxes `first..first + count`,
+    /// [`Self::triangles`] giving each one's input index (for instances' boxes above their
+    /// meshes' hierarchies).
+    pub fn over_boxes(boxes: &[(Vec3, Vec3)]) -> FlatBvh {
+        if boxes.is_empty() {
+            return FlatBvh::default();
+        }
+        let aabbs: Vec<Aabb> = (boxes.iter())
+            .map(|(lo, hi)| Aabb::new((*lo).into(), (*hi).into()))
+            .collect();
+        let bvh = build_bvh2(
+            &aabbs,
+            BvhBuildParams::fast_build(),
+            &mut Duration::default(),
+        );
+        FlatBvh {
+            nodes: (bvh.nodes.iter())
+                .map(|n| FlatNode {
+                    min: n.aabb.min.into(),
+                    max: n.aabb.max.into(),
+                    first: n.first_index,
+                    count: n.prim_count,
+                })
+                .collect(),
+            triangles: bvh.primitive_indices.clone(),
+        }
+    }
 }
 
 /// What a leaf visit tells the traversal.

@@ -3,13 +3,15 @@
 //! (`ray-tracing/trace.wgsl`), so it runs on every adapter with storage buffers.
 
 use bytemuck::{Pod, Zeroable};
+use zoo_host::glam::{Mat4, Vec3};
 use zoo_host::judge::FlatBvh;
 use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
 use zoo_host::scene::Scene;
 use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
 use crate::{
-    BuildStats, CasterTriangle, Casters, GpuTranslucent, Hierarchy, Tracer, storage_buffer,
+    BuildStats, CasterInstance, CasterTriangle, Casters, GpuTranslucent, Hierarchy, NO_HIERARCHY,
+    Tracer, storage_buffer,
 };
 
 /// Nodes a traversal can hold pending (`RT_STACK_SIZE` in `ray-tracing/trace.wgsl`): a
@@ -49,28 +51,77 @@ pub struct GpuTexcoords {
     pub _pad: [f32; 2],
 }
 
-/// The shadow casters as the GPU traces them, triangles in the hierarchy's leaf order.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// `RtInstance` in `ray-tracing/trace.wgsl`: an instance's inverse placement (the rows of a
+/// 3x4 matrix), the root node of its mesh's hierarchy and its translucent object
+/// ([`NO_OBJECT`] for a blocking caster).
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuInstance {
+    pub to_local: [[f32; 4]; 3],
+    pub root: u32,
+    pub translucent: u32,
+    pub _pad: [u32; 2],
+}
+
+/// [`GpuInstance::translucent`] of a blocking caster (`RT_NO_OBJECT` in
+/// `ray-tracing/trace.wgsl`).
+pub const NO_OBJECT: u32 = u32::MAX;
+
+/// `RtRoots` in `ray-tracing/trace.wgsl`: the first nodes of the hierarchies of translucent
+/// casters drawn once, of blocking instances and of translucent instances
+/// ([`crate::NO_HIERARCHY`] where there are none). Blocking casters drawn once start at node 0.
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuRoots {
+    pub translucent: u32,
+    pub blocking_instances: u32,
+    pub translucent_instances: u32,
+    pub _pad: u32,
+}
+
+/// The shadow casters as the GPU traces them, triangles in their hierarchies' leaf order.
+/// Casters drawn once are in world space; each mesh instances share has a hierarchy of its
+/// own in its stored space, and the instances (in leaf order) are under hierarchies over their
+/// world boxes, one of blocking and one of translucent instances.
+#[derive(Debug, Clone, PartialEq)]
 pub struct CasterGeometry {
-    /// The hierarchy of opaque and masked casters from node 0, then that of translucent ones
-    /// from [`Self::translucent_root`].
+    /// The hierarchy of opaque and masked casters drawn once from node 0, then the others.
     pub nodes: Vec<GpuNode>,
     pub triangles: Vec<GpuTriangle>,
     pub texcoords: Vec<GpuTexcoords>,
-    /// The first node of the translucent casters' hierarchy, if there are any.
-    pub translucent_root: Option<u32>,
+    pub instances: Vec<GpuInstance>,
+    pub roots: GpuRoots,
     /// The translucent objects' records ([`crate::translucent_records`]).
     pub translucent: Vec<GpuTranslucent>,
+    /// The first node of every hierarchy.
+    hierarchies: Vec<u32>,
+    /// Triangles traced, an instance's each time.
+    traced: usize,
 }
 
 impl CasterGeometry {
     /// Every shadow caster of `scene` (degenerate triangles left out): opaque and masked ones
-    /// in one hierarchy, translucent ones in a second.
+    /// drawn once in one hierarchy, translucent ones in a second, one per mesh instances
+    /// share, and one over each kind of instance.
     pub fn of(scene: &Scene) -> CasterGeometry {
         let casters = Casters::of(scene);
         let (translucent, blocking): (Vec<&CasterTriangle>, Vec<&CasterTriangle>) =
             (casters.triangles.iter()).partition(|c| c.translucent.is_some());
-        let mut geometry = CasterGeometry::default();
+        let mut geometry = CasterGeometry {
+            nodes: Vec::new(),
+            triangles: Vec::new(),
+            texcoords: Vec::new(),
+            instances: Vec::new(),
+            roots: GpuRoots {
+                translucent: NO_HIERARCHY,
+                blocking_instances: NO_HIERARCHY,
+                translucent_instances: NO_HIERARCHY,
+                _pad: 0,
+            },
+            translucent: Vec::new(),
+            hierarchies: Vec::new(),
+            traced: casters.traced_count(),
+        };
         geometry.append_hierarchy(&blocking);
         if geometry.nodes.is_empty() {
             // Node 0 is where `rt_occluded` starts: without blocking casters, a leaf over a
@@ -83,24 +134,78 @@ impl CasterGeometry {
             });
             geometry.triangles.push(GpuTriangle::zeroed());
             geometry.texcoords.push(GpuTexcoords::zeroed());
+            geometry.hierarchies.push(0);
         }
-        let first_translucent = geometry.nodes.len() as u32;
-        geometry.append_hierarchy(&translucent);
         // (None where every translucent triangle is degenerate and left out.)
-        geometry.translucent_root =
-            (geometry.nodes.len() as u32 > first_translucent).then_some(first_translucent);
-        let root = geometry.translucent_root.unwrap_or(crate::NO_HIERARCHY);
-        geometry.translucent = crate::translucent_records(&casters.transmittance, root);
+        if let Some(root) = geometry.append_hierarchy(&translucent) {
+            geometry.roots.translucent = root;
+        }
+        let meshes: Vec<Option<u32>> = (casters.meshes.iter())
+            .map(|mesh| geometry.append_hierarchy(&mesh.triangles.iter().collect::<Vec<_>>()))
+            .collect();
+        for translucent in [false, true] {
+            let members: Vec<(&CasterInstance, u32)> = (casters.instances.iter())
+                .filter(|i| casters.meshes[i.mesh].translucent == translucent)
+                .filter_map(|i| Some((i, meshes[i.mesh]?)))
+                .collect();
+            if let Some(root) = geometry.append_instances(&members) {
+                match translucent {
+                    false => geometry.roots.blocking_instances = root,
+                    true => geometry.roots.translucent_instances = root,
+                }
+            }
+        }
+        geometry.translucent =
+            crate::translucent_records(&casters.transmittance, geometry.roots.translucent);
         geometry
     }
 
-    /// Appends a hierarchy over `casters` (nothing without any), its node and triangle
-    /// indices offset past what is there.
-    fn append_hierarchy(&mut self, casters: &[&CasterTriangle]) {
+    /// Appends a hierarchy over instances (each with its mesh's root node) and the instances
+    /// in its leaf order; its root, or `None` without instances.
+    fn append_instances(&mut self, members: &[(&CasterInstance, u32)]) -> Option<u32> {
+        let boxes: Vec<(Vec3, Vec3)> = (members.iter())
+            .map(|(instance, root)| {
+                let node = &self.nodes[*root as usize];
+                placed_box(instance.to_world, node.min.into(), node.max.into())
+            })
+            .collect();
+        let bvh = FlatBvh::over_boxes(&boxes);
+        if bvh.nodes.is_empty() {
+            return None;
+        }
+        let (node_base, instance_base) = (self.nodes.len() as u32, self.instances.len() as u32);
+        self.nodes.extend(bvh.nodes.iter().map(|n| GpuNode {
+            min: n.min.to_array(),
+            first: n.first
+                + if n.count > 0 {
+                    instance_base
+                } else {
+                    node_base
+                },
+            max: n.max.to_array(),
+            count: n.count,
+        }));
+        for &source in &bvh.triangles {
+            let (instance, root) = members[source as usize];
+            let rows = instance.to_world.inverse().transpose();
+            self.instances.push(GpuInstance {
+                to_local: [rows.x_axis, rows.y_axis, rows.z_axis].map(|r| r.to_array()),
+                root,
+                translucent: instance.translucent.unwrap_or(NO_OBJECT),
+                _pad: [0; 2],
+            });
+        }
+        self.hierarchies.push(node_base);
+        Some(node_base)
+    }
+
+    /// Appends a hierarchy over `casters`, its node and triangle indices offset past what is
+    /// there; its root, or `None` without any.
+    fn append_hierarchy(&mut self, casters: &[&CasterTriangle]) -> Option<u32> {
         let corners: Vec<_> = casters.iter().map(|c| c.corners).collect();
         let bvh = FlatBvh::build(&corners);
         if bvh.nodes.is_empty() {
-            return;
+            return None;
         }
         let (node_base, triangle_base) = (self.nodes.len() as u32, self.triangles.len() as u32);
         self.nodes.extend(bvh.nodes.iter().map(|n| GpuNode {
@@ -131,16 +236,14 @@ impl CasterGeometry {
                 _pad: [0.0; 2],
             });
         }
+        self.hierarchies.push(node_base);
+        Some(node_base)
     }
 
-    /// Levels of the deeper hierarchy (0 without casters): a traversal holds at most this
+    /// Levels of the deepest hierarchy (0 without casters): a traversal holds at most this
     /// many nodes plus one pending.
     pub fn depth(&self) -> u32 {
-        let roots = [Some(0), self.translucent_root].into_iter().flatten();
-        let mut pending: Vec<(u32, u32)> = roots
-            .filter(|&r| (r as usize) < self.nodes.len())
-            .map(|r| (r, 1))
-            .collect();
+        let mut pending: Vec<(u32, u32)> = self.hierarchies.iter().map(|&r| (r, 1)).collect();
         let mut deepest = 0;
         while let Some((index, level)) = pending.pop() {
             deepest = deepest.max(level);
@@ -153,11 +256,30 @@ impl CasterGeometry {
     }
 
     /// Shadow-casting triangles stored (the placeholder of a scene without blocking casters
-    /// left out).
+    /// left out; an instance's shared triangles once).
     pub fn caster_count(&self) -> usize {
         let placeholder = self.triangles.first() == Some(&GpuTriangle::zeroed());
         self.triangles.len() - usize::from(placeholder)
     }
+
+    /// Shadow-casting triangles traced, an instance's each time.
+    pub fn traced_count(&self) -> usize {
+        self.traced
+    }
+}
+
+/// The world box around a stored box's placed corners, grown by the placement's rounding.
+fn placed_box(to_world: Mat4, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
+    let corners = (0..8).map(|k: u32| {
+        let pick = |bit: u32| if k & bit == 0 { 0.0 } else { 1.0 };
+        to_world.transform_point3(lo + (hi - lo) * Vec3::new(pick(1), pick(2), pick(4)))
+    });
+    let (min, max) = corners.fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(a, b), c| (a.min(c), b.max(c)),
+    );
+    let pad = Vec3::splat(1e-6 * min.abs().max(max.abs()).max_element());
+    (min - pad, max + pad)
 }
 
 /// The layout of the compute traversal's group.
@@ -180,6 +302,8 @@ pub(crate) fn entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         ),
         sampler(4, stages, wgpu::SamplerBindingType::Filtering),
         storage(5, stages, true),
+        storage(6, stages, true),
+        storage(7, stages, true),
     ]
 }
 
@@ -217,6 +341,16 @@ pub(crate) fn upload(
         "ray tracing translucent objects",
         bytemuck::cast_slice(&geometry.translucent),
     );
+    let instances = storage_buffer(
+        device,
+        "ray tracing instances",
+        &crate::or_one_zeroed(&geometry.instances),
+    );
+    let roots = storage_buffer(
+        device,
+        "ray tracing roots",
+        bytemuck::bytes_of(&geometry.roots),
+    );
     let materials = &ctx.scene_buffers.materials;
     let bind_group = bind_group(
         device,
@@ -229,11 +363,13 @@ pub(crate) fn upload(
             wgpu::BindingResource::TextureView(&materials.textures),
             wgpu::BindingResource::Sampler(&materials.sampler),
             translucent.as_entire_binding(),
+            instances.as_entire_binding(),
+            roots.as_entire_binding(),
         ],
     );
     let stats = BuildStats {
         tracer: Tracer::Compute,
-        triangles: geometry.caster_count(),
+        triangles: geometry.traced_count(),
         hierarchy: Some(Hierarchy {
             nodes: geometry.nodes.len(),
             depth,
@@ -271,6 +407,24 @@ mod tests {
             SizeRule::Equal,
         )
         .unwrap();
+        let instance = zoo_host::mirror_fields!(GpuInstance {
+            to_local,
+            root,
+            translucent
+        });
+        check_embedded_mirror(
+            "ray-tracing/trace.wgsl",
+            "RtInstance",
+            instance,
+            SizeRule::Equal,
+        )
+        .unwrap();
+        let roots = zoo_host::mirror_fields!(GpuRoots {
+            translucent,
+            blocking_instances,
+            translucent_instances
+        });
+        check_embedded_mirror("ray-tracing/trace.wgsl", "RtRoots", roots, SizeRule::Equal).unwrap();
         let texcoords = zoo_host::mirror_fields!(GpuTexcoords { uv, _pad });
         check_embedded_mirror(
             "ray-tracing/trace.wgsl",
@@ -333,7 +487,8 @@ mod tests {
                 ])"#,
         );
         let geometry = CasterGeometry::of(&scene);
-        let root = geometry.translucent_root.expect("two translucent boxes");
+        let root = geometry.roots.translucent;
+        assert_ne!(root, NO_HIERARCHY, "two translucent boxes");
         assert_eq!(geometry.caster_count(), 36);
         assert_eq!(geometry.translucent.len(), 2);
         assert!(geometry.translucent.iter().all(|t| t.hierarchy == root));
@@ -374,8 +529,89 @@ mod tests {
         let geometry = CasterGeometry::of(&only_glass);
         assert_eq!(geometry.nodes[0].count, 1);
         assert_eq!(geometry.triangles[0], GpuTriangle::zeroed());
-        assert_eq!(geometry.translucent_root, Some(1));
+        assert_eq!(geometry.roots.translucent, 1);
         assert_eq!(geometry.caster_count(), 12);
+    }
+
+    #[test]
+    fn instances_share_their_mesh_hierarchy_under_one_over_their_boxes() {
+        let scene = zoo_host::test_support::scene_from_ron(
+            "instances.ron",
+            r#"(camera: (position: (0, 3, 6), target: (0, 0, 0)),
+                lights: [Point(position: (0, 4, 0))],
+                objects: [
+                    (mesh: Plane(size: 10)),
+                    (mesh: Box(size: (1, 1, 1)), instances: [
+                        (translation: (2, 0.5, 0)),
+                        (translation: (-2, 1, 0), rotation_degrees: (0, 30, 0), scale: (1, 2, 1)),
+                        (translation: (0, 0.5, 3), scale: (0.5, 0.5, 0.5)),
+                    ]),
+                    (mesh: Sphere(radius: 0.5, segments: 8, rings: 4), opacity: 0.5,
+                     instances: [(translation: (0, 2, 0)), (translation: (1, 2, 1))]),
+                ])"#,
+        );
+        let geometry = CasterGeometry::of(&scene);
+        let sphere = scene.objects[4].indices.len() / 3;
+        // The plane, one box and one sphere stored; three boxes and two spheres traced.
+        assert_eq!(geometry.caster_count(), 2 + 12 + sphere);
+        assert_eq!(geometry.traced_count(), 2 + 3 * 12 + 2 * sphere);
+        assert_eq!(geometry.instances.len(), 5);
+        let roots = geometry.roots;
+        assert_eq!(
+            roots.translucent, NO_HIERARCHY,
+            "no translucent caster drawn once"
+        );
+        assert!(
+            roots.blocking_instances != NO_HIERARCHY && roots.translucent_instances != NO_HIERARCHY
+        );
+        // Each hierarchy over instances reaches each of its instances once.
+        let leaves = |root: u32| {
+            let mut found = Vec::new();
+            let mut pending = vec![root];
+            while let Some(i) = pending.pop() {
+                let n = geometry.nodes[i as usize];
+                match n.count {
+                    0 => pending.extend([n.first, n.first + 1]),
+                    _ => found.extend(n.first..n.first + n.count),
+                }
+            }
+            found.sort();
+            found
+        };
+        let (blocking, glass) = (
+            leaves(roots.blocking_instances),
+            leaves(roots.translucent_instances),
+        );
+        assert_eq!(blocking.len() + glass.len(), 5);
+        assert!(blocking.iter().chain(&glass).all(|&i| (i as usize) < 5));
+        // The blocking instances share a root, and undo their placements.
+        let placements: Vec<_> = scene.objects[1..4].iter().map(|o| o.placement).collect();
+        for &i in &blocking {
+            let instance = geometry.instances[i as usize];
+            assert_eq!(instance.root, geometry.instances[blocking[0] as usize].root);
+            assert_eq!(instance.translucent, NO_OBJECT);
+            let rows = zoo_host::glam::Mat4::from_cols_array_2d(&[
+                instance.to_local[0],
+                instance.to_local[1],
+                instance.to_local[2],
+                [0.0, 0.0, 0.0, 1.0],
+            ])
+            .transpose();
+            assert!(
+                placements
+                    .iter()
+                    .any(|p| (rows * *p).abs_diff_eq(zoo_host::glam::Mat4::IDENTITY, 1e-5))
+            );
+        }
+        // Each glass instance filters as an object of its own.
+        let mut objects: Vec<u32> = glass
+            .iter()
+            .map(|&i| geometry.instances[i as usize].translucent)
+            .collect();
+        objects.sort();
+        assert_eq!(objects, [0, 1]);
+        assert_eq!(geometry.translucent.len(), 2);
+        assert!((2..STACK_SIZE).contains(&geometry.depth()));
     }
 
     #[test]
@@ -383,8 +619,9 @@ mod tests {
         let composed = zoo_host::ShaderLibrary::embedded()
             .compose("ray-tracing/trace.wgsl")
             .unwrap();
-        let size = zoo_host::gpu::layout::wgsl_integer_constant(&composed.source, "RT_STACK_SIZE");
-        assert_eq!(size, Ok(i64::from(STACK_SIZE)));
+        let constant = |name| zoo_host::gpu::layout::wgsl_integer_constant(&composed.source, name);
+        assert_eq!(constant("RT_STACK_SIZE"), Ok(i64::from(STACK_SIZE)));
+        assert_eq!(constant("RT_NO_OBJECT"), Ok(i64::from(NO_OBJECT)));
     }
 
     fn glam_vec(v: [f32; 3]) -> zoo_host::glam::Vec3 {

@@ -11,6 +11,9 @@
 //!   hardware ray queries (`ray-tracing/query.wgsl`), where the device has
 //!   `EXPERIMENTAL_RAY_QUERY`.
 //!
+//! Instances share their mesh's triangles in both: a hierarchy (or bottom level) per shared
+//! mesh, in its stored space, which rays enter through each instance's placement.
+//!
 //! Alpha-masked casters are tested at the hit with the alpha test every pass shares
 //! (`common/alpha_test.wgsl`). Translucent casters (opacity below 1) do not block
 //! (`rt_occluded`); `rt_transmittance` filters a ray by the transmittance colour of each
@@ -22,14 +25,17 @@
 //! [`GROUP`] (a [`zoo_host::kit::FullscreenLightPass`]'s first own group).
 
 use bytemuck::Pod;
-use zoo_host::glam::{Vec2, Vec3};
+use zoo_host::glam::{Mat4, Vec2, Vec3};
 use zoo_host::scene::{AlphaMask, Scene};
 use zoo_host::{RenderContext, ShaderLibrary, TechniqueError, TechniqueResult, wgpu};
 
 mod compute;
 mod query;
 
-pub use compute::{CasterGeometry, GpuNode, GpuTexcoords, GpuTriangle, STACK_SIZE};
+pub use compute::{
+    CasterGeometry, GpuInstance, GpuNode, GpuRoots, GpuTexcoords, GpuTriangle, NO_OBJECT,
+    STACK_SIZE,
+};
 pub use query::GpuMaskedTriangle;
 
 /// The bind group index both traversals declare their bindings in.
@@ -136,6 +142,7 @@ pub fn shader_source(
 
 /// One shadow-casting triangle as both traversals store it.
 pub(crate) struct CasterTriangle {
+    /// Its corners where they are stored: world space, or its shared mesh's space.
     pub corners: [Vec3; 3],
     /// Its alpha mask (never on a translucent one: translucency wins, as in the judge).
     pub mask: Option<AlphaMask>,
@@ -144,43 +151,88 @@ pub(crate) struct CasterTriangle {
     pub translucent: Option<u32>,
 }
 
-/// The scene's shadow casters as both traversals store them.
+/// A mesh that instances share, in its stored space: its casters (their translucent object
+/// unset: each instance names its own).
+pub(crate) struct SharedMesh {
+    pub triangles: Vec<CasterTriangle>,
+    /// Whether its object is a translucent caster.
+    pub translucent: bool,
+}
+
+/// One instance: its mesh, its placement and, for a translucent caster, its object's index in
+/// [`Casters::transmittance`].
+pub(crate) struct CasterInstance {
+    pub mesh: usize,
+    pub to_world: Mat4,
+    pub translucent: Option<u32>,
+}
+
+/// The scene's shadow casters as both traversals store them: the triangles of objects drawn
+/// once in world space, and each mesh instances share once, with the instances.
 pub(crate) struct Casters {
     pub triangles: Vec<CasterTriangle>,
-    /// The colour each translucent object lets through ([`zoo_host::scene::SceneObject::transmittance`]),
-    /// in object order.
+    /// The colour each translucent object (instances included) lets through
+    /// ([`zoo_host::scene::SceneObject::transmittance`]), in object order.
     pub transmittance: Vec<Vec3>,
+    pub meshes: Vec<SharedMesh>,
+    pub instances: Vec<CasterInstance>,
 }
 
 impl Casters {
     /// Every shadow-casting triangle of `scene` with an area (the judge's rule,
-    /// [`zoo_host::judge::has_no_area`]), in object order, in world space: an instance's
-    /// triangles are placed here, once per instance.
+    /// [`zoo_host::judge::has_no_area`], in the space it is stored in), in object order; an
+    /// instance's triangles once for all the instances of its object.
     pub fn of(scene: &Scene) -> Casters {
-        let mut triangles = Vec::new();
-        let mut transmittance = Vec::new();
+        let mut casters = Casters {
+            triangles: Vec::new(),
+            transmittance: Vec::new(),
+            meshes: Vec::new(),
+            instances: Vec::new(),
+        };
+        let mut shared = std::collections::HashMap::new();
         for o in scene.objects.iter().filter(|o| o.casts_shadows) {
             let translucent = o.transmittance().map(|t| {
-                transmittance.push(t);
-                transmittance.len() as u32 - 1
+                casters.transmittance.push(t);
+                casters.transmittance.len() as u32 - 1
             });
-            let uvs = scene.triangle_indices(o);
-            for (corners, tri) in scene.object_triangles(o).zip(uvs) {
-                if zoo_host::judge::has_no_area(&corners) {
-                    continue;
-                }
-                triangles.push(CasterTriangle {
-                    corners,
-                    mask: o.alpha_mask.filter(|_| translucent.is_none()),
-                    uv: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
-                    translucent,
-                });
+            let stored = |translucent: Option<u32>| {
+                let uvs = scene.triangle_indices(o);
+                (scene.stored_triangles(o).zip(uvs))
+                    .filter(|(corners, _)| !zoo_host::judge::has_no_area(corners))
+                    .map(|(corners, tri)| CasterTriangle {
+                        corners,
+                        mask: o.alpha_mask.filter(|_| o.transmittance().is_none()),
+                        uv: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
+                        translucent,
+                    })
+                    .collect::<Vec<_>>()
+            };
+            if !o.is_placed() {
+                casters.triangles.extend(stored(translucent));
+                continue;
             }
+            let mesh = *shared.entry(o.indices.clone()).or_insert_with(|| {
+                casters.meshes.push(SharedMesh {
+                    triangles: stored(None),
+                    translucent: translucent.is_some(),
+                });
+                casters.meshes.len() - 1
+            });
+            casters.instances.push(CasterInstance {
+                mesh,
+                to_world: o.placement,
+                translucent,
+            });
         }
-        Casters {
-            triangles,
-            transmittance,
-        }
+        casters
+    }
+
+    /// Triangles traced: an instance's each time.
+    pub fn traced_count(&self) -> usize {
+        let shared: usize = (self.instances.iter())
+            .map(|i| self.meshes[i.mesh].triangles.len())
+            .sum();
+        self.triangles.len() + shared
     }
 }
 

@@ -6,9 +6,9 @@
 //! instance (its own mask), a non-opaque geometry per object, whose candidates filter the ray.
 
 use bytemuck::{Pod, Zeroable};
-use zoo_host::glam::Vec3;
+use zoo_host::glam::{Mat4, Vec3};
 use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
-use zoo_host::{RenderContext, TechniqueResult, wgpu};
+use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
 use crate::{BuildStats, CasterTriangle, Casters, Tracer, or_one_zeroed, storage_buffer};
 
@@ -22,7 +22,7 @@ pub struct GpuMaskedTriangle {
     pub alpha_cutoff: f32,
 }
 
-/// A 3x4 row-major identity: the casters are in world space already.
+/// A 3x4 row-major identity: the casters drawn once are in world space already.
 const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
 
 /// The layout of the hardware traversal's group.
@@ -149,8 +149,33 @@ fn bottom_level(
     Some(blas)
 }
 
+/// The alpha tests of `triangles` (all masked), in order.
+fn masked_records(triangles: &[&CasterTriangle]) -> Vec<GpuMaskedTriangle> {
+    (triangles.iter())
+        .filter_map(|t| {
+            let mask = t.mask?;
+            Some(GpuMaskedTriangle {
+                uv: t.uv.map(|uv| uv.to_array()),
+                mask_layer: mask.layer as i32,
+                alpha_cutoff: mask.cutoff,
+            })
+        })
+        .collect()
+}
+
+/// The row-major 3x4 form of an affine `transform`.
+fn rows(transform: Mat4) -> [f32; 12] {
+    let t = transform.transpose();
+    let [a, b, c] = [t.x_axis, t.y_axis, t.z_axis].map(|r| r.to_array());
+    [a, b, c].concat().try_into().expect("twelve numbers")
+}
+
 /// Builds the acceleration structure of `ctx`'s scene (submitted to the queue) and its bind
-/// group, with its size (without the time).
+/// group, with its size (without the time). Casters drawn once are two instances (blocking,
+/// translucent) at the identity; each mesh instances share is one bottom level, placed by each
+/// of its instances. An instance's custom data is where its records start: the masked
+/// triangles' alpha tests (blocking instances) or its translucent object (translucent ones, one
+/// geometry each; the world's translucent casters, a geometry per object).
 pub(crate) fn upload(
     ctx: &RenderContext<'_>,
     layout: &wgpu::BindGroupLayout,
@@ -161,33 +186,23 @@ pub(crate) fn upload(
     };
     let opaque = of_kind(&|c| c.translucent.is_none() && c.mask.is_none());
     let masked = of_kind(&|c| c.mask.is_some());
-    let records: Vec<GpuMaskedTriangle> = masked
-        .iter()
-        .map(|t| {
-            let mask = t.mask.expect("kept for its mask");
-            GpuMaskedTriangle {
-                uv: t.uv.map(|uv| uv.to_array()),
-                mask_layer: mask.layer as i32,
-                alpha_cutoff: mask.cutoff,
-            }
-        })
-        .collect();
+    let mut records = masked_records(&masked);
     // One geometry per translucent object with triangles: its geometry index is its record's.
-    let (translucent, transmittance): (Vec<Geometry>, Vec<Vec3>) = (casters.transmittance.iter())
-        .enumerate()
-        .map(|(object, colour)| {
-            let triangles = of_kind(&|c| c.translucent == Some(object as u32));
-            (Geometry::of(&triangles, false), *colour)
-        })
-        .filter(|(geometry, _)| !geometry.corners.is_empty())
-        .unzip();
+    let (translucent, mut transmittance): (Vec<Geometry>, Vec<Vec3>) =
+        (casters.transmittance.iter().enumerate())
+            .map(|(object, colour)| {
+                let triangles = of_kind(&|c| c.translucent == Some(object as u32));
+                (Geometry::of(&triangles, false), *colour)
+            })
+            .filter(|(geometry, _)| !geometry.corners.is_empty())
+            .unzip();
 
     let device = &ctx.gpu.device;
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("ray tracing acceleration structure build"),
     });
     let blocking = [Geometry::of(&opaque, true), Geometry::of(&masked, false)];
-    let levels = [
+    let mut levels = vec![
         (
             bottom_level(
                 device,
@@ -195,6 +210,8 @@ pub(crate) fn upload(
                 &blocking,
                 &mut encoder,
             ),
+            IDENTITY,
+            0,
             BLOCKING_MASK,
         ),
         (
@@ -204,9 +221,42 @@ pub(crate) fn upload(
                 &translucent,
                 &mut encoder,
             ),
+            IDENTITY,
+            0,
             TRANSLUCENT_MASK,
         ),
     ];
+    // Each shared mesh's bottom level, and where its masked records start.
+    let meshes: Vec<(Option<wgpu::Blas>, u32)> = (casters.meshes.iter())
+        .map(|mesh| {
+            let triangles: Vec<&CasterTriangle> = mesh.triangles.iter().collect();
+            let opaque = !mesh.translucent && triangles.iter().all(|t| t.mask.is_none());
+            let first = records.len() as u32;
+            records.extend(masked_records(&triangles));
+            let geometry = [Geometry::of(&triangles, opaque)];
+            let blas = bottom_level(device, "ray tracing shared mesh", &geometry, &mut encoder);
+            (blas, first)
+        })
+        .collect();
+    for instance in &casters.instances {
+        let (blas, first) = &meshes[instance.mesh];
+        let Some(blas) = blas else { continue };
+        let (custom, mask) = match instance.translucent {
+            Some(object) => {
+                transmittance.push(casters.transmittance[object as usize]);
+                (transmittance.len() as u32 - 1, TRANSLUCENT_MASK)
+            }
+            None => (*first, BLOCKING_MASK),
+        };
+        levels.push((Some(blas.clone()), rows(instance.to_world), custom, mask));
+    }
+    if records.len().max(transmittance.len()) >= 1 << 24 {
+        return Err(TechniqueError::Other(format!(
+            "{} masked triangles and {} translucent objects: ray queries index at most 2^24",
+            records.len(),
+            transmittance.len()
+        )));
+    }
     let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
         label: Some("ray tracing scene (top level)"),
         max_instances: levels.len() as u32,
@@ -214,10 +264,9 @@ pub(crate) fn upload(
         update_mode: wgpu::AccelerationStructureUpdateMode::Build,
     });
     // A missing level (no casters of its kind) is an empty instance, which no ray hits.
-    for (index, (blas, mask)) in levels.iter().enumerate() {
-        tlas[index] = blas
-            .as_ref()
-            .map(|blas| wgpu::TlasInstance::new(blas, IDENTITY, 0, *mask));
+    for (index, (blas, transform, custom, mask)) in levels.iter().enumerate() {
+        tlas[index] =
+            (blas.as_ref()).map(|b| wgpu::TlasInstance::new(b, *transform, *custom, *mask));
     }
     encoder.build_acceleration_structures([], [&tlas]);
     ctx.gpu.queue.submit([encoder.finish()]);
@@ -247,7 +296,7 @@ pub(crate) fn upload(
     );
     let stats = BuildStats {
         tracer: Tracer::RayQuery,
-        triangles: casters.triangles.len(),
+        triangles: casters.traced_count(),
         hierarchy: None,
         milliseconds: 0.0,
     };
