@@ -5,10 +5,9 @@
 // Bind group 3. The casters drawn once are two instances: the blocking casters (mask
 // `RT_BLOCKING`: opaque ones decided by the hardware, masked ones a non-opaque geometry whose
 // candidate hits pass the shared alpha test before they count) and the translucent ones (mask
-// `RT_TRANSLUCENT`, a non-opaque geometry per object). A mesh instances share is one bottom
-// level, an instance of it for each of theirs. An instance's custom data is where its records
-// start: a masked triangle's is that plus its primitive index, a translucent object's that
-// plus its geometry index.
+// `RT_TRANSLUCENT`, a non-opaque geometry per object). A mesh instances share (unless masked)
+// is one bottom level, an instance of it for each of theirs. A translucent object's record is
+// its instance's custom data plus its geometry index.
 
 enable wgpu_ray_query;
 
@@ -17,7 +16,8 @@ enable wgpu_ray_query;
 #import "ray-tracing/translucent.wgsl"
 
 // Mirrors `GpuMaskedTriangle`: a masked caster's corners' texture coordinates and alpha test,
-// indexed by its primitive index in the masked geometry.
+// indexed by its primitive index in the masked geometry (masked instances are placed into
+// it, so no candidate's instance data is read).
 struct RtMaskedTriangle {
     uv: array<vec2<f32>, 3>,
     mask_layer: i32,
@@ -42,7 +42,7 @@ fn rt_query_blocking(origin: vec3<f32>, dir: vec3<f32>, tmax: f32, flags: u32) -
     while rayQueryProceed(&query) {
         // Only the masked geometry is non-opaque, so every candidate is a masked triangle.
         let candidate = rayQueryGetCandidateIntersection(&query);
-        let tri = rt_masked[candidate.instance_custom_data + candidate.primitive_index];
+        let tri = rt_masked[candidate.primitive_index];
         let b = candidate.barycentrics;
         let at = tri.uv[0] * (1.0 - b.x - b.y) + tri.uv[1] * b.x + tri.uv[2] * b.y;
         if alpha_covers(rt_textures, rt_sampler, at, tri.mask_layer, tri.alpha_cutoff) {
@@ -73,9 +73,7 @@ fn rt_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> RtHit {
 // any); blocking casters are `rt_occluded`'s.
 fn rt_transmittance(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec3<f32> {
     var crossing = rt_filter_new();
-    if rt_translucent[0].hierarchy == RT_NO_HIERARCHY {
-        return crossing.light;
-    }
+    // (Without translucent casters no instance has the mask, and the query finds nothing.)
     var query: ray_query;
     rayQueryInitialize(&query, rt_scene, RayDesc(RAY_FLAG_NONE, RT_TRANSLUCENT, 0.0, tmax, origin, dir));
     // Every candidate filters the ray once per object; none is committed, so all are seen.

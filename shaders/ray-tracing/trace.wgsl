@@ -17,8 +17,8 @@ struct RtNode {
     count: u32,
 }
 
-// Mirrors `GpuTriangle`: a corner, the edges from it, its translucent object (in the
-// translucent hierarchy) and its alpha test.
+// Mirrors `GpuTriangle`: a corner, the edges from it, its translucent object (for translucent
+// casters drawn once; an instance names its own) and its alpha test.
 struct RtTriangle {
     v0: vec3<f32>,
     translucent: u32,
@@ -63,7 +63,10 @@ struct RtRoots {
 }
 
 @group(3) @binding(6) var<storage, read> rt_instances: array<RtInstance>;
-@group(3) @binding(7) var<storage, read> rt_roots: RtRoots;
+@group(3) @binding(7) var<uniform> rt_roots: RtRoots;
+
+// `zoo_ray_tracing::NO_HIERARCHY`: a root of `RtRoots` without its hierarchy.
+const RT_NO_HIERARCHY: u32 = 0xffffffffu;
 
 // `zoo_ray_tracing::NO_OBJECT`: each triangle names its translucent object.
 const RT_NO_OBJECT: u32 = 0xffffffffu;

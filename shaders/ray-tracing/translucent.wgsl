@@ -2,16 +2,10 @@
 // object a ray crosses filters it once by its transmittance colour, however many of its
 // surfaces the ray passes, as the judge's reference does.
 
-// Mirrors `GpuTranslucent`: an object's transmittance colour, and the first node of the
-// portable traversal's hierarchy of translucent casters (the same in every record;
-// `RT_NO_HIERARCHY` where the scene has no translucent casters).
+// Mirrors `GpuTranslucent`: an object's transmittance colour.
 struct RtTranslucent {
     transmittance: vec3<f32>,
-    hierarchy: u32,
 }
-
-// `zoo_ray_tracing::NO_HIERARCHY`.
-const RT_NO_HIERARCHY: u32 = 0xffffffffu;
 
 // Distinct objects one ray is filtered by (`zoo_ray_tracing::MAX_CROSSED`); further ones let
 // it through unfiltered.

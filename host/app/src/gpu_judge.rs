@@ -114,7 +114,8 @@ pub fn trace_reference(renderer: &mut Renderer, samples: u32) -> anyhow::Result<
             light_reference(contributing, hard, area, samples, coloured)
         })
         .collect();
-    let casters = zoo_ray_tracing::CasterGeometry::of(renderer.scene()).caster_count();
+    // Counted as the CPU judge counts them: an instance's triangles each time.
+    let casters = zoo_ray_tracing::CasterGeometry::of(renderer.scene()).traced_count();
     Ok(SceneReference::from_traced(
         gbuffer, lights, casters, seconds,
     ))

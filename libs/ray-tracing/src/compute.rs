@@ -5,7 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use zoo_host::glam::{Mat4, Vec3};
 use zoo_host::judge::FlatBvh;
-use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
+use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture, uniform};
 use zoo_host::scene::Scene;
 use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
@@ -30,8 +30,8 @@ pub struct GpuNode {
 }
 
 /// `RtTriangle` in `ray-tracing/trace.wgsl`: a corner and the two edges from it, its
-/// translucent object (in the translucent hierarchy) and its alpha test (mask layer, -1 for
-/// none, and cutoff).
+/// translucent object (for translucent casters drawn once; an instance names its own) and its
+/// alpha test (mask layer, -1 for none, and cutoff).
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 #[repr(C)]
 pub struct GpuTriangle {
@@ -155,8 +155,7 @@ impl CasterGeometry {
                 }
             }
         }
-        geometry.translucent =
-            crate::translucent_records(&casters.transmittance, geometry.roots.translucent);
+        geometry.translucent = crate::translucent_records(&casters.transmittance);
         geometry
     }
 
@@ -303,7 +302,7 @@ pub(crate) fn entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         sampler(4, stages, wgpu::SamplerBindingType::Filtering),
         storage(5, stages, true),
         storage(6, stages, true),
-        storage(7, stages, true),
+        uniform(7, stages),
     ]
 }
 
@@ -346,10 +345,13 @@ pub(crate) fn upload(
         "ray tracing instances",
         &crate::or_one_zeroed(&geometry.instances),
     );
-    let roots = storage_buffer(
+    let roots = wgpu::util::DeviceExt::create_buffer_init(
         device,
-        "ray tracing roots",
-        bytemuck::bytes_of(&geometry.roots),
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("ray tracing roots"),
+            contents: bytemuck::bytes_of(&geometry.roots),
+            usage: wgpu::BufferUsages::UNIFORM,
+        },
     );
     let materials = &ctx.scene_buffers.materials;
     let bind_group = bind_group(
@@ -491,7 +493,6 @@ mod tests {
         assert_ne!(root, NO_HIERARCHY, "two translucent boxes");
         assert_eq!(geometry.caster_count(), 36);
         assert_eq!(geometry.translucent.len(), 2);
-        assert!(geometry.translucent.iter().all(|t| t.hierarchy == root));
         assert_eq!(geometry.translucent[0].transmittance, [0.5, 0.1, 0.05]);
         assert_eq!(geometry.translucent[1].transmittance, [0.15, 0.3, 0.75]);
         // The opaque box alone under node 0; each glass box's triangles name its object.

@@ -237,17 +237,16 @@ impl Casters {
 }
 
 /// `RtTranslucent` in `ray-tracing/translucent.wgsl`: a translucent object's transmittance
-/// colour, and where the portable traversal's hierarchy of translucent casters starts (the
-/// same in every record; [`NO_HIERARCHY`] without one).
+/// colour.
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 pub struct GpuTranslucent {
     pub transmittance: [f32; 3],
-    pub hierarchy: u32,
+    pub _pad: u32,
 }
 
-/// [`GpuTranslucent::hierarchy`] where there is no hierarchy of translucent casters
-/// (`RT_NO_HIERARCHY` in `ray-tracing/translucent.wgsl`).
+/// A root of [`GpuRoots`] where there is no such hierarchy (`RT_NO_HIERARCHY` in
+/// `ray-tracing/trace.wgsl`).
 pub const NO_HIERARCHY: u32 = u32::MAX;
 
 /// Distinct translucent objects one ray is filtered by (`RT_MAX_CROSSED` in
@@ -256,20 +255,14 @@ pub const MAX_CROSSED: u32 = 8;
 
 /// The records of translucent objects letting `transmittance` through (one record, of no
 /// object, without any).
-pub(crate) fn translucent_records(transmittance: &[Vec3], hierarchy: u32) -> Vec<GpuTranslucent> {
-    let records: Vec<GpuTranslucent> = (transmittance.iter())
-        .map(|t| GpuTranslucent {
-            transmittance: t.to_array(),
-            hierarchy,
-        })
-        .collect();
-    if records.is_empty() {
-        vec![GpuTranslucent {
-            transmittance: [1.0; 3],
-            hierarchy: NO_HIERARCHY,
-        }]
-    } else {
-        records
+pub(crate) fn translucent_records(transmittance: &[Vec3]) -> Vec<GpuTranslucent> {
+    let record = |t: Vec3| GpuTranslucent {
+        transmittance: t.to_array(),
+        _pad: 0,
+    };
+    match transmittance.is_empty() {
+        true => vec![record(Vec3::ONE)],
+        false => transmittance.iter().map(|t| record(*t)).collect(),
     }
 }
 
@@ -374,16 +367,18 @@ mod tests {
     #[test]
     fn translucent_records_and_numbers_match_the_shader() {
         use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror, wgsl_integer_constant};
-        let record = zoo_host::mirror_fields!(GpuTranslucent {
-            transmittance,
-            hierarchy
-        });
+        let record = zoo_host::mirror_fields!(GpuTranslucent { transmittance });
         let module = "ray-tracing/translucent.wgsl";
         check_embedded_mirror(module, "RtTranslucent", record, SizeRule::Equal).unwrap();
         let source = ShaderLibrary::embedded().compose(module).unwrap().source;
         let constant = |name| wgsl_integer_constant(&source, name);
-        assert_eq!(constant("RT_NO_HIERARCHY"), Ok(i64::from(NO_HIERARCHY)));
         assert_eq!(constant("RT_MAX_CROSSED"), Ok(i64::from(MAX_CROSSED)));
+        let source = ShaderLibrary::embedded()
+            .compose(TRACE_MODULE)
+            .unwrap()
+            .source;
+        let constant = |name| wgsl_integer_constant(&source, name);
+        assert_eq!(constant("RT_NO_HIERARCHY"), Ok(i64::from(NO_HIERARCHY)));
     }
 
     /// Each traversal's layout has the shader's bindings of group [`GROUP`], in number and
@@ -407,6 +402,7 @@ mod tests {
                                 !access.contains(StorageAccess::STORE)
                             )
                         }
+                        (_, AddressSpace::Uniform) => "uniform".to_string(),
                         (TypeInner::Image { .. }, _) => "texture".to_string(),
                         (TypeInner::Sampler { .. }, _) => "sampler".to_string(),
                         (TypeInner::AccelerationStructure { .. }, _) => "scene".to_string(),
@@ -423,6 +419,10 @@ mod tests {
                             ty: wgpu::BufferBindingType::Storage { read_only },
                             ..
                         } => format!("storage read-only {read_only}"),
+                        wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            ..
+                        } => "uniform".to_string(),
                         wgpu::BindingType::Texture { .. } => "texture".to_string(),
                         wgpu::BindingType::Sampler(_) => "sampler".to_string(),
                         wgpu::BindingType::AccelerationStructure { .. } => "scene".to_string(),

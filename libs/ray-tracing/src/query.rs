@@ -4,16 +4,23 @@
 //! alpha-masked ones are a second, non-opaque geometry whose candidate hits the shader tests
 //! with the shared alpha test before it commits them. Translucent casters are a second
 //! instance (its own mask), a non-opaque geometry per object, whose candidates filter the ray.
+//! A mesh instances share is one bottom level, placed by an instance of the top level for each
+//! of theirs (a translucent instance's custom data locating its object's colour). Masked
+//! instances are the exception: placed into the masked geometry in world space, since their
+//! alpha test would read the candidate hit's instance data, which crashes lavapipe 25.0.7's
+//! shader compiler in a closest-hit query.
 
 use bytemuck::{Pod, Zeroable};
 use zoo_host::glam::{Mat4, Vec3};
 use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
 use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
-use crate::{BuildStats, CasterTriangle, Casters, Tracer, or_one_zeroed, storage_buffer};
+use crate::{
+    BuildStats, CasterTriangle, Casters, SharedMesh, Tracer, or_one_zeroed, storage_buffer,
+};
 
 /// `RtMaskedTriangle` in `ray-tracing/query.wgsl`: a masked caster's corners' texture
-/// coordinates and its alpha test, in the masked geometry's primitive order.
+/// coordinates and its alpha test, in primitive order from its instance's custom data.
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 #[repr(C)]
 pub struct GpuMaskedTriangle {
@@ -172,10 +179,9 @@ fn rows(transform: Mat4) -> [f32; 12] {
 
 /// Builds the acceleration structure of `ctx`'s scene (submitted to the queue) and its bind
 /// group, with its size (without the time). Casters drawn once are two instances (blocking,
-/// translucent) at the identity; each mesh instances share is one bottom level, placed by each
-/// of its instances. An instance's custom data is where its records start: the masked
-/// triangles' alpha tests (blocking instances) or its translucent object (translucent ones, one
-/// geometry each; the world's translucent casters, a geometry per object).
+/// translucent) at the identity; each unmasked mesh instances share is one bottom level,
+/// placed by each of its instances. A translucent instance's custom data is its object's
+/// record (the world's translucent casters: a geometry per object, from record 0).
 pub(crate) fn upload(
     ctx: &RenderContext<'_>,
     layout: &wgpu::BindGroupLayout,
@@ -185,8 +191,24 @@ pub(crate) fn upload(
         casters.triangles.iter().filter(|c| keep(c)).collect()
     };
     let opaque = of_kind(&|c| c.translucent.is_none() && c.mask.is_none());
-    let masked = of_kind(&|c| c.mask.is_some());
-    let mut records = masked_records(&masked);
+    // Masked instances are placed into world space here: their alpha tests would need the
+    // candidate hit's instance data, and reading it in a closest-hit query crashes lavapipe
+    // 25.0.7's shader compiler.
+    let is_masked = |mesh: &SharedMesh| mesh.triangles.iter().any(|t| t.mask.is_some());
+    let placed_masked: Vec<CasterTriangle> = (casters.instances.iter())
+        .filter(|i| is_masked(&casters.meshes[i.mesh]))
+        .flat_map(|i| {
+            (casters.meshes[i.mesh].triangles.iter()).map(|t| CasterTriangle {
+                corners: t.corners.map(|p| i.to_world.transform_point3(p)),
+                mask: t.mask,
+                uv: t.uv,
+                translucent: None,
+            })
+        })
+        .collect();
+    let mut masked = of_kind(&|c| c.mask.is_some());
+    masked.extend(&placed_masked);
+    let records = masked_records(&masked);
     // One geometry per translucent object with triangles: its geometry index is its record's.
     let (translucent, mut transmittance): (Vec<Geometry>, Vec<Vec3>) =
         (casters.transmittance.iter().enumerate())
@@ -227,46 +249,55 @@ pub(crate) fn upload(
         ),
     ];
     // Each shared mesh's bottom level, and where its masked records start.
-    let meshes: Vec<(Option<wgpu::Blas>, u32)> = (casters.meshes.iter())
+    // Each other shared mesh's bottom level (opaque, or one translucent geometry).
+    let meshes: Vec<Option<wgpu::Blas>> = (casters.meshes.iter())
         .map(|mesh| {
+            if is_masked(mesh) {
+                return None;
+            }
             let triangles: Vec<&CasterTriangle> = mesh.triangles.iter().collect();
-            let opaque = !mesh.translucent && triangles.iter().all(|t| t.mask.is_none());
-            let first = records.len() as u32;
-            records.extend(masked_records(&triangles));
-            let geometry = [Geometry::of(&triangles, opaque)];
-            let blas = bottom_level(device, "ray tracing shared mesh", &geometry, &mut encoder);
-            (blas, first)
+            let geometry = [Geometry::of(&triangles, !mesh.translucent)];
+            bottom_level(device, "ray tracing shared mesh", &geometry, &mut encoder)
         })
         .collect();
     for instance in &casters.instances {
-        let (blas, first) = &meshes[instance.mesh];
-        let Some(blas) = blas else { continue };
+        let Some(blas) = &meshes[instance.mesh] else {
+            continue;
+        };
         let (custom, mask) = match instance.translucent {
             Some(object) => {
                 transmittance.push(casters.transmittance[object as usize]);
                 (transmittance.len() as u32 - 1, TRANSLUCENT_MASK)
             }
-            None => (*first, BLOCKING_MASK),
+            None => (0, BLOCKING_MASK),
         };
         levels.push((Some(blas.clone()), rows(instance.to_world), custom, mask));
     }
-    if records.len().max(transmittance.len()) >= 1 << 24 {
+    if transmittance.len() >= 1 << 24 {
         return Err(TechniqueError::Other(format!(
-            "{} masked triangles and {} translucent objects: ray queries index at most 2^24",
-            records.len(),
+            "{} translucent objects: ray queries index at most 2^24",
             transmittance.len()
         )));
     }
+    // A missing level (no casters of its kind) has no instance.
+    let instances: Vec<wgpu::TlasInstance> = (levels.iter())
+        .filter_map(|(blas, transform, custom, mask)| {
+            Some(wgpu::TlasInstance::new(
+                blas.as_ref()?,
+                *transform,
+                *custom,
+                *mask,
+            ))
+        })
+        .collect();
     let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
         label: Some("ray tracing scene (top level)"),
-        max_instances: levels.len() as u32,
+        max_instances: instances.len().max(1) as u32,
         flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
         update_mode: wgpu::AccelerationStructureUpdateMode::Build,
     });
-    // A missing level (no casters of its kind) is an empty instance, which no ray hits.
-    for (index, (blas, transform, custom, mask)) in levels.iter().enumerate() {
-        tlas[index] =
-            (blas.as_ref()).map(|b| wgpu::TlasInstance::new(b, *transform, *custom, *mask));
+    for (index, instance) in instances.into_iter().enumerate() {
+        tlas[index] = Some(instance);
     }
     encoder.build_acceleration_structures([], [&tlas]);
     ctx.gpu.queue.submit([encoder.finish()]);
@@ -279,7 +310,7 @@ pub(crate) fn upload(
     let translucent_records = storage_buffer(
         device,
         "ray tracing translucent objects",
-        bytemuck::cast_slice(&crate::translucent_records(&transmittance, 0)),
+        bytemuck::cast_slice(&crate::translucent_records(&transmittance)),
     );
     let materials = &ctx.scene_buffers.materials;
     let bind_group = bind_group(

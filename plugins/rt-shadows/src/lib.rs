@@ -296,10 +296,10 @@ zoo_host::register_technique! {
     source: "ray tracing (the judge's visibility on the GPU)",
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
-    // The frame's lights and objects and the hierarchy's four buffers (nodes, triangles,
-    // texture coordinates, translucent objects), in fragment shaders.
+    // The frame's lights and objects and the hierarchy's five buffers (nodes, triangles,
+    // texture coordinates, translucent objects, instances), in fragment shaders.
     required_limits: || wgpu::Limits {
-        max_storage_buffers_per_shader_stage: 6,
+        max_storage_buffers_per_shader_stage: 7,
         ..wgpu::Limits::downlevel_defaults()
     },
     // Hardware ray queries where the adapter has them (`traversal` Auto or RayQuery).
