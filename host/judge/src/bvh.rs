@@ -99,17 +99,22 @@ impl FlatBvh {
             &mut Duration::default(),
         );
         FlatBvh {
-            nodes: (bvh.nodes.iter())
-                .map(|n| FlatNode {
-                    min: n.aabb.min.into(),
-                    max: n.aabb.max.into(),
-                    first: n.first_index,
-                    count: n.prim_count,
-                })
-                .collect(),
+            nodes: flat_nodes(&bvh),
             triangles: bvh.primitive_indices.clone(),
         }
     }
+}
+
+/// The nodes of `bvh` in flat form.
+fn flat_nodes(bvh: &Bvh2) -> Vec<FlatNode> {
+    (bvh.nodes.iter())
+        .map(|n| FlatNode {
+            min: n.aabb.min.into(),
+            max: n.aabb.max.into(),
+            first: n.first_index,
+            count: n.prim_count,
+        })
+        .collect()
 }
 
 /// What a leaf visit tells the traversal.
@@ -196,14 +201,7 @@ impl TriangleBvh {
             return FlatBvh::default();
         }
         FlatBvh {
-            nodes: (self.bvh.nodes.iter())
-                .map(|n| FlatNode {
-                    min: n.aabb.min.into(),
-                    max: n.aabb.max.into(),
-                    first: n.first_index,
-                    count: n.prim_count,
-                })
-                .collect(),
+            nodes: flat_nodes(&self.bvh),
             triangles: self.sources.iter().map(|&s| s as u32).collect(),
         }
     }

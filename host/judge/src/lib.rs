@@ -25,6 +25,7 @@ pub use indirect::{ReflectorHit, Reflectors, one_bounce, reflected_direct, relat
 pub use leak::{leak, lit_points, unlit_by_one_bounce};
 pub use metrics::{ErrorClass, Metrics, edge_band, error_class, percentile};
 pub use occluders::Occluders;
+pub use placed::placed_box;
 pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, reference_visibility};
 pub use sampling::{concentric_disk, stratified_disk};
 pub use surfaces::{SurfaceHit, SurfacePoint, Surfaces};

@@ -184,7 +184,8 @@ impl PlacedTriangles {
         let (traced, boxes): (Vec<usize>, Vec<Aabb>) = (instances.iter().enumerate())
             .filter_map(|(k, i)| {
                 let (lo, hi) = meshes[i.mesh].bvh.bounds()?;
-                Some((k, placed_box(i.to_world, lo, hi)))
+                let (min, max) = placed_box(i.to_world, lo, hi);
+                Some((k, Aabb::new(Vec3A::from(min), Vec3A::from(max))))
             })
             .unzip();
         let top = if boxes.is_empty() {
@@ -377,8 +378,9 @@ impl PlacedTriangles {
     }
 }
 
-/// The world box around a stored box's placed corners.
-fn placed_box(to_world: Mat4, lo: Vec3, hi: Vec3) -> Aabb {
+/// The world box (min, max) around a stored box's placed corners, grown by the placement's
+/// rounding at the box's magnitude so that slab tests against it stay conservative.
+pub fn placed_box(to_world: Mat4, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
     let corners = (0..8).map(|k: u32| {
         let pick = |bit: u32| if k & bit == 0 { 0.0 } else { 1.0 };
         to_world.transform_point3(lo + (hi - lo) * Vec3::new(pick(1), pick(2), pick(4)))
@@ -387,9 +389,8 @@ fn placed_box(to_world: Mat4, lo: Vec3, hi: Vec3) -> Aabb {
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(a, b), c| (a.min(c), b.max(c)),
     );
-    // The placement's rounding, at the box's magnitude: the slab test stays conservative.
     let pad = Vec3::splat(gamma(8) * min.abs().max(max.abs()).max_element());
-    Aabb::new(Vec3A::from(min - pad), Vec3A::from(max + pad))
+    (min - pad, max + pad)
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! (`ray-tracing/trace.wgsl`), so it runs on every adapter with storage buffers.
 
 use bytemuck::{Pod, Zeroable};
-use zoo_host::glam::{Mat4, Vec3};
+use zoo_host::glam::Vec3;
 use zoo_host::judge::FlatBvh;
 use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture, uniform};
 use zoo_host::scene::Scene;
@@ -165,7 +165,7 @@ impl CasterGeometry {
         let boxes: Vec<(Vec3, Vec3)> = (members.iter())
             .map(|(instance, root)| {
                 let node = &self.nodes[*root as usize];
-                placed_box(instance.to_world, node.min.into(), node.max.into())
+                zoo_host::judge::placed_box(instance.to_world, node.min.into(), node.max.into())
             })
             .collect();
         let bvh = FlatBvh::over_boxes(&boxes);
@@ -265,20 +265,6 @@ impl CasterGeometry {
     pub fn traced_count(&self) -> usize {
         self.traced
     }
-}
-
-/// The world box around a stored box's placed corners, grown by the placement's rounding.
-fn placed_box(to_world: Mat4, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
-    let corners = (0..8).map(|k: u32| {
-        let pick = |bit: u32| if k & bit == 0 { 0.0 } else { 1.0 };
-        to_world.transform_point3(lo + (hi - lo) * Vec3::new(pick(1), pick(2), pick(4)))
-    });
-    let (min, max) = corners.fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(a, b), c| (a.min(c), b.max(c)),
-    );
-    let pad = Vec3::splat(1e-6 * min.abs().max(max.abs()).max_element());
-    (min - pad, max + pad)
 }
 
 /// The layout of the compute traversal's group.

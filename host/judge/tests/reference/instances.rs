@@ -8,6 +8,8 @@ use glam::Vec3;
 use zoo_judge::{Occluders, Surfaces};
 use zoo_scene::Scene;
 
+use crate::Rng;
+
 /// A scene of instanced casters (rotated, non-uniformly scaled, far from the origin and small),
 /// each object's own transform the identity.
 const INSTANCED: &str = r#"(
@@ -42,20 +44,9 @@ fn scenes() -> (Scene, Scene) {
     (instanced, copied)
 }
 
-/// Small deterministic generator.
-struct Rng(u64);
-
-impl Rng {
-    fn unit(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 40) as f32) / (1u64 << 24) as f32
-    }
-    fn point(&mut self, extent: f32) -> Vec3 {
-        Vec3::new(self.unit() - 0.5, self.unit() * 0.5, self.unit() - 0.5) * 2.0 * extent
-    }
+/// A random point in the box of half-width `extent` above the ground.
+fn point(rng: &mut Rng, extent: f32) -> Vec3 {
+    Vec3::new(rng.range(-1.0, 1.0), rng.unit(), rng.range(-1.0, 1.0)) * extent
 }
 
 #[test]
@@ -71,8 +62,8 @@ fn instances_block_and_are_seen_where_their_copies_are() {
     let mut rng = Rng(17);
     let (mut rays, mut blocked, mut differ, mut seen) = (0, 0, 0, 0);
     for _ in 0..40_000 {
-        let origin = rng.point(8.0);
-        let target = rng.point(8.0);
+        let origin = point(&mut rng, 8.0);
+        let target = point(&mut rng, 8.0);
         let length = origin.distance(target);
         if length < 1e-3 {
             continue;

@@ -5,34 +5,7 @@
 use glam::Vec3;
 use zoo_judge::{Occluders, Surfaces};
 
-/// Small deterministic generator (an LCG with an xorshift output).
-struct Rng(u64);
-
-impl Rng {
-    fn unit(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let x = self.0 ^ (self.0 >> 33);
-        ((x >> 40) as u32) as f32 / (1u32 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
-    }
-    fn direction(&mut self) -> Vec3 {
-        loop {
-            let d = Vec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            if d.length() > 0.1 && d.length() <= 1.0 {
-                break d.normalize();
-            }
-        }
-    }
-}
+use crate::Rng;
 
 /// A random triangle of size about `size` around `centre`, not too thin.
 fn triangle(rng: &mut Rng, centre: Vec3, size: f32) -> [Vec3; 3] {
