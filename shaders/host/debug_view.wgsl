@@ -3,7 +3,8 @@
 #import "common/fullscreen.wgsl"
 
 struct ViewParams {
-    // 0 colour, 1 single channel, 2 depth (raw), 3 depth linearised with near/far, 4 integer.
+    // 0 colour, 1 single channel, 2 depth (raw), 3 depth linearised with near/far, 4 integer,
+    // 5 single channel of float bits.
     mode: u32,
     channel: u32,
     min_value: f32,
@@ -66,7 +67,11 @@ fn fs_depth(in: FullscreenOut) -> @location(0) vec4<f32> {
 
 @fragment
 fn fs_uint(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let v = textureLoad(source_uint, source_pixel(in, textureDimensions(source_uint)), 0).r;
+    let texel = textureLoad(source_uint, source_pixel(in, textureDimensions(source_uint)), 0);
+    if params.mode == 5u {
+        return display(vec3<f32>(remap(bitcast<f32>(texel[params.channel]))));
+    }
+    let v = texel.r;
     if v == 0u || params.mode != 4u {
         return display(vec3<f32>(0.0));
     }

@@ -266,6 +266,58 @@ fn compare_writes_csv_report_and_error_maps() {
     );
 }
 
+/// `--sweep` judges each value of a parameter against one reference, as its own row.
+#[test]
+fn compare_sweeps_a_parameter_in_one_run() {
+    let out_dir = temp_dir("compare-sweep").join("results");
+    let out = shadow_zoo(&[
+        "compare",
+        "--scene",
+        "scenes/contact.ron",
+        "--techniques",
+        "unshadowed,sm-pcf",
+        "--sweep",
+        "sm-pcf.map_size=256,1024",
+        "--sweep",
+        "sm-pcf.filter=None,Pcss",
+        "--size",
+        "64x48",
+        "--samples",
+        "4",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    assert!(all.contains("5 configurations"), "{all}");
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let labels: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap())
+        .collect();
+    let mut distinct = labels.clone();
+    distinct.dedup();
+    assert_eq!(
+        distinct,
+        [
+            "unshadowed",
+            "sm-pcf@map_size=256@filter=None",
+            "sm-pcf@map_size=256@filter=Pcss",
+            "sm-pcf@map_size=1024@filter=None",
+            "sm-pcf@map_size=1024@filter=Pcss",
+        ],
+        "{csv}"
+    );
+    let lights = labels.iter().filter(|l| **l == "unshadowed").count();
+    assert_eq!(labels.len(), 5 * lights, "{csv}");
+    assert!(
+        out_dir
+            .join("sm-pcf@map_size=1024@filter=Pcss-light0-error.png")
+            .is_file()
+    );
+}
+
 #[test]
 fn compare_judges_views_along_the_paths_and_scores_final_images() {
     let out_dir = temp_dir("compare-views").join("results");
@@ -487,6 +539,35 @@ fn compare_rejects_bad_input_clearly() {
                 "unshadowed.size=3",
             ],
             "unknown parameter `size`",
+        ),
+        (
+            vec![
+                "--scene",
+                "scenes/contact.ron",
+                "--sweep",
+                "size=64x48,32x32",
+            ],
+            "compare sweeps technique parameters",
+        ),
+        (
+            vec![
+                "--scene",
+                "scenes/contact.ron",
+                "--techniques",
+                "unshadowed",
+                "--sweep",
+                "sm-pcf.map_size=256,512",
+            ],
+            "technique `sm-pcf` is not being compared",
+        ),
+        (
+            vec![
+                "--scene",
+                "scenes/contact.ron",
+                "--sweep",
+                "sm-pcf.map_size=256,7",
+            ],
+            "--sweep sm-pcf.map_size",
         ),
     ];
     for (args, expected) in cases {

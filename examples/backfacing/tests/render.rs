@@ -73,17 +73,17 @@ fn out_of_range_darkness_is_rejected() {
 }
 
 #[test]
-fn the_readme_shows_this_crate_and_its_shader_verbatim() {
+fn the_docs_show_this_crate_and_its_shader_verbatim() {
     let root = zoo_host::test_support::workspace_root();
-    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let page = std::fs::read_to_string(root.join("docs/writing-a-technique.md")).unwrap();
     for file in [
         "examples/backfacing/src/lib.rs",
         "shaders/backfacing/mask.wgsl",
     ] {
         let text = std::fs::read_to_string(root.join(file)).unwrap();
         assert!(
-            readme.contains(&text),
-            "README.md's \"Writing a technique\" must show {file} as it is"
+            page.contains(&text),
+            "docs/writing-a-technique.md must show {file} as it is"
         );
     }
     let lines = std::fs::read_to_string(root.join("examples/backfacing/src/lib.rs"))

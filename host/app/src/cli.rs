@@ -101,6 +101,11 @@ pub struct CompareArgs {
     /// Set a technique parameter, e.g. `--set sm-pcf.map_size=4096` (repeatable).
     #[arg(long = "set", value_name = "ID.KEY=VALUE", value_parser = parse_assignment)]
     pub set: Vec<(String, String)>,
+    /// Judge a technique at several values of a parameter in one run, against one reference:
+    /// `--sweep sm-pcf.map_size=512,1024,2048` (repeatable; one technique's sweeps multiply).
+    /// Each configuration is a row `ID@KEY=VALUE@...` of the results.
+    #[arg(long = "sweep", value_name = "ID.KEY=v1,v2,...", value_parser = parse_assignment)]
+    pub sweep: Vec<(String, String)>,
     /// Area-light samples per pixel for the soft reference (rounded up to a square).
     #[arg(long, default_value_t = zoo_host::judging::DEFAULT_SAMPLES,
           value_parser = clap::value_parser!(u32).range(1..=4096))]

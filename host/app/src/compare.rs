@@ -138,10 +138,66 @@ pub fn technique_params(
         .collect()
 }
 
-/// Runs `shadow-zoo compare`.
-pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
+/// One judged configuration: a technique, its parameters, and its label in the results (the
+/// id, then `@KEY=VALUE` for each swept value).
+struct Configuration {
+    technique: &'static TechniqueRegistration,
+    params: ParamValues,
+    label: String,
+}
+
+/// The configurations of a run: each technique with its `--set` values, multiplied by the
+/// `--sweep`s of its own parameters.
+fn configurations(args: &CompareArgs) -> anyhow::Result<Vec<Configuration>> {
     let techniques = select_techniques(&args.techniques)?;
     let params = technique_params(&techniques, &args.set)?;
+    let sweeps = crate::bench::parse_sweeps(&args.sweep)?;
+    let mut out = Vec::new();
+    for (technique, values) in techniques.iter().zip(params) {
+        let mut own = Vec::new();
+        for sweep in &sweeps {
+            let crate::bench::SweepKey::Param { technique: id, .. } = &sweep.key else {
+                bail!(
+                    "--sweep {}: compare sweeps technique parameters (ID.KEY)",
+                    sweep.name
+                );
+            };
+            if !techniques.iter().any(|t| t.id == id) {
+                bail!(
+                    "--sweep {}: technique `{id}` is not being compared",
+                    sweep.name
+                );
+            }
+            if id == technique.id {
+                own.push(sweep);
+            }
+        }
+        let schema = (technique.params)();
+        let base = (values, Vec::<String>::new());
+        let swept = crate::bench::cartesian(vec![base], &own, |(values, swept), sweep, value| {
+            let crate::bench::SweepKey::Param { key, .. } = &sweep.key else {
+                unreachable!("only parameter sweeps are kept")
+            };
+            params::apply_assignments(&schema, values, &[(key.clone(), value.to_string())])?;
+            swept.push(format!("{key}={value}"));
+            Ok(())
+        })?;
+        out.extend(swept.into_iter().map(|(params, swept)| Configuration {
+            technique,
+            params,
+            label: if swept.is_empty() {
+                technique.id.to_string()
+            } else {
+                format!("{}@{}", technique.id, swept.join("@"))
+            },
+        }));
+    }
+    Ok(out)
+}
+
+/// Runs `shadow-zoo compare`.
+pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
+    let configurations = configurations(args)?;
     let scene = Scene::load(&args.scene)?;
     let times = view_times(&scene, args.views)?;
     std::fs::create_dir_all(&args.out)
@@ -154,11 +210,11 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
     let adapter = gpu.describe();
     println!(
-        "scene: {} ({}, {} lights); {} techniques at {}x{}, {} view{}",
+        "scene: {} ({}, {} lights); {} configurations at {}x{}, {} view{}",
         scene.name,
         scene.triangle_summary(),
         scene.lights.len(),
-        techniques.len(),
+        configurations.len(),
         args.size.x,
         args.size.y,
         times.len(),
@@ -169,7 +225,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let triangles = scene.triangle_summary();
     let mut renderer = Renderer::with_shaders(gpu, scene, args.size, shaders)?;
 
-    let bar = ProgressBar::new((times.len() * (light_count + techniques.len())) as u64);
+    let bar = ProgressBar::new((times.len() * (light_count + configurations.len())) as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed}]")
             .expect("valid template"),
@@ -188,11 +244,15 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             }
         };
         let mut judged = Vec::new();
-        for (technique, values) in techniques.iter().zip(&params) {
-            bar.set_message(format!("view {view}: {}", technique.id));
-            match judge_technique(&mut renderer, &reference, technique.id, values) {
-                Ok(j) => judged.push(j),
-                Err(e) => failures.push((view, technique.id, e.to_string())),
+        for config in &configurations {
+            bar.set_message(format!("view {view}: {}", config.label));
+            let id = config.technique.id;
+            match judge_technique(&mut renderer, &reference, id, &config.params) {
+                Ok(j) => judged.push(Judged {
+                    technique: config.label.clone(),
+                    ..j
+                }),
+                Err(e) => failures.push((view, config.label.as_str(), e.to_string())),
             }
             bar.inc(1);
         }
@@ -272,7 +332,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         bail!(
             "{} of {} technique runs failed",
             failures.len(),
-            techniques.len() * views.len()
+            configurations.len() * views.len()
         );
     }
     Ok(())
@@ -674,7 +734,7 @@ struct ReportInputs<'a> {
     judge: Judge,
     views: &'a [JudgedView],
     /// (view, technique, error) of the runs that failed.
-    failures: &'a [(usize, &'static str, String)],
+    failures: &'a [(usize, &'a str, String)],
 }
 
 /// One row of the report's metrics table.

@@ -2,7 +2,7 @@
 //! link-time technique registry, scenes, the GPU context and the deferred renderer that shades
 //! every technique identically from the per-light visibility it produces.
 //!
-//! A plugin crate depends on this crate only. See `README.md` ("Writing a technique") for a
+//! A plugin crate depends on this crate only. See `docs/writing-a-technique.md` for a
 //! complete minimal plugin.
 
 // Lets the macros name this crate as `zoo_host` from inside it too.

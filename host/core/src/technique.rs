@@ -293,6 +293,9 @@ pub enum ViewMapping {
     Channel { channel: u32, min: f32, max: f32 },
     /// Unsigned integers (counts, ids) shown with a false-colour palette.
     Integer,
+    /// One channel of an integer texture holding the bits of 32-bit floats (textures every
+    /// device can render into) as greyscale, remapped from [min, max].
+    FloatBits { channel: u32, min: f32, max: f32 },
 }
 
 /// A technique resource as listed in the memory table and debug view menu.

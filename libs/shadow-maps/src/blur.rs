@@ -52,7 +52,7 @@ impl LayerBlur {
         let device = &ctx.gpu.device;
         let module = ctx.shaders.create_module(device, "shadow-maps/blur.wgsl")?;
         let fragment = wgpu::ShaderStages::FRAGMENT;
-        let unfiltered = wgpu::TextureSampleType::Float { filterable: false };
+        let unfiltered = wgpu::TextureSampleType::Uint;
         let layout = bind_group_layout(
             device,
             &format!("{label} source layout"),

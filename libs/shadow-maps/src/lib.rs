@@ -37,7 +37,7 @@ pub use depth::{CAMERA_STRIDE, ColorOutput, DepthPass, DepthState, LayerCamera};
 pub use filter::{Filter, MapFilter, MapFilters};
 pub use header::MapHeader;
 pub use lookup_pass::{Lookup, LookupPass, LookupShader};
-pub use maps::{CUBE_GUARD, MAP_FORMAT, MapArray, filterable_rg_format, filterable_rgba_format};
+pub use maps::{CUBE_GUARD, MAP_FORMAT, MOMENTS_RG_FORMAT, MOMENTS_RGBA_FORMAT, MapArray};
 pub use moments::{MomentMaps, MomentMethod, MomentSettings};
 pub use params::{FilterParams, MapParams};
 pub use planning::{

@@ -1,8 +1,8 @@
 //! The bind group lookups read a [`crate::ShadowMapSet`]'s maps through.
 //!
-//! - Colour maps (moments, fluxes): the maps (`texture_2d_array<f32>`, filterable) at binding
-//!   0, a linear clamping sampler at 1, the layer cameras (storage, 256-byte `LayerCamera`
-//!   slots) at 2.
+//! - Colour maps (moments): the maps (`texture_2d_array<u32>`, the bits of 32-bit floats,
+//!   filtered in the shader) at binding 0, the layer cameras (storage, 256-byte `LayerCamera` slots) at
+//!   1.
 //! - Depth maps: the layout of `shaders/shadow-maps/depth_lookup.wgsl` (group 3): the maps with
 //!   linear and nearest comparison samplers, the layer cameras, the maps as plain floats, and
 //!   the maps again for the nearest sampler (GLSL pairs each texture with one sampler).
@@ -60,16 +60,10 @@ impl LookupGroup {
         } else {
             (
                 vec![
-                    texture(
-                        0,
-                        stage,
-                        wgpu::TextureSampleType::Float { filterable: true },
-                        array,
-                    ),
-                    sampler(1, stage, wgpu::SamplerBindingType::Filtering),
-                    storage(2, stage, true),
+                    texture(0, stage, wgpu::TextureSampleType::Uint, array),
+                    storage(1, stage, true),
                 ],
-                vec![sampler_of("linear", wgpu::FilterMode::Linear, None)],
+                Vec::new(),
             )
         };
         LookupGroup {
@@ -94,11 +88,7 @@ impl LookupGroup {
                 view,
             ]
         } else {
-            vec![
-                view,
-                wgpu::BindingResource::Sampler(&self.samplers[0]),
-                cameras.as_entire_binding(),
-            ]
+            vec![view, cameras.as_entire_binding()]
         };
         let label = format!("{} lookup", self.label);
         self.group = Some(bind_group(device, &label, &self.layout, &resources));

@@ -8,31 +8,16 @@ use zoo_host::wgpu;
 pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Texels of guard band around each cube face (covers bilinear taps across face edges).
 pub const CUBE_GUARD: u32 = 2;
-/// The two-channel float format for filtered colour maps (moments): `Rg32Float` where the
-/// device filters 32-bit floats (`FLOAT32_FILTERABLE`), `Rg16Float` elsewhere.
-pub fn filterable_rg_format(device: &wgpu::Device) -> wgpu::TextureFormat {
-    if device
-        .features()
-        .contains(wgpu::Features::FLOAT32_FILTERABLE)
-    {
-        wgpu::TextureFormat::Rg32Float
-    } else {
-        wgpu::TextureFormat::Rg16Float
-    }
-}
-
-/// The four-channel float format for filtered colour maps (higher moments): `Rgba32Float`
-/// where the device filters 32-bit floats, `Rgba16Float` elsewhere.
-pub fn filterable_rgba_format(device: &wgpu::Device) -> wgpu::TextureFormat {
-    if device
-        .features()
-        .contains(wgpu::Features::FLOAT32_FILTERABLE)
-    {
-        wgpu::TextureFormat::Rgba32Float
-    } else {
-        wgpu::TextureFormat::Rgba16Float
-    }
-}
+/// The two-channel format of colour maps (moments): 32-bit floats stored as their bits, on
+/// every device. Not every device renders into or filters 32-bit float textures (GL without
+/// `EXT_color_buffer_float`, WebGPU without `float32-filterable`), while every one renders
+/// 32-bit integers; the passes write `bitcast<u32>` of their floats and lookups filter the
+/// texels in the shader (`shaders/shadow-maps/color_lookup.wgsl`), so every backend holds and
+/// filters the same moments.
+pub const MOMENTS_RG_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
+/// The four-channel format of colour maps (higher moments), stored like
+/// [`MOMENTS_RG_FORMAT`].
+pub const MOMENTS_RGBA_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 
 /// `layers` square maps (atlas pages) of `resolution` texels in one array texture (depth or
 /// colour).

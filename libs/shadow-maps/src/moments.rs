@@ -21,9 +21,21 @@ use crate::{ColorOutput, DepthState, LayerBlur, MapHeader, ShadowMapSet};
 
 const STORE_SHADER: &str = "shadow-maps/moments_store.wgsl";
 const LOOKUP_SHADER: &str = "shadow-maps/moments_lookup.wgsl";
-const STORE_ENTRY: &str = "@fragment fn fs_moments(in: DepthVertex) -> @location(0) vec4<f32> { return store_moments(in); }
-@fragment fn fs_moments_masked(in: MaskedVertex) -> @location(0) vec4<f32> { let m = store_moments(to_depth_vertex(in)); if !covered(in.object, in.uv) { discard; } return m; }";
+const STORE_ENTRY: &str = "@fragment fn fs_moments(in: DepthVertex) -> @location(0) vec4<u32> { return bitcast<vec4<u32>>(store_moments(in)); }
+@fragment fn fs_moments_masked(in: MaskedVertex) -> @location(0) vec4<u32> { let m = store_moments(to_depth_vertex(in)); if !covered(in.object, in.uv) { discard; } return bitcast<vec4<u32>>(m); }";
 const LOOKUP_ENTRY: &str = "@fragment fn fs_moment_lookup(in: FullscreenOut) -> @location(0) vec4<f32> { return moment_lookup(in); }";
+
+/// The maps' clear value: 1.0 in every channel, as the bits the maps store (a clear of an
+/// integer format takes the colour's values as integers).
+const ONE_BITS: wgpu::Color = {
+    let one = 1.0f32.to_bits() as f64;
+    wgpu::Color {
+        r: one,
+        g: one,
+        b: one,
+        a: one,
+    }
+};
 
 /// `MomentLight` in `shadow-maps/moments_lookup.wgsl`: one light's lookup.
 #[derive(Debug, Clone, Copy, zoo_host::bytemuck::Pod, zoo_host::bytemuck::Zeroable)]
@@ -91,7 +103,7 @@ impl MomentMaps {
             entry: "fs_moments",
             masked_entry: "fs_moments_masked",
             format: method.format,
-            clear: wgpu::Color::WHITE,
+            clear: ONE_BITS,
         };
         let label = format!("{} moments", method.label);
         let maps = ShadowMapSet::new(ctx, &label, DepthState::default(), Some(output))?;
@@ -158,7 +170,7 @@ impl MomentMaps {
     pub fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
         let page = self.maps.lights().first()?.tiles.first()?.page as usize;
         let view = &self.maps.maps()?.layer_views[page];
-        let mapping = ViewMapping::Channel {
+        let mapping = ViewMapping::FloatBits {
             channel: 0,
             min: 0.0,
             max: 1.0,

@@ -143,14 +143,15 @@ impl ShadowMapSet {
         state: DepthState,
         color: Option<ColorOutput<'_>>,
     ) -> TechniqueResult<ShadowMapSet> {
+        // Colour maps are filtered by the lookups themselves (`color_lookup.wgsl`), so the
+        // format needs no filtering.
         if let Some(color) = color {
             let features = ctx.gpu.adapter.get_texture_format_features(color.format);
-            let needed = wgpu::TextureFormatFeatureFlags::FILTERABLE;
             let usages =
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-            if !features.flags.contains(needed) || !features.allowed_usages.contains(usages) {
+            if !features.allowed_usages.contains(usages) {
                 return Err(zoo_host::TechniqueError::Other(format!(
-                    "{label}: this device cannot render into and filter {:?} maps",
+                    "{label}: this device cannot render into {:?} maps",
                     color.format
                 )));
             }

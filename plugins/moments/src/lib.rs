@@ -10,7 +10,7 @@ use zoo_host::params::{ParamSpec, TechniqueParams, find_spec};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo};
 use zoo_shadow_maps::{
-    MomentMaps, MomentMethod, MomentSettings, filterable_rg_format, filterable_rgba_format,
+    MOMENTS_RG_FORMAT, MOMENTS_RGBA_FORMAT, MomentMaps, MomentMethod, MomentSettings,
 };
 
 zoo_host::technique_params! {
@@ -20,15 +20,14 @@ zoo_host::technique_params! {
         map_size: u32 = 2048, range(256, 8192), step(256);
         /// Gaussian blur of the moments, in taps on each side (0: bilinear filtering only).
         blur_radius: u32 = 2, range(0, 16), step(1);
-        /// Exponent of the positive warp exp(c (z - 1)) (32-bit maps; at most 5.5 with 16-bit
-        /// ones).
+        /// Exponent of the positive warp exp(c (z - 1)).
         positive_exponent: f32 = 40.0, range(1.0, 42.0), step(1.0), flags(rebuild);
         /// Exponent of the negative warp exp(c (1 - z)) (EVSM4).
         negative_exponent: f32 = 5.0, range(1.0, 42.0), step(1.0), flags(rebuild);
         /// Smallest variance in squared light-depth units, scaled by each warp's slope (EVSM).
         min_variance: f32 = 0.00001, range(0.0, 0.001), step(0.00001);
         /// Moment bias: the filtered moments move this far towards (0.5, 0.5, 0.5, 0.5)
-        /// (MSM; at least 6e-5 with 16-bit maps).
+        /// (MSM).
         moment_bias: f32 = 0.00003, range(0.0, 0.01), step(0.00001);
         /// Light-bleeding reduction: visibility below it becomes 0 and the rest is rescaled.
         bleeding_reduction: f32 = 0.0, range(0.0, 0.95), step(0.05);
@@ -57,7 +56,7 @@ pub struct Method {
     /// The method's own parameters, beside [`COMMON`].
     reads: &'static [&'static str],
     /// Its bias, in the units its WGSL reads.
-    bias: fn(&MomentParams, bool) -> f32,
+    bias: fn(&MomentParams) -> f32,
 }
 
 const ESM: Method = Method {
@@ -65,34 +64,28 @@ const ESM: Method = Method {
     shader: "moments/esm.wgsl",
     four: false,
     reads: &["positive_exponent"],
-    bias: |_, _| 0.0,
+    bias: |_| 0.0,
 };
 const EVSM2: Method = Method {
     label: "EVSM2",
     shader: "moments/evsm2.wgsl",
     four: false,
     reads: &["positive_exponent", "min_variance"],
-    bias: |p, _| p.min_variance,
+    bias: |p| p.min_variance,
 };
 const EVSM4: Method = Method {
     label: "EVSM4",
     shader: "moments/evsm4.wgsl",
     four: true,
     reads: &["positive_exponent", "negative_exponent", "min_variance"],
-    bias: |p, _| p.min_variance,
+    bias: |p| p.min_variance,
 };
 const MSM: Method = Method {
     label: "MSM",
     shader: "moments/msm.wgsl",
     four: true,
     reads: &["moment_bias"],
-    bias: |p, half| {
-        if half {
-            p.moment_bias.max(6e-5)
-        } else {
-            p.moment_bias
-        }
-    },
+    bias: |p| p.moment_bias,
 };
 
 impl Method {
@@ -113,19 +106,24 @@ impl Method {
         Ok(MomentParams::from_values(values)?)
     }
 
-    /// The method's WGSL constants for maps of `format`: 16-bit maps hold the warps only
-    /// with exponents up to 5.5, and no moment above the format's largest finite value.
-    fn prelude(p: &MomentParams, half: bool) -> String {
-        let (exponent_limit, moment_limit) = if half {
-            (5.5f32, 65504.0f32)
-        } else {
-            (f32::MAX, 1.0e38)
-        };
-        let positive = p.positive_exponent.min(exponent_limit);
-        let negative = p.negative_exponent.min(exponent_limit);
+    /// The method's WGSL constants. The maps hold 32-bit floats, so no moment of an exponent
+    /// in range overflows: exp(2 * 42) < f32::MAX.
+    fn prelude(p: &MomentParams) -> String {
         format!(
-            "const POSITIVE_EXPONENT: f32 = {positive:?};\nconst NEGATIVE_EXPONENT: f32 = {negative:?};\nconst MOMENT_LIMIT: f32 = {moment_limit:?};\n"
+            "const POSITIVE_EXPONENT: f32 = {:?};\nconst NEGATIVE_EXPONENT: f32 = {:?};\nconst MOMENT_LIMIT: f32 = {:?};\n",
+            p.positive_exponent,
+            p.negative_exponent,
+            f32::MAX,
         )
+    }
+
+    /// The format of the method's maps.
+    fn format(&self) -> wgpu::TextureFormat {
+        if self.four {
+            MOMENTS_RGBA_FORMAT
+        } else {
+            MOMENTS_RG_FORMAT
+        }
     }
 }
 
@@ -136,20 +134,13 @@ struct MomentShadows {
     maps: LazyGpu<MomentMaps>,
 }
 
-fn is_half(format: Option<wgpu::TextureFormat>) -> bool {
-    matches!(
-        format,
-        Some(wgpu::TextureFormat::Rg16Float | wgpu::TextureFormat::Rgba16Float)
-    )
-}
-
-fn settings(method: &Method, p: &MomentParams, half: bool) -> MomentSettings {
+fn settings(method: &Method, p: &MomentParams) -> MomentSettings {
     MomentSettings {
         map_size: p.map_size,
         stable_fit: p.stable_fit,
         blur_radius: p.blur_radius,
         normal_offset: p.normal_offset,
-        bias: (method.bias)(p, half),
+        bias: (method.bias)(p),
         bleeding_reduction: p.bleeding_reduction,
     }
 }
@@ -163,22 +154,15 @@ impl ShadowTechnique for MomentShadows {
         let method = self.method;
         let params = &self.params;
         let maps = self.maps.prepare(false, || {
-            let device = &ctx.gpu.device;
-            let format = if method.four {
-                filterable_rgba_format(device)
-            } else {
-                filterable_rg_format(device)
-            };
             let maps = MomentMethod {
                 label: method.label,
                 shader: method.shader,
-                prelude: Method::prelude(params, is_half(Some(format))),
-                format,
+                prelude: Method::prelude(params),
+                format: method.format(),
             };
             MomentMaps::new(ctx, &maps)
         })?;
-        let half = is_half(maps.format());
-        maps.prepare(ctx, changes, &settings(method, &self.params, half));
+        maps.prepare(ctx, changes, &settings(method, &self.params));
         Ok(())
     }
 
@@ -188,8 +172,7 @@ impl ShadowTechnique for MomentShadows {
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
         let maps = self.maps.get_mut()?;
-        let half = is_half(maps.format());
-        maps.record(ctx, recorder, &settings(self.method, &self.params, half))
+        maps.record(ctx, recorder, &settings(self.method, &self.params))
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -232,7 +215,6 @@ macro_rules! register_method {
             source: $source,
             readme: include_str!("../README.md"),
             light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
-            optional_features: || wgpu::Features::FLOAT32_FILTERABLE,
             params: || $method.schema(),
             create: |_, values| create(&$method, values),
         }
@@ -287,11 +269,21 @@ mod tests {
     }
 
     #[test]
-    fn exponents_are_clamped_for_half_floats() {
-        let p = MomentParams::default();
-        assert!(Method::prelude(&p, false).contains("POSITIVE_EXPONENT: f32 = 40.0;"));
-        let half = Method::prelude(&p, true);
-        assert!(half.contains("POSITIVE_EXPONENT: f32 = 5.5;"), "{half}");
-        assert!(half.contains("MOMENT_LIMIT: f32 = 65504.0;"), "{half}");
+    fn exponents_reach_the_shaders_unclamped() {
+        let p = MomentParams {
+            positive_exponent: 42.0,
+            ..MomentParams::default()
+        };
+        let prelude = Method::prelude(&p);
+        assert!(
+            prelude.contains("POSITIVE_EXPONENT: f32 = 42.0;"),
+            "{prelude}"
+        );
+        assert!(
+            prelude.contains("NEGATIVE_EXPONENT: f32 = 5.0;"),
+            "{prelude}"
+        );
+        // The largest second moment of the largest exponent stays finite in the maps.
+        assert!((2.0 * 42.0f32).exp().is_finite());
     }
 }

@@ -9,6 +9,13 @@
 //! lit. Bias: constant and slope-scaled pipeline depth bias, normal offset in texels, and
 //! optional front-face culling in the depth pass. Maps, fitting and the lookup's map access
 //! come from the shadow-map library.
+//!
+//! The crate also registers `contact-shadows`: the same maps, and a short march toward the
+//! light through the depth buffer (`contact.rs`) that restores the shadow near contacts.
+
+mod contact;
+
+use contact::ContactParams;
 
 use zoo_host::glam::UVec2;
 use zoo_host::prelude::*;
@@ -43,7 +50,10 @@ struct ShadowLight {
     map: MapHeader,
     map_filter: MapFilter,
     debug: u32,
-    _pad: [f32; 3],
+    contact_texels: f32,
+    /// 0: no contact march.
+    contact_steps: u32,
+    contact_thickness: f32,
 }
 
 const SHADER: &str = "sm-pcf/lookup.wgsl";
@@ -100,6 +110,7 @@ impl Gpu {
 /// The lookup's uniform for one light's maps.
 fn shadow_light(
     p: &SmParams,
+    contact: Option<&ContactParams>,
     filters: &MapFilters,
     maps: &LightMaps,
     light: &zoo_host::Light,
@@ -110,13 +121,16 @@ fn shadow_light(
         map: MapHeader::new(maps, p.map.normal_offset),
         map_filter: filters.filter(&p.filtering, size),
         debug: u32::from(debug),
-        _pad: [0.0; 3],
+        contact_texels: contact.map_or(0.0, |c| c.contact_texels),
+        contact_steps: contact.map_or(0, |c| c.contact_steps),
+        contact_thickness: contact.map_or(0.0, |c| c.contact_thickness),
     }
 }
 
-/// Shadow maps with PCF.
+/// Shadow maps with PCF, and contact shadows where `contact` is set.
 pub struct ShadowMaps {
     params: SmParams,
+    contact: Option<ContactParams>,
     gpu: LazyGpu<Gpu>,
 }
 
@@ -177,7 +191,7 @@ impl ShadowTechnique for ShadowMaps {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
-        let p = &self.params;
+        let (p, contact) = (&self.params, self.contact.as_ref());
         let Gpu {
             maps,
             lookup,
@@ -187,7 +201,7 @@ impl ShadowTechnique for ShadowMaps {
         maps.record(ctx, recorder, DEPTH_PASS)?;
         let uniform = |l: &LightMaps, debug| {
             let light = &ctx.lights[l.light];
-            Some(shadow_light(p, filters, l, light, debug))
+            Some(shadow_light(p, contact, filters, l, light, debug))
         };
         lookup.record(
             ctx,
@@ -203,6 +217,12 @@ impl ShadowTechnique for ShadowMaps {
         // Biases and culling live in the depth pipeline (`flags(rebuild)`); the map size is
         // applied by the map set at the next `prepare`, the rest reaches the shader through the
         // per-light uniforms written every frame.
+        if self.contact.is_some() {
+            let (params, contact) = contact::split_values(values)?;
+            let update = self.params.update(&params)?;
+            self.contact = Some(contact);
+            return Ok(update);
+        }
         Ok(self.params.update(values)?)
     }
 
@@ -233,6 +253,7 @@ fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn Shado
     let params = SmParams::from_values(values)?;
     Ok(Box::new(ShadowMaps {
         params,
+        contact: None,
         gpu: LazyGpu::default(),
     }))
 }
@@ -265,7 +286,10 @@ mod tests {
         let (size, fields) = zoo_host::mirror_fields!(ShadowLight {
             map,
             map_filter,
-            debug
+            debug,
+            contact_texels,
+            contact_steps,
+            contact_thickness
         });
         check_mirror(&shader(), "ShadowLight", size, &fields, SizeRule::Equal).unwrap();
     }

@@ -7,7 +7,7 @@
 
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo};
-use zoo_shadow_maps::{MomentMaps, MomentMethod, MomentSettings, filterable_rg_format};
+use zoo_shadow_maps::{MOMENTS_RG_FORMAT, MomentMaps, MomentMethod, MomentSettings};
 
 zoo_host::technique_params! {
     /// Parameters of variance shadow maps.
@@ -16,8 +16,7 @@ zoo_host::technique_params! {
         map_size: u32 = 2048, range(256, 8192), step(256);
         /// Gaussian blur of the moments, in taps on each side (0: bilinear filtering only).
         blur_radius: u32 = 2, range(0, 16), step(1);
-        /// Smallest variance, in squared light-depth units (0 to 1 over the map; at least 1e-4
-        /// with 16-bit moments).
+        /// Smallest variance, in squared light-depth units (0 to 1 over the map).
         min_variance: f32 = 0.000001, range(0.0, 0.001), step(0.000001);
         /// Light-bleeding reduction: bounds below it become 0 and the rest is rescaled.
         bleeding_reduction: f32 = 0.2, range(0.0, 0.95), step(0.05);
@@ -33,20 +32,14 @@ struct Vsm {
     maps: LazyGpu<MomentMaps>,
 }
 
-/// The moment maps' settings for `p`, with maps of `format`.
-fn settings(p: &VsmParams, format: Option<wgpu::TextureFormat>) -> MomentSettings {
-    // Half floats hold E[z²] - E[z]² only to about 1e-4 near depth 1.
-    let half = format == Some(wgpu::TextureFormat::Rg16Float);
+/// The moment maps' settings for `p`.
+fn settings(p: &VsmParams) -> MomentSettings {
     MomentSettings {
         map_size: p.map_size,
         stable_fit: p.stable_fit,
         blur_radius: p.blur_radius,
         normal_offset: p.normal_offset,
-        bias: if half {
-            p.min_variance.max(1e-4)
-        } else {
-            p.min_variance
-        },
+        bias: p.min_variance,
         bleeding_reduction: p.bleeding_reduction,
     }
 }
@@ -62,11 +55,11 @@ impl ShadowTechnique for Vsm {
                 label: "VSM",
                 shader: "vsm/vsm.wgsl",
                 prelude: String::new(),
-                format: filterable_rg_format(&ctx.gpu.device),
+                format: MOMENTS_RG_FORMAT,
             };
             MomentMaps::new(ctx, &method)
         })?;
-        maps.prepare(ctx, changes, &settings(&self.params, maps.format()));
+        maps.prepare(ctx, changes, &settings(&self.params));
         Ok(())
     }
 
@@ -76,7 +69,7 @@ impl ShadowTechnique for Vsm {
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
         let maps = self.maps.get_mut()?;
-        maps.record(ctx, recorder, &settings(&self.params, maps.format()))
+        maps.record(ctx, recorder, &settings(&self.params))
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -108,7 +101,6 @@ zoo_host::register_technique! {
     source: "seed 000 section 13.3 (Donnelly and Lauritzen 2006)",
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
-    optional_features: || wgpu::Features::FLOAT32_FILTERABLE,
     params: VsmParams::schema,
     create: create,
 }

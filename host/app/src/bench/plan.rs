@@ -162,7 +162,7 @@ pub fn expand(plan: &BenchPlan) -> anyhow::Result<Vec<Configuration>> {
             .collect();
         params::apply_assignments(&schema, &mut base, &fixed)
             .with_context(|| format!("technique `{}`", technique.id))?;
-        let mut configs = vec![Configuration {
+        let configs = vec![Configuration {
             run: plan.run.clone(),
             technique,
             params: base,
@@ -171,39 +171,64 @@ pub fn expand(plan: &BenchPlan) -> anyhow::Result<Vec<Configuration>> {
             tessellation: 1.0,
             lights: None,
         }];
-        for sweep in &plan.sweeps {
-            if let SweepKey::Param { technique: t, .. } = &sweep.key
-                && t != technique.id
-            {
-                continue;
-            }
-            let mut next = Vec::new();
-            for config in &configs {
-                for value in &sweep.values {
-                    let mut c = config.clone();
-                    match &sweep.key {
-                        SweepKey::Size => {
-                            c.size = parse_size(value).map_err(|e| anyhow::anyhow!(e))?
-                        }
-                        SweepKey::Tessellation => c.tessellation = value.parse()?,
-                        SweepKey::Lights => c.lights = Some(value.parse()?),
-                        SweepKey::Param { key, .. } => {
-                            params::apply_assignments(
-                                &schema,
-                                &mut c.params,
-                                &[(key.clone(), value.clone())],
-                            )?;
-                        }
-                    }
-                    c.swept.push((sweep.name.clone(), value.clone()));
-                    next.push(c);
+        let own: Vec<&Sweep> = plan
+            .sweeps
+            .iter()
+            .filter(|sweep| match &sweep.key {
+                SweepKey::Param { technique: t, .. } => t == technique.id,
+                _ => true,
+            })
+            .collect();
+        let configs = cartesian(configs, &own, |c, sweep, value| {
+            match &sweep.key {
+                SweepKey::Size => c.size = parse_size(value).map_err(|e| anyhow::anyhow!(e))?,
+                SweepKey::Tessellation => c.tessellation = value.parse()?,
+                SweepKey::Lights => c.lights = Some(value.parse()?),
+                SweepKey::Param { key, .. } => {
+                    params::apply_assignments(
+                        &schema,
+                        &mut c.params,
+                        &[(key.clone(), value.to_string())],
+                    )?;
                 }
             }
-            configs = next;
-        }
+            c.swept.push((sweep.name.clone(), value.to_string()));
+            Ok(())
+        })?;
         out.extend(configs);
     }
     Ok(out)
+}
+
+/// The cartesian product of `configs` with the values of each of `sweeps`, in order: `apply`
+/// sets one sweep's value on a copy of a configuration.
+pub fn cartesian<C: Clone>(
+    mut configs: Vec<C>,
+    sweeps: &[&Sweep],
+    mut apply: impl FnMut(&mut C, &Sweep, &str) -> anyhow::Result<()>,
+) -> anyhow::Result<Vec<C>> {
+    for sweep in sweeps {
+        let mut next = Vec::with_capacity(configs.len() * sweep.values.len());
+        for config in &configs {
+            for value in &sweep.values {
+                let mut c = config.clone();
+                apply(&mut c, sweep, value)?;
+                next.push(c);
+            }
+        }
+        configs = next;
+    }
+    Ok(configs)
+}
+
+/// Parses the `--sweep KEY=v1,v2,...` arguments.
+pub fn parse_sweeps(args: &[(String, String)]) -> anyhow::Result<Vec<Sweep>> {
+    args.iter()
+        .map(|(key, values)| {
+            let values: Vec<String> = values.split(',').map(str::to_string).collect();
+            parse_sweep(key, &values)
+        })
+        .collect()
 }
 
 /// Builds the plan for a command-line run.
@@ -214,14 +239,7 @@ pub fn plan_from_args(args: &BenchArgs, scene: &Path) -> anyhow::Result<BenchPla
     if !techniques.iter().any(|t| t.id == baseline.id) {
         techniques.insert(0, baseline);
     }
-    let sweeps = args
-        .sweep
-        .iter()
-        .map(|(key, values)| {
-            let values: Vec<String> = values.split(',').map(str::to_string).collect();
-            parse_sweep(key, &values)
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
+    let sweeps = parse_sweeps(&args.sweep)?;
     let set = split_sets(&args.set, &techniques)?;
     Ok(BenchPlan {
         run: scene

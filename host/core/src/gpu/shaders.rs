@@ -112,7 +112,7 @@ impl ShaderLibrary {
 
     /// The `shaders/` folder this binary was built from, if it still exists.
     pub fn build_time_root() -> Option<PathBuf> {
-        let root = PathBuf::from(embedded::SOURCE_ROOT);
+        let root = PathBuf::from(embedded::SOURCE_ROOT).canonicalize().ok()?;
         root.is_dir().then_some(root)
     }
 
@@ -428,6 +428,29 @@ mod tests {
                 assert_eq!((file.as_str(), line), ("main.wgsl", 5))
             }
             other => panic!("unexpected {other}"),
+        }
+    }
+
+    /// The binary embeds the shaders of the checkout it was built in, as they are now: every
+    /// `.wgsl` file of this checkout's `shaders/`, and no other (a build script that watched
+    /// another checkout's absolute paths once kept serving stale copies after edits).
+    #[test]
+    fn embedded_shaders_are_this_checkout_s() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shaders");
+        let root = root.canonicalize().unwrap();
+        assert_eq!(ShaderLibrary::build_time_root(), Some(root.clone()));
+        let mut on_disk = Vec::new();
+        collect_wgsl(&root, &root, &mut on_disk);
+        on_disk.sort();
+        let mut embedded: Vec<String> = ShaderLibrary::names().map(str::to_string).collect();
+        embedded.sort();
+        assert_eq!(embedded, on_disk);
+        for (name, source) in embedded::EMBEDDED {
+            let file = std::fs::read_to_string(root.join(name)).unwrap();
+            assert!(
+                file == *source,
+                "shaders/{name} differs from its embedded copy"
+            );
         }
     }
 }

@@ -139,6 +139,9 @@ impl DebugViewPass {
                 (if source.linearize.is_some() { 3 } else { 2 }, 0, min, max),
             ),
             ViewMapping::Integer => (SourceKind::Uint, (4, 0, 0.0, 1.0)),
+            ViewMapping::FloatBits { channel, min, max } => {
+                (SourceKind::Uint, (5, channel.min(3), min, max))
+            }
         };
         let (near, far) = source.linearize.unwrap_or((0.0, 1.0));
         let (slice_axis, slice_index) = source.slice.map_or((0, 0), |slice| {
