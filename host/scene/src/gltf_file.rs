@@ -9,7 +9,7 @@ use glam::{Mat4, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
-use crate::material::ImageSource;
+use crate::image_source::ImageSource;
 use crate::mesh::{MeshData, MeshReport};
 
 /// Extensions whose absence changes nothing the zoo draws; every other one is named in a

@@ -7,6 +7,7 @@ pub mod description;
 pub mod gltf_file;
 #[cfg(any(test, feature = "test-support"))]
 pub mod gltf_writer;
+pub mod image_source;
 pub mod material;
 pub mod mesh;
 pub mod paths;
@@ -20,7 +21,8 @@ use glam::{Mat4, Vec3, Vec4};
 pub use adjacency::{Adjacency, EdgeKind, EdgeRecord};
 pub use description::*;
 pub use gltf_file::{GltfError, GltfFile};
-pub use material::{AlphaMask, ImageSource, TextureLayer, TextureUse, Textures};
+pub use image_source::ImageSource;
+pub use material::{AlphaMask, TextureLayer, TextureUse, Textures};
 pub use mesh::{MeshData, MeshReport};
 
 use material::{FileMaterial, ObjectMaterial, TextureRequests, check_material, mesh_folder};

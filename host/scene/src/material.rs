@@ -4,12 +4,12 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
 use crate::description::{MeshDesc, ObjectDesc};
 use crate::gltf_file::{GltfAlpha, GltfMaterial};
+use crate::image_source::ImageSource;
 
 /// Largest side of the scene's texture layers; bigger images are scaled down to it.
 pub const MAX_TEXTURE_SIZE: u32 = 1024;
@@ -28,23 +28,7 @@ pub enum TextureUse {
     Mask,
 }
 
-/// Where an image's encoded bytes are.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ImageSource {
-    /// A file of its own.
-    File(PathBuf),
-    /// Bytes inside another file (a GLB's binary chunk, a data URI); `name` says where.
-    Encoded { name: PathBuf, bytes: Arc<[u8]> },
-}
-
 impl ImageSource {
-    /// The file, or the place in a file, that names the image in warnings and layers.
-    pub fn name(&self) -> &Path {
-        match self {
-            ImageSource::File(path) | ImageSource::Encoded { name: path, .. } => path,
-        }
-    }
-
     fn decode(&self) -> image::ImageResult<image::DynamicImage> {
         match self {
             ImageSource::File(path) => image::open(path),

@@ -3,7 +3,7 @@
 //! `page_size >> l` (a tile of tier `l`), numbered along the Z-order curve, so a free square
 //! of any tier is found by descending the tree instead of scanning texels.
 
-use crate::atlas::{AtlasLimits, MapTile, z_order};
+use crate::atlas_pages::{AtlasLimits, MapTile};
 
 /// What a node's square holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -126,6 +126,16 @@ fn morton(x: u32, y: u32) -> usize {
         index |= (((y >> bit) & 1) as usize) << (2 * bit + 1);
     }
     index
+}
+
+/// The cell at `index` along a Z-order (Morton) curve.
+pub(crate) fn z_order(index: u64) -> [u32; 2] {
+    let (mut x, mut y) = (0u32, 0u32);
+    for bit in 0..32 {
+        x |= (((index >> (2 * bit)) & 1) as u32) << bit;
+        y |= (((index >> (2 * bit + 1)) & 1) as u32) << bit;
+    }
+    [x, y]
 }
 
 #[cfg(test)]

@@ -7,9 +7,9 @@ use zoo_host::gpu::PassRecorder;
 use zoo_host::kit::{UniformSlots, bind_group, bind_group_layout, texture};
 use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
 
-use crate::atlas::MapTile;
+use crate::atlas_pages::MapTile;
 use crate::maps::MapArray;
-use crate::set::TilePass;
+use crate::tile_pass::TilePass;
 
 /// `BlurParams` in `shadow-maps/blur.wgsl`.
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]

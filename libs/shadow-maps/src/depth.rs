@@ -8,11 +8,11 @@ use zoo_host::gpu::PassRecorder;
 use zoo_host::render::SceneBuffers;
 use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
 
-use crate::atlas::MapTile;
+use crate::atlas_pages::MapTile;
 use crate::light_space::{LightFrustum, Projection};
 use crate::maps::{MAP_FORMAT, MapArray};
 use crate::planning::LightMaps;
-use crate::set::TilePass;
+use crate::tile_pass::TilePass;
 
 /// Bytes between layer cameras: a uniform dynamic-offset slot, and `LayerCamera` as an array
 /// element for lookups that project into any layer.

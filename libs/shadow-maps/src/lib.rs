@@ -12,6 +12,7 @@
 //! live in WGSL: `shaders/shadow-maps/`.
 
 pub mod atlas;
+pub mod atlas_pages;
 pub mod atlas_space;
 pub mod blur;
 pub mod cascades;
@@ -27,10 +28,11 @@ pub mod moments;
 pub mod params;
 pub mod planning;
 pub mod set;
+pub mod tile_pass;
 pub mod translucent;
 pub mod warped;
 
-pub use atlas::{AtlasLimits, MEMORY_BUDGET, MapTile};
+pub use atlas_pages::{AtlasLimits, MEMORY_BUDGET, MapTile};
 pub use blur::LayerBlur;
 pub use cascades::Cascades;
 pub use depth::{CAMERA_STRIDE, ColorOutput, DepthPass, DepthState, LayerCamera};
@@ -44,5 +46,6 @@ pub use planning::{
     LayerPlan, LightMaps, MapScale, PlanInputs, StandardLayers, light_scissor, light_size,
     object_bounds, plan_with,
 };
-pub use set::{ShadowMapSet, TilePass, layer_pass_name};
+pub use set::ShadowMapSet;
+pub use tile_pass::{TilePass, layer_pass_name};
 pub use translucent::{TRANSLUCENT_FORMAT, TranslucentPass};

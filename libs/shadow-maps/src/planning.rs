@@ -3,7 +3,8 @@
 use zoo_host::glam::{Mat4, UVec2, Vec2, Vec3};
 use zoo_host::scene::{Camera, Light, LightKind, Scene};
 
-use crate::atlas::{Allocation, AtlasLimits, MapTile, allocate, wanted_tier};
+use crate::atlas::{Allocation, allocate, wanted_tier};
+use crate::atlas_pages::{AtlasLimits, MapTile};
 use crate::light_space::{
     Aabb, LightFrustum, Projection, cube_frustums, directional_frustum, spot_frustum,
 };

@@ -572,7 +572,7 @@ mod tests {
         let block = zoo_host::gpu::layout::wgsl_integer_constant(&source, "MIN_BLOCK");
         assert_eq!(block, Ok(i64::from(gpu::MIN_BLOCK)));
         // Min texels never straddle two atlas tiles.
-        assert!(zoo_shadow_maps::atlas::TILE_ALIGN.is_multiple_of(gpu::MIN_BLOCK));
+        assert!(zoo_shadow_maps::atlas_pages::TILE_ALIGN.is_multiple_of(gpu::MIN_BLOCK));
     }
 
     #[test]

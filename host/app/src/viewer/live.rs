@@ -17,7 +17,7 @@ use zoo_host::scene::shading::contributes;
 use zoo_host::technique::counter;
 use zoo_host::{Renderer, View};
 
-use super::reference::{JudgedView, Judgement};
+use super::judgement::{JudgedView, Judgement};
 use crate::gpu_judge::{MAX_SAMPLES, TRACER, light_reference, read_traced, tracer_values};
 
 /// Area rays a pixel and light each frame adds.

@@ -8,6 +8,7 @@
 
 pub mod camera;
 pub mod hot_reload;
+pub mod judgement;
 pub mod lights;
 mod live;
 mod panels;
