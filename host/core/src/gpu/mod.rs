@@ -2,6 +2,7 @@
 
 pub mod adapter;
 mod context;
+pub mod gpu_struct;
 pub mod layout;
 pub mod readback;
 mod recorder;
@@ -9,6 +10,7 @@ mod shaders;
 mod targets;
 
 pub use context::{GpuContext, GpuError};
+pub use gpu_struct::{GpuStruct, GpuType, gpu_bytes, gpu_bytes_padded};
 pub use recorder::{
     FrameTimings, PASSES_PER_CHUNK, PassOwner, PassRecorder, PassTiming, RecordedComputePass,
     RecordedRenderPass, StatisticsQueries, TimestampQueries, TimingSource,
