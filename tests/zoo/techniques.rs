@@ -447,6 +447,23 @@ fn every_shader_validates_with_the_generated_modules() {
     }
 }
 
+/// Every GPU struct the linked crates declare with `gpu_struct!` is laid out in Rust exactly
+/// as naga lays out its generated WGSL (offsets and size), and no file shadows its module.
+#[test]
+fn every_gpu_struct_is_laid_out_as_naga_lays_it_out() {
+    use zoo_host::ShaderLibrary;
+    use zoo_host::gpu::gpu_struct::{check_with_naga, registered_structs};
+    let files: Vec<_> = ShaderLibrary::names().collect();
+    let mut problems = Vec::new();
+    for s in registered_structs() {
+        assert!(!files.contains(&s.module), "{} shadows `{}`", s.module, s.name);
+        if let Err(e) = check_with_naga(s) {
+            problems.push(e);
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
 /// Parameter keys are unique within each technique (shared groups included).
 #[test]
 fn every_technique_has_unique_parameter_keys() {
