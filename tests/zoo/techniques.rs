@@ -456,7 +456,12 @@ fn every_gpu_struct_is_laid_out_as_naga_lays_it_out() {
     let files: Vec<_> = ShaderLibrary::names().collect();
     let mut problems = Vec::new();
     for s in registered_structs() {
-        assert!(!files.contains(&s.module), "{} shadows `{}`", s.module, s.name);
+        assert!(
+            !files.contains(&s.module),
+            "{} shadows `{}`",
+            s.module,
+            s.name
+        );
         if let Err(e) = check_with_naga(s) {
             problems.push(e);
         }

@@ -306,15 +306,18 @@ macro_rules! gpu_struct {
                         <$ty as $crate::gpu::gpu_struct::GpuType>::SIZE,
                     ), )*
                 ]);
-                let mut members = Vec::new();
-                $(
-                    members.push($crate::gpu::gpu_struct::Member {
-                        name: stringify!($field),
-                        wgsl_type: <$ty as $crate::gpu::gpu_struct::GpuType>::wgsl_type(),
-                        offset: offsets[members.len()],
-                    });
-                )*
-                members
+                let names = [$( stringify!($field), )*];
+                let types = vec![$( <$ty as $crate::gpu::gpu_struct::GpuType>::wgsl_type(), )*];
+                names
+                    .into_iter()
+                    .zip(types)
+                    .zip(offsets)
+                    .map(|((name, wgsl_type), offset)| $crate::gpu::gpu_struct::Member {
+                        name,
+                        wgsl_type,
+                        offset,
+                    })
+                    .collect()
             }
         }
 
