@@ -1,5 +1,5 @@
 // Per-frame data shared by the host and every technique: bind group 0.
-// Layouts mirror `zoo_host::render::frame` (CameraUniform, GpuLight, GpuObject).
+// `Camera` mirrors `zoo_host::render::frame::CameraUniform`.
 
 struct Camera {
     view: mat4x4<f32>,
@@ -19,36 +19,11 @@ const LIGHT_DIRECTIONAL: u32 = 0u;
 const LIGHT_POINT: u32 = 1u;
 const LIGHT_SPOT: u32 = 2u;
 
-struct Light {
-    position: vec3<f32>,
-    kind: u32,
-    // Unit direction the light travels (directional, spot).
-    direction: vec3<f32>,
-    range: f32,
-    // Colour times intensity.
-    radiance: vec3<f32>,
-    // Emitter radius (point, spot) or angular radius in radians (directional).
-    radius: f32,
-    cos_outer: f32,
-    cos_inner: f32,
-    // Visibility slot of this light: array layer and channel (0..3).
-    slot_layer: u32,
-    slot_channel: u32,
-}
-
-struct Object {
-    // Takes the object's stored vertices to world space (`SceneObject::placement`).
-    placement: mat4x4<f32>,
-    // rgb albedo, a specular strength.
-    color: vec4<f32>,
-    // x shininess, y casts shadows (0 or 1).
-    material: vec4<f32>,
-    // Translucent casters: rgb the colour they let through, w = 1; opaque casters: all 0.
-    transmittance: vec4<f32>,
-    // Its first drawn triangle (instances counted, in object order), its first stored
-    // triangle, its triangle count.
-    drawn: vec4<u32>,
-}
+// `zoo_host::render::frame::GpuLight` and `GpuObject`, by their WGSL names.
+#import "common/light.wgsl"
+#import "common/object.wgsl"
+alias Light = GpuLight;
+alias Object = GpuObject;
 
 @group(0) @binding(0) var<uniform> camera: Camera;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;

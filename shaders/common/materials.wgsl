@@ -1,19 +1,11 @@
 // The scene's materials: bind group 1 of the passes that draw the scene's geometry (the
 // G-buffer, the shadow-map depth passes, planar's flattened casters, lpv's reflective maps).
-// Layout mirrors `zoo_host::render::materials`.
+// Records: `zoo_host::render::materials::GpuObjectMaterial`.
 
 #import "common/alpha_test.wgsl"
+#import "common/object_material.wgsl"
 
-struct ObjectMaterial {
-    // Texture layers, -1 for none.
-    albedo_layer: i32,
-    mask_layer: i32,
-    // Coverage below which a masked texel is a hole.
-    alpha_cutoff: f32,
-    _pad: f32,
-}
-
-@group(1) @binding(0) var<storage, read> object_materials: array<ObjectMaterial>;
+@group(1) @binding(0) var<storage, read> object_materials: array<GpuObjectMaterial>;
 @group(1) @binding(1) var material_textures: texture_2d_array<f32>;
 @group(1) @binding(2) var material_sampler: sampler;
 

@@ -2,24 +2,7 @@
 
 #import "common/fullscreen.wgsl"
 
-struct ViewParams {
-    // 0 colour, 1 single channel, 2 depth (raw), 3 depth linearised with near/far, 4 integer,
-    // 5 single channel of float bits.
-    mode: u32,
-    channel: u32,
-    min_value: f32,
-    max_value: f32,
-    near: f32,
-    far: f32,
-    // Alpha of the output: 1 full screen, less when blended over the final image.
-    opacity: f32,
-    // 3D sources: the axis across which the slice is taken (0 x, 1 y, 2 z) and its texel.
-    slice_axis: u32,
-    slice_index: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
+#import "host/view_params.wgsl"
 
 @group(0) @binding(0) var<uniform> params: ViewParams;
 @group(0) @binding(1) var source_float: texture_2d<f32>;

@@ -3,11 +3,7 @@
 
 #import "common/fullscreen.wgsl"
 
-struct DifferenceParams {
-    gain: f32,
-    context: f32,
-    _pad: vec2<f32>,
-}
+#import "host/difference_params.wgsl"
 
 @group(0) @binding(0) var<uniform> params: DifferenceParams;
 @group(0) @binding(1) var image_a: texture_2d<f32>;

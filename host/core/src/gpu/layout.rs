@@ -210,7 +210,7 @@ mod tests {
         let signed = "const MODE_A: i32 = 1;\n";
         assert!(ChoiceCodes::read(signed, "MODE", &["A"]).is_err());
     }
-    use crate::render::frame::{CameraUniform, GpuLight, GpuObject};
+    use crate::render::frame::CameraUniform;
 
     fn frame() -> String {
         ShaderLibrary::embedded()
@@ -236,39 +236,25 @@ mod tests {
             _pad
         });
         check_mirror(&source, "Camera", size, &fields, SizeRule::Equal).unwrap();
-        let (size, fields) = crate::mirror_fields!(GpuLight {
-            position,
-            kind,
-            direction,
-            range,
-            radiance,
-            radius,
-            cos_outer,
-            cos_inner,
-            slot_layer,
-            slot_channel
-        });
-        check_mirror(&source, "Light", size, &fields, SizeRule::Equal).unwrap();
-        let (size, fields) = crate::mirror_fields!(GpuObject {
-            placement,
-            color,
-            material,
-            transmittance,
-            drawn
-        });
-        check_mirror(&source, "Object", size, &fields, SizeRule::Equal).unwrap();
+    }
+
+    #[repr(C)]
+    struct PartialLight {
+        position: [f32; 3],
+        kind: u32,
+        direction: [f32; 3],
     }
 
     #[test]
     fn embedded_mirrors_name_the_shader_on_failure() {
-        let mirror = crate::mirror_fields!(GpuLight {
+        let mirror = crate::mirror_fields!(PartialLight {
             position,
             kind,
             direction
         });
-        let missing = check_embedded_mirror("nowhere.wgsl", "GpuLight", mirror, SizeRule::Equal);
+        let missing = check_embedded_mirror("nowhere.wgsl", "Light", mirror, SizeRule::Equal);
         assert!(missing.unwrap_err().contains("nowhere.wgsl"));
-        let mirror = crate::mirror_fields!(GpuLight {
+        let mirror = crate::mirror_fields!(PartialLight {
             position,
             kind,
             direction

@@ -1,10 +1,10 @@
 //! Bind group 0: camera, lights and objects, laid out as in `shaders/common/frame.wgsl`.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, UVec2, Vec3};
+use glam::{Mat4, UVec2, UVec4, Vec3, Vec4};
 
 use super::visibility::SlotAssignment;
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, GpuType, gpu_bytes};
 use crate::scene::{Camera, Light, LightKind, Scene};
 
 /// `Camera` in WGSL.
@@ -24,35 +24,46 @@ pub struct CameraUniform {
     pub _pad: f32,
 }
 
-/// `Light` in WGSL.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuLight {
-    pub position: [f32; 3],
-    pub kind: u32,
-    pub direction: [f32; 3],
-    pub range: f32,
-    pub radiance: [f32; 3],
-    pub radius: f32,
-    pub cos_outer: f32,
-    pub cos_inner: f32,
-    pub slot_layer: u32,
-    pub slot_channel: u32,
+crate::gpu_struct! {
+    "common/light.wgsl" =>
+    /// `Light` in WGSL (`common/frame.wgsl` aliases it).
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct GpuLight {
+        pub position: Vec3,
+        /// `LIGHT_DIRECTIONAL`, `LIGHT_POINT` or `LIGHT_SPOT` in `common/frame.wgsl`.
+        pub kind: u32,
+        /// Unit direction the light travels (directional, spot).
+        pub direction: Vec3,
+        pub range: f32,
+        /// Colour times intensity.
+        pub radiance: Vec3,
+        /// Emitter radius (point, spot) or angular radius in radians (directional).
+        pub radius: f32,
+        pub cos_outer: f32,
+        pub cos_inner: f32,
+        /// Visibility slot of this light: array layer and channel (0..3).
+        pub slot_layer: u32,
+        pub slot_channel: u32,
+    }
 }
 
-/// `Object` in WGSL.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuObject {
-    /// [`crate::scene::SceneObject::placement`]: stored vertices to world space.
-    pub placement: [[f32; 4]; 4],
-    pub color: [f32; 4],
-    pub material: [f32; 4],
-    /// Translucent casters: the colour they let through and w = 1; opaque: (0, 0, 0, 0).
-    pub transmittance: [f32; 4],
-    /// Its first drawn triangle (instances counted, in object order), its first stored
-    /// triangle, its triangle count, 0.
-    pub drawn: [u32; 4],
+crate::gpu_struct! {
+    "common/object.wgsl" =>
+    /// `Object` in WGSL (`common/frame.wgsl` aliases it).
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct GpuObject {
+        /// [`crate::scene::SceneObject::placement`]: stored vertices to world space.
+        pub placement: Mat4,
+        /// rgb albedo, a specular strength.
+        pub color: Vec4,
+        /// x shininess, y casts shadows (0 or 1).
+        pub material: Vec4,
+        /// Translucent casters: the colour they let through and w = 1; opaque: (0, 0, 0, 0).
+        pub transmittance: Vec4,
+        /// Its first drawn triangle (instances counted, in object order), its first stored
+        /// triangle, its triangle count, 0.
+        pub drawn: UVec4,
+    }
 }
 
 /// The view and projection of the current camera at the current size.
@@ -88,19 +99,19 @@ impl GpuLight {
         let outer = light.spot_angle;
         let inner = outer * (1.0 - light.spot_softness);
         GpuLight {
-            position: light.position.to_array(),
+            position: light.position,
             kind: match light.kind {
                 LightKind::Directional => 0,
                 LightKind::Point => 1,
                 LightKind::Spot => 2,
             },
-            direction: light.direction.to_array(),
+            direction: light.direction,
             range: if light.range.is_finite() {
                 light.range
             } else {
                 f32::MAX
             },
-            radiance: light.radiance.to_array(),
+            radiance: light.radiance,
             radius: light.radius,
             cos_outer: outer.cos(),
             cos_inner: inner.cos(),
@@ -172,7 +183,7 @@ impl FrameBindings {
         );
         let object_buffer = buffer(
             "objects storage",
-            size_of::<GpuObject>() * scene.objects.len(),
+            GpuObject::SIZE * scene.objects.len(),
             wgpu::BufferUsages::STORAGE,
         );
         let light_capacity = scene.lights.len();
@@ -181,21 +192,19 @@ impl FrameBindings {
             .objects
             .iter()
             .map(|o| GpuObject {
-                placement: o.placement.to_cols_array_2d(),
+                placement: o.placement,
                 drawn: {
                     let (first, count) = (o.indices.start / 3, o.indices.len() / 3);
                     drawn += count;
-                    [(drawn - count) as u32, first as u32, count as u32, 0]
+                    UVec4::new((drawn - count) as u32, first as u32, count as u32, 0)
                 },
-                color: o.color.extend(o.specular).to_array(),
-                material: [o.shininess, f32::from(u8::from(o.casts_shadows)), 0.0, 0.0],
-                transmittance: o
-                    .transmittance()
-                    .map_or([0.0; 4], |t| t.extend(1.0).to_array()),
+                color: o.color.extend(o.specular),
+                material: Vec4::new(o.shininess, f32::from(u8::from(o.casts_shadows)), 0.0, 0.0),
+                transmittance: o.transmittance().map_or(Vec4::ZERO, |t| t.extend(1.0)),
             })
             .collect();
         gpu.queue
-            .write_buffer(&object_buffer, 0, bytemuck::cast_slice(&objects));
+            .write_buffer(&object_buffer, 0, &gpu_bytes(&objects));
         let light_buffer = light_buffer(gpu, light_capacity);
         let bind_group = bind_group(gpu, &layout, &camera_buffer, &light_buffer, &object_buffer);
         FrameBindings {
@@ -252,7 +261,7 @@ impl FrameBindings {
             .map(|(i, l)| GpuLight::new(l, slots.slot(i)))
             .collect();
         gpu.queue
-            .write_buffer(&self.light_buffer, 0, bytemuck::cast_slice(&gpu_lights));
+            .write_buffer(&self.light_buffer, 0, &gpu_bytes(&gpu_lights));
         self.matrices = m;
     }
 }
@@ -260,7 +269,7 @@ impl FrameBindings {
 fn light_buffer(gpu: &GpuContext, count: usize) -> wgpu::Buffer {
     gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("lights storage"),
-        size: (size_of::<GpuLight>() * count.max(1)) as u64,
+        size: (GpuLight::SIZE * count.max(1)) as u64,
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
