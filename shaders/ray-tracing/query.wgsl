@@ -15,20 +15,16 @@ enable wgpu_ray_query;
 #import "ray-tracing/hit.wgsl"
 #import "ray-tracing/translucent.wgsl"
 
-// Mirrors `GpuMaskedTriangle`: a masked caster's corners' texture coordinates and alpha test,
+// `GpuMaskedTriangle`: a masked caster's corners' texture coordinates and alpha test,
 // indexed by its primitive index in the masked geometry (masked instances are placed into
 // it, so no candidate's instance data is read).
-struct RtMaskedTriangle {
-    uv: array<vec2<f32>, 3>,
-    mask_layer: i32,
-    alpha_cutoff: f32,
-}
+#import "ray-tracing/masked_triangle.wgsl"
 
 @group(3) @binding(0) var rt_scene: acceleration_structure;
-@group(3) @binding(1) var<storage, read> rt_masked: array<RtMaskedTriangle>;
+@group(3) @binding(1) var<storage, read> rt_masked: array<GpuMaskedTriangle>;
 @group(3) @binding(2) var rt_textures: texture_2d_array<f32>;
 @group(3) @binding(3) var rt_sampler: sampler;
-@group(3) @binding(4) var<storage, read> rt_translucent: array<RtTranslucent>;
+@group(3) @binding(4) var<storage, read> rt_translucent: array<GpuTranslucent>;
 
 // Instance masks (`zoo_ray_tracing`'s `BLOCKING_MASK` and `TRANSLUCENT_MASK`).
 const RT_BLOCKING: u32 = 1u;

@@ -8,64 +8,25 @@
 #import "common/alpha_test.wgsl"
 #import "ray-tracing/hit.wgsl"
 #import "ray-tracing/translucent.wgsl"
+// `zoo_ray_tracing`'s records: nodes (children `first` and `first + 1`, or triangles
+// `first..first + count`), triangles, their texture coordinates, instances and the roots.
+#import "ray-tracing/node.wgsl"
+#import "ray-tracing/triangle.wgsl"
+#import "ray-tracing/texcoords.wgsl"
+#import "ray-tracing/instance.wgsl"
+#import "ray-tracing/roots.wgsl"
 
-// Mirrors `GpuNode`: children `first` and `first + 1`, or triangles `first..first + count`.
-struct RtNode {
-    min: vec3<f32>,
-    first: u32,
-    max: vec3<f32>,
-    count: u32,
-}
-
-// Mirrors `GpuTriangle`: a corner, the edges from it, its translucent object (for translucent
-// casters drawn once; an instance names its own) and its alpha test.
-struct RtTriangle {
-    v0: vec3<f32>,
-    translucent: u32,
-    e1: vec3<f32>,
-    mask_layer: i32,
-    e2: vec3<f32>,
-    alpha_cutoff: f32,
-}
-
-// Mirrors `GpuTexcoords`.
-struct RtTexcoords {
-    uv: array<vec2<f32>, 3>,
-    _pad: vec2<f32>,
-}
-
-@group(3) @binding(0) var<storage, read> rt_nodes: array<RtNode>;
-@group(3) @binding(1) var<storage, read> rt_triangles: array<RtTriangle>;
-@group(3) @binding(2) var<storage, read> rt_texcoords: array<RtTexcoords>;
+@group(3) @binding(0) var<storage, read> rt_nodes: array<GpuNode>;
+@group(3) @binding(1) var<storage, read> rt_triangles: array<GpuTriangle>;
+@group(3) @binding(2) var<storage, read> rt_texcoords: array<GpuTexcoords>;
 @group(3) @binding(3) var rt_textures: texture_2d_array<f32>;
 @group(3) @binding(4) var rt_sampler: sampler;
-@group(3) @binding(5) var<storage, read> rt_translucent: array<RtTranslucent>;
+@group(3) @binding(5) var<storage, read> rt_translucent: array<GpuTranslucent>;
 
-// Mirrors `GpuInstance`: an instance's inverse placement (the rows of a 3x4 matrix), the root
-// node of its mesh's hierarchy, and its translucent object (`RT_NO_OBJECT` for a blocking
-// caster).
-struct RtInstance {
-    to_local: array<vec4<f32>, 3>,
-    root: u32,
-    translucent: u32,
-    _pad0: u32,
-    _pad1: u32,
-}
+@group(3) @binding(6) var<storage, read> rt_instances: array<GpuInstance>;
+@group(3) @binding(7) var<uniform> rt_roots: GpuRoots;
 
-// Mirrors `GpuRoots`: the first nodes of the hierarchies of translucent casters drawn once, of
-// blocking instances and of translucent instances (`RT_NO_HIERARCHY` where there are none).
-// Blocking casters drawn once start at node 0.
-struct RtRoots {
-    translucent: u32,
-    blocking_instances: u32,
-    translucent_instances: u32,
-    _pad: u32,
-}
-
-@group(3) @binding(6) var<storage, read> rt_instances: array<RtInstance>;
-@group(3) @binding(7) var<uniform> rt_roots: RtRoots;
-
-// `zoo_ray_tracing::NO_HIERARCHY`: a root of `RtRoots` without its hierarchy.
+// `zoo_ray_tracing::NO_HIERARCHY`: a root of `GpuRoots` without its hierarchy.
 const RT_NO_HIERARCHY: u32 = 0xffffffffu;
 
 // `zoo_ray_tracing::NO_OBJECT`: each triangle names its translucent object.
@@ -76,7 +37,7 @@ const RT_NO_OBJECT: u32 = 0xffffffffu;
 const RT_STACK_SIZE: u32 = 64u;
 
 // Whether the ray enters the node's box before `tmax` (slab test; `inv_dir` finite).
-fn rt_enters(node: RtNode, origin: vec3<f32>, inv_dir: vec3<f32>, tmax: f32) -> bool {
+fn rt_enters(node: GpuNode, origin: vec3<f32>, inv_dir: vec3<f32>, tmax: f32) -> bool {
     let t1 = (node.min - origin) * inv_dir;
     let t2 = (node.max - origin) * inv_dir;
     let near = max(max(min(t1.x, t2.x), min(t1.y, t2.y)), max(min(t1.z, t2.z), 0.0));

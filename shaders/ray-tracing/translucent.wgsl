@@ -2,10 +2,8 @@
 // object a ray crosses filters it once by its transmittance colour, however many of its
 // surfaces the ray passes, as the judge's reference does.
 
-// Mirrors `GpuTranslucent`: an object's transmittance colour.
-struct RtTranslucent {
-    transmittance: vec3<f32>,
-}
+// `GpuTranslucent`: an object's transmittance colour.
+#import "ray-tracing/translucent_object.wgsl"
 
 // Distinct objects one ray is filtered by (`zoo_ray_tracing::MAX_CROSSED`); further ones let
 // it through unfiltered.

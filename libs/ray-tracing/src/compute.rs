@@ -2,8 +2,8 @@
 //! ([`zoo_host::judge::FlatBvh`]), uploaded as storage buffers and walked in WGSL
 //! (`ray-tracing/trace.wgsl`), so it runs on every adapter with storage buffers.
 
-use bytemuck::{Pod, Zeroable};
-use zoo_host::glam::Vec3;
+use zoo_host::glam::{Vec2, Vec3, Vec4};
+use zoo_host::gpu::{gpu_bytes, gpu_bytes_padded};
 use zoo_host::judge::FlatBvh;
 use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture, uniform};
 use zoo_host::scene::Scene;
@@ -18,65 +18,73 @@ use crate::{
 /// hierarchy at most this deep is traversed exactly.
 pub const STACK_SIZE: u32 = 64;
 
-/// `RtNode` in `ray-tracing/trace.wgsl`: a box, and its children (`first`, `first + 1`) or,
-/// for a leaf (`count` > 0), its triangles `first..first + count`.
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuNode {
-    pub min: [f32; 3],
-    pub first: u32,
-    pub max: [f32; 3],
-    pub count: u32,
+zoo_host::gpu_struct! {
+    "ray-tracing/node.wgsl" =>
+    /// A node of `ray-tracing/trace.wgsl`'s hierarchies: a box, and its children (`first`,
+    /// `first + 1`) or, for a leaf (`count` > 0), its triangles `first..first + count`.
+    #[derive(Debug, Clone, Copy, PartialEq, Default)]
+    pub struct GpuNode {
+        pub min: Vec3,
+        pub first: u32,
+        pub max: Vec3,
+        pub count: u32,
+    }
 }
 
-/// `RtTriangle` in `ray-tracing/trace.wgsl`: a corner and the two edges from it, its
-/// translucent object (for translucent casters drawn once; an instance names its own) and its
-/// alpha test (mask layer, -1 for none, and cutoff).
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuTriangle {
-    pub v0: [f32; 3],
-    pub translucent: u32,
-    pub e1: [f32; 3],
-    pub mask_layer: i32,
-    pub e2: [f32; 3],
-    pub alpha_cutoff: f32,
+zoo_host::gpu_struct! {
+    "ray-tracing/triangle.wgsl" =>
+    /// A triangle of `ray-tracing/trace.wgsl`: a corner and the two edges from it, its
+    /// translucent object (for translucent casters drawn once; an instance names its own) and
+    /// its alpha test (mask layer, -1 for none, and cutoff).
+    #[derive(Debug, Clone, Copy, PartialEq, Default)]
+    pub struct GpuTriangle {
+        pub v0: Vec3,
+        pub translucent: u32,
+        pub e1: Vec3,
+        pub mask_layer: i32,
+        pub e2: Vec3,
+        pub alpha_cutoff: f32,
+    }
 }
 
-/// `RtTexcoords` in `ray-tracing/trace.wgsl`: a triangle's corners' texture coordinates.
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuTexcoords {
-    pub uv: [[f32; 2]; 3],
-    pub _pad: [f32; 2],
+zoo_host::gpu_struct! {
+    "ray-tracing/texcoords.wgsl" =>
+    /// A triangle's corners' texture coordinates in `ray-tracing/trace.wgsl`.
+    #[derive(Debug, Clone, Copy, PartialEq, Default)]
+    pub struct GpuTexcoords {
+        pub uv: [Vec2; 3],
+    }
 }
 
-/// `RtInstance` in `ray-tracing/trace.wgsl`: an instance's inverse placement (the rows of a
-/// 3x4 matrix), the root node of its mesh's hierarchy and its translucent object
-/// ([`NO_OBJECT`] for a blocking caster).
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuInstance {
-    pub to_local: [[f32; 4]; 3],
-    pub root: u32,
-    pub translucent: u32,
-    pub _pad: [u32; 2],
+zoo_host::gpu_struct! {
+    "ray-tracing/instance.wgsl" =>
+    /// An instance in `ray-tracing/trace.wgsl`: its inverse placement (the rows of a 3x4
+    /// matrix), the root node of its mesh's hierarchy and its translucent object
+    /// ([`NO_OBJECT`] for a blocking caster).
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct GpuInstance {
+        pub to_local: [Vec4; 3],
+        pub root: u32,
+        pub translucent: u32,
+    }
 }
 
 /// [`GpuInstance::translucent`] of a blocking caster (`RT_NO_OBJECT` in
 /// `ray-tracing/trace.wgsl`).
 pub const NO_OBJECT: u32 = u32::MAX;
 
-/// `RtRoots` in `ray-tracing/trace.wgsl`: the first nodes of the hierarchies of translucent
-/// casters drawn once, of blocking instances and of translucent instances
-/// ([`crate::NO_HIERARCHY`] where there are none). Blocking casters drawn once start at node 0.
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct GpuRoots {
-    pub translucent: u32,
-    pub blocking_instances: u32,
-    pub translucent_instances: u32,
-    pub _pad: u32,
+zoo_host::gpu_struct! {
+    "ray-tracing/roots.wgsl" =>
+    /// The roots of `ray-tracing/trace.wgsl`: the first nodes of the hierarchies of
+    /// translucent casters drawn once, of blocking instances and of translucent instances
+    /// ([`crate::NO_HIERARCHY`] where there are none). Blocking casters drawn once start at
+    /// node 0.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct GpuRoots {
+        pub translucent: u32,
+        pub blocking_instances: u32,
+        pub translucent_instances: u32,
+    }
 }
 
 /// The shadow casters as the GPU traces them, triangles in their hierarchies' leaf order.
@@ -116,7 +124,6 @@ impl CasterGeometry {
                 translucent: NO_HIERARCHY,
                 blocking_instances: NO_HIERARCHY,
                 translucent_instances: NO_HIERARCHY,
-                _pad: 0,
             },
             translucent: Vec::new(),
             hierarchies: Vec::new(),
@@ -127,13 +134,11 @@ impl CasterGeometry {
             // Node 0 is where `rt_occluded` starts: without blocking casters, a leaf over a
             // triangle without area, which no ray hits.
             geometry.nodes.push(GpuNode {
-                min: [0.0; 3],
-                first: 0,
-                max: [0.0; 3],
                 count: 1,
+                ..GpuNode::default()
             });
-            geometry.triangles.push(GpuTriangle::zeroed());
-            geometry.texcoords.push(GpuTexcoords::zeroed());
+            geometry.triangles.push(GpuTriangle::default());
+            geometry.texcoords.push(GpuTexcoords::default());
             geometry.hierarchies.push(0);
         }
         // (None where every translucent triangle is degenerate and left out.)
@@ -165,7 +170,7 @@ impl CasterGeometry {
         let boxes: Vec<(Vec3, Vec3)> = (members.iter())
             .map(|(instance, root)| {
                 let node = &self.nodes[*root as usize];
-                zoo_host::judge::placed_box(instance.to_world, node.min.into(), node.max.into())
+                zoo_host::judge::placed_box(instance.to_world, node.min, node.max)
             })
             .collect();
         let bvh = FlatBvh::over_boxes(&boxes);
@@ -174,24 +179,23 @@ impl CasterGeometry {
         }
         let (node_base, instance_base) = (self.nodes.len() as u32, self.instances.len() as u32);
         self.nodes.extend(bvh.nodes.iter().map(|n| GpuNode {
-            min: n.min.to_array(),
+            min: n.min,
             first: n.first
                 + if n.count > 0 {
                     instance_base
                 } else {
                     node_base
                 },
-            max: n.max.to_array(),
+            max: n.max,
             count: n.count,
         }));
         for &source in &bvh.triangles {
             let (instance, root) = members[source as usize];
             let rows = instance.to_world.inverse().transpose();
             self.instances.push(GpuInstance {
-                to_local: [rows.x_axis, rows.y_axis, rows.z_axis].map(|r| r.to_array()),
+                to_local: [rows.x_axis, rows.y_axis, rows.z_axis],
                 root,
                 translucent: instance.translucent.unwrap_or(NO_OBJECT),
-                _pad: [0; 2],
             });
         }
         self.hierarchies.push(node_base);
@@ -208,14 +212,14 @@ impl CasterGeometry {
         }
         let (node_base, triangle_base) = (self.nodes.len() as u32, self.triangles.len() as u32);
         self.nodes.extend(bvh.nodes.iter().map(|n| GpuNode {
-            min: n.min.to_array(),
+            min: n.min,
             first: n.first
                 + if n.count > 0 {
                     triangle_base
                 } else {
                     node_base
                 },
-            max: n.max.to_array(),
+            max: n.max,
             count: n.count,
         }));
         for &source in &bvh.triangles {
@@ -223,17 +227,14 @@ impl CasterGeometry {
             let [a, b, c] = caster.corners;
             let mask = caster.mask;
             self.triangles.push(GpuTriangle {
-                v0: a.to_array(),
+                v0: a,
                 translucent: caster.translucent.unwrap_or(0),
-                e1: (b - a).to_array(),
+                e1: b - a,
                 mask_layer: mask.map_or(-1, |m| m.layer as i32),
-                e2: (c - a).to_array(),
+                e2: c - a,
                 alpha_cutoff: mask.map_or(0.0, |m| m.cutoff),
             });
-            self.texcoords.push(GpuTexcoords {
-                uv: caster.uv.map(|t| t.to_array()),
-                _pad: [0.0; 2],
-            });
+            self.texcoords.push(GpuTexcoords { uv: caster.uv });
         }
         self.hierarchies.push(node_base);
         Some(node_base)
@@ -257,7 +258,7 @@ impl CasterGeometry {
     /// Shadow-casting triangles stored (the placeholder of a scene without blocking casters
     /// left out; an instance's shared triangles once).
     pub fn caster_count(&self) -> usize {
-        let placeholder = self.triangles.first() == Some(&GpuTriangle::zeroed());
+        let placeholder = self.triangles.first() == Some(&GpuTriangle::default());
         self.triangles.len() - usize::from(placeholder)
     }
 
@@ -306,25 +307,21 @@ pub(crate) fn upload(
         )));
     }
     let device = &ctx.gpu.device;
-    let nodes = storage_buffer(
-        device,
-        "ray tracing nodes",
-        bytemuck::cast_slice(&geometry.nodes),
-    );
+    let nodes = storage_buffer(device, "ray tracing nodes", &gpu_bytes(&geometry.nodes));
     let triangles = storage_buffer(
         device,
         "ray tracing triangles",
-        bytemuck::cast_slice(&geometry.triangles),
+        &gpu_bytes(&geometry.triangles),
     );
     let texcoords = storage_buffer(
         device,
         "ray tracing texture coordinates",
-        bytemuck::cast_slice(&geometry.texcoords),
+        &gpu_bytes(&geometry.texcoords),
     );
     let translucent = storage_buffer(
         device,
         "ray tracing translucent objects",
-        bytemuck::cast_slice(&geometry.translucent),
+        &gpu_bytes(&geometry.translucent),
     );
     let instances = storage_buffer(
         device,
@@ -335,7 +332,8 @@ pub(crate) fn upload(
         device,
         &wgpu::util::BufferInitDescriptor {
             label: Some("ray tracing roots"),
-            contents: bytemuck::bytes_of(&geometry.roots),
+            // A whole 16-byte slot, as a uniform block holds it everywhere.
+            contents: &gpu_bytes_padded(&geometry.roots, 16),
             usage: wgpu::BufferUsages::UNIFORM,
         },
     );
@@ -369,59 +367,6 @@ pub(crate) fn upload(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror};
-
-    #[test]
-    fn records_mirror_the_shader() {
-        let node = zoo_host::mirror_fields!(GpuNode {
-            min,
-            first,
-            max,
-            count
-        });
-        check_embedded_mirror("ray-tracing/trace.wgsl", "RtNode", node, SizeRule::Equal).unwrap();
-        let triangle = zoo_host::mirror_fields!(GpuTriangle {
-            v0,
-            translucent,
-            e1,
-            mask_layer,
-            e2,
-            alpha_cutoff
-        });
-        check_embedded_mirror(
-            "ray-tracing/trace.wgsl",
-            "RtTriangle",
-            triangle,
-            SizeRule::Equal,
-        )
-        .unwrap();
-        let instance = zoo_host::mirror_fields!(GpuInstance {
-            to_local,
-            root,
-            translucent
-        });
-        check_embedded_mirror(
-            "ray-tracing/trace.wgsl",
-            "RtInstance",
-            instance,
-            SizeRule::Equal,
-        )
-        .unwrap();
-        let roots = zoo_host::mirror_fields!(GpuRoots {
-            translucent,
-            blocking_instances,
-            translucent_instances
-        });
-        check_embedded_mirror("ray-tracing/trace.wgsl", "RtRoots", roots, SizeRule::Equal).unwrap();
-        let texcoords = zoo_host::mirror_fields!(GpuTexcoords { uv, _pad });
-        check_embedded_mirror(
-            "ray-tracing/trace.wgsl",
-            "RtTexcoords",
-            texcoords,
-            SizeRule::Equal,
-        )
-        .unwrap();
-    }
 
     #[test]
     fn every_caster_triangle_is_stored_once_inside_its_leaf() {
@@ -446,10 +391,10 @@ mod tests {
         assert!((2..STACK_SIZE).contains(&depth), "{depth} levels");
         let mut covered = vec![0; geometry.triangles.len()];
         for node in geometry.nodes.iter().filter(|n| n.count > 0) {
-            let (lo, hi) = (glam_vec(node.min), glam_vec(node.max));
+            let (lo, hi) = (node.min, node.max);
             for t in &geometry.triangles[node.first as usize..(node.first + node.count) as usize] {
-                let v0 = glam_vec(t.v0);
-                for p in [v0, v0 + glam_vec(t.e1), v0 + glam_vec(t.e2)] {
+                let v0 = t.v0;
+                for p in [v0, v0 + t.e1, v0 + t.e2] {
                     assert!(p.cmpge(lo - 1e-4).all() && p.cmple(hi + 1e-4).all());
                 }
             }
@@ -479,8 +424,14 @@ mod tests {
         assert_ne!(root, NO_HIERARCHY, "two translucent boxes");
         assert_eq!(geometry.caster_count(), 36);
         assert_eq!(geometry.translucent.len(), 2);
-        assert_eq!(geometry.translucent[0].transmittance, [0.5, 0.1, 0.05]);
-        assert_eq!(geometry.translucent[1].transmittance, [0.15, 0.3, 0.75]);
+        assert_eq!(
+            geometry.translucent[0].transmittance,
+            Vec3::new(0.5, 0.1, 0.05)
+        );
+        assert_eq!(
+            geometry.translucent[1].transmittance,
+            Vec3::new(0.15, 0.3, 0.75)
+        );
         // The opaque box alone under node 0; each glass box's triangles name its object.
         let leaves_under = |root: u32| {
             let mut triangles = Vec::new();
@@ -515,7 +466,7 @@ mod tests {
         );
         let geometry = CasterGeometry::of(&only_glass);
         assert_eq!(geometry.nodes[0].count, 1);
-        assert_eq!(geometry.triangles[0], GpuTriangle::zeroed());
+        assert_eq!(geometry.triangles[0], GpuTriangle::default());
         assert_eq!(geometry.roots.translucent, 1);
         assert_eq!(geometry.caster_count(), 12);
     }
@@ -577,13 +528,8 @@ mod tests {
             let instance = geometry.instances[i as usize];
             assert_eq!(instance.root, geometry.instances[blocking[0] as usize].root);
             assert_eq!(instance.translucent, NO_OBJECT);
-            let rows = zoo_host::glam::Mat4::from_cols_array_2d(&[
-                instance.to_local[0],
-                instance.to_local[1],
-                instance.to_local[2],
-                [0.0, 0.0, 0.0, 1.0],
-            ])
-            .transpose();
+            let [x, y, z] = instance.to_local;
+            let rows = zoo_host::glam::Mat4::from_cols(x, y, z, Vec4::W).transpose();
             assert!(
                 placements
                     .iter()
@@ -609,9 +555,5 @@ mod tests {
         let constant = |name| zoo_host::gpu::layout::wgsl_integer_constant(&composed.source, name);
         assert_eq!(constant("RT_STACK_SIZE"), Ok(i64::from(STACK_SIZE)));
         assert_eq!(constant("RT_NO_OBJECT"), Ok(i64::from(NO_OBJECT)));
-    }
-
-    fn glam_vec(v: [f32; 3]) -> zoo_host::glam::Vec3 {
-        zoo_host::glam::Vec3::from(v)
     }
 }
