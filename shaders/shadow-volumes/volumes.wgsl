@@ -23,23 +23,10 @@ const MODE_PER_TRIANGLE: u32 = 1u;
 // Invocations per workgroup of both entry points (`WORKGROUP_SIZE` in the library).
 const WORKGROUP_SIZE: u32 = 64u;
 
-struct Params {
-    light: u32,
-    mode: u32,
-    capacity: u32,
-    _pad0: u32,
-}
-
-// One dispatch's triangles and edges, and what takes their stored vertices to world space.
-struct Part {
-    to_world: mat4x4<f32>,
-    first_triangle: u32,
-    triangle_count: u32,
-    first_edge: u32,
-    edge_count: u32,
-    // 1 for an instance, 0 for the world-space part.
-    instance: u32,
-}
+// The per-light `Params` and per-part `Part` (one dispatch's triangles and edges, and what
+// takes their stored vertices to world space) of `zoo_shadow_volumes`.
+#import "shadow-volumes/params.wgsl"
+#import "shadow-volumes/part.wgsl"
 
 struct DrawArgs {
     vertex_count: atomic<u32>,

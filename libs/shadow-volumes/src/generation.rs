@@ -11,8 +11,9 @@
 //! instance's shared triangles and edges under its placement, so instances share their
 //! geometry here as in every other pass.
 
-use bytemuck::{Pod, Zeroable};
-use zoo_host::gpu::PassRecorder;
+use zoo_host::glam::Mat4;
+use zoo_host::gpu::gpu_struct::round_up;
+use zoo_host::gpu::{GpuType, PassRecorder, gpu_bytes_padded};
 use zoo_host::scene::{EdgeKind, Scene};
 use zoo_host::technique::ResourceInfo;
 use zoo_host::{RenderContext, TechniqueError, wgpu};
@@ -33,44 +34,57 @@ const SLOT: u64 = 256;
 /// Draw arguments followed by the silhouette counter (`DrawArgs` in the shader).
 pub const ARGS_BYTES: u64 = 20;
 
-/// `Params` in `shadow-volumes/volumes.wgsl`, in a 256-byte slot.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-#[repr(C)]
-pub struct Params {
-    pub light: u32,
-    pub mode: u32,
-    pub capacity: u32,
-    pub _pad: [u32; 61],
+zoo_host::gpu_struct! {
+    "shadow-volumes/params.wgsl" =>
+    /// The per-light uniform of `shadow-volumes/volumes.wgsl`, in a [`SLOT`]-byte slot.
+    #[derive(Debug, Clone, Copy)]
+    pub struct Params {
+        pub light: u32,
+        pub mode: u32,
+        pub capacity: u32,
+    }
 }
 
-/// `Part` in `shadow-volumes/volumes.wgsl`, in a 256-byte slot: one dispatch's triangles and
-/// edges, and the placement of their stored vertices.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-#[repr(C)]
-pub struct Part {
-    pub to_world: [[f32; 4]; 4],
-    pub first_triangle: u32,
-    pub triangle_count: u32,
-    pub first_edge: u32,
-    pub edge_count: u32,
-    pub instance: u32,
-    pub _pad: [u32; 43],
+zoo_host::gpu_struct! {
+    "shadow-volumes/part.wgsl" =>
+    /// The per-part uniform of `shadow-volumes/volumes.wgsl`, in a [`SLOT`]-byte slot: one
+    /// dispatch's triangles and edges, and the placement of their stored vertices.
+    #[derive(Debug, Clone, Copy)]
+    pub struct Part {
+        pub to_world: Mat4,
+        pub first_triangle: u32,
+        pub triangle_count: u32,
+        pub first_edge: u32,
+        pub edge_count: u32,
+        /// 1 for an instance, 0 for the world-space part.
+        pub instance: u32,
+    }
+}
+
+// Each value fits its slot.
+const _: () = assert!(Params::SIZE <= SLOT as usize);
+const _: () = assert!(Part::SIZE <= SLOT as usize);
+
+/// The bytes of `values`, each in a [`SLOT`]-byte slot.
+fn in_slots<T: GpuType>(values: &[T]) -> Vec<u8> {
+    (values.iter())
+        .flat_map(|v| gpu_bytes_padded(v, SLOT as usize))
+        .collect()
 }
 
 /// The parts volumes are built from: every stored triangle and edge in world space (instances'
 /// triangles left out by their flag), then each shadow-casting instance's.
 pub fn parts(scene: &Scene) -> Vec<Part> {
-    let part = |to_world: zoo_host::glam::Mat4,
+    let part = |to_world: Mat4,
                 triangles: std::ops::Range<usize>,
                 edges: &std::ops::Range<u32>,
                 instance| Part {
-        to_world: to_world.to_cols_array_2d(),
+        to_world,
         first_triangle: triangles.start as u32,
         triangle_count: triangles.len() as u32,
         first_edge: edges.start,
         edge_count: edges.len() as u32,
         instance,
-        _pad: [0; 43],
     };
     let everything = 0..scene.adjacency.edges.len() as u32;
     let instances = (scene.objects.iter().enumerate())
@@ -181,8 +195,8 @@ impl VolumeGenerator {
                 storage(5, false),
                 storage(6, false),
                 storage(7, false),
-                slot(8, 16),
-                slot(9, 96),
+                slot(8, round_up(Params::SIZE, 16) as u64),
+                slot(9, round_up(Part::SIZE, 16) as u64),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -264,20 +278,15 @@ impl VolumeGenerator {
                 light: light as u32,
                 mode: u32::from(volumes == Volumes::PerTriangle),
                 capacity,
-                _pad: [0; 61],
             })
             .collect();
         let params = init(
             "light parameters",
-            bytemuck::cast_slice(&params),
+            &in_slots(&params),
             wgpu::BufferUsages::UNIFORM,
         );
         let parts = parts(scene);
-        let part_slots = init(
-            "parts",
-            bytemuck::cast_slice(&parts),
-            wgpu::BufferUsages::UNIFORM,
-        );
+        let part_slots = init("parts", &in_slots(&parts), wgpu::BufferUsages::UNIFORM);
         let b = ctx.scene_buffers;
         fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry {
@@ -285,17 +294,14 @@ impl VolumeGenerator {
                 resource: buffer.as_entire_binding(),
             }
         }
-        fn slot_entry(
-            binding: u32,
-            buffer: &wgpu::Buffer,
-            size: usize,
-        ) -> wgpu::BindGroupEntry<'_> {
+        // One whole slot, at dynamic offsets.
+        fn slot_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry {
                 binding,
                 resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                     buffer,
                     offset: 0,
-                    size: wgpu::BufferSize::new(size as u64),
+                    size: wgpu::BufferSize::new(SLOT),
                 }),
             }
         }
@@ -311,8 +317,8 @@ impl VolumeGenerator {
                 entry(5, &weights),
                 entry(6, &volume),
                 entry(7, &args),
-                slot_entry(8, &params, size_of::<Params>()),
-                slot_entry(9, &part_slots, size_of::<Part>()),
+                slot_entry(8, &params),
+                slot_entry(9, &part_slots),
             ],
         });
         self.buffers = Some(Buffers {
@@ -389,33 +395,15 @@ impl VolumeGenerator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror, wgsl_struct};
+    use zoo_host::gpu::layout::wgsl_struct;
     use zoo_host::scene::EdgeRecord;
 
     #[test]
-    fn gpu_structs_mirror_the_shader() {
+    fn draw_arguments_match_the_shader() {
         let source = zoo_host::ShaderLibrary::embedded()
             .compose("shadow-volumes/volumes.wgsl")
             .unwrap()
             .source;
-        // Uniforms at 256-byte dynamic offsets: the Rust struct fills the slot.
-        let (size, fields) = zoo_host::mirror_fields!(Params {
-            light,
-            mode,
-            capacity
-        });
-        check_mirror(&source, "Params", size, &fields, SizeRule::AtLeast).unwrap();
-        assert_eq!(size as u64, SLOT);
-        let (size, fields) = zoo_host::mirror_fields!(Part {
-            to_world,
-            first_triangle,
-            triangle_count,
-            first_edge,
-            edge_count,
-            instance
-        });
-        check_mirror(&source, "Part", size, &fields, SizeRule::AtLeast).unwrap();
-        assert_eq!(size as u64, SLOT);
         assert_eq!(
             wgsl_struct(&source, "DrawArgs").unwrap().size as u64,
             ARGS_BYTES
