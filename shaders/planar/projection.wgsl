@@ -1,15 +1,7 @@
 // The uniforms of one (light, receiver plane) pair, shared by the marking and the shadow
 // passes of planar projected shadows.
 
-struct Projection {
-    shadow_matrix: mat4x4<f32>,
-    // Receiver plane (n, d): n . x + d = 0, n pointing to the lit side.
-    plane: vec4<f32>,
-    // Homogeneous light: (position, 1) or (direction toward the light, 0).
-    light: vec4<f32>,
-    // x: visibility written in shadow, y: plane id, z: distance tolerance for plane pixels.
-    params: vec4<f32>,
-}
+#import "planar/projection_uniform.wgsl"
 
 @group(2) @binding(0) var<uniform> projection: Projection;
 
