@@ -19,6 +19,10 @@
 //! queue.write_buffer(&buffer, 0, &gpu_bytes(&lights));
 //! ```
 //!
+//! A `gpu_struct!` type is also a [`UniformValue`](crate::kit::UniformValue), so
+//! [`UniformSlots`](crate::kit::UniformSlots) and
+//! [`FullscreenLightPass`](crate::kit::FullscreenLightPass) hold it.
+//!
 //! Field types: `f32`, `u32`, `i32`, glam's `Vec2`/`Vec3`/`Vec4`, `UVec2`..`UVec4`,
 //! `IVec2`..`IVec4`, `Mat4` (WGSL vectors and `mat4x4<f32>`), fixed-size Rust arrays (WGSL
 //! `array<T, N>`) and other `gpu_struct!` types (their modules are imported). Layouts follow
@@ -294,6 +298,13 @@ macro_rules! gpu_struct {
             fn write(&self, out: &mut [u8]) {
                 let mut writer = $crate::gpu::gpu_struct::FieldWriter::new(out);
                 $( writer.field(&self.$field); )*
+            }
+        }
+
+        impl $crate::kit::UniformValue for $name {
+            const SIZE: usize = <$name as $crate::gpu::gpu_struct::GpuType>::SIZE;
+            fn write_bytes(&self, out: &mut [u8]) {
+                $crate::gpu::gpu_struct::GpuType::write(self, out);
             }
         }
 

@@ -1,9 +1,7 @@
 //! A full-screen pass per light with per-light uniforms: the shape of most screen-space
 //! visibility passes (shadow-map lookups, back-facing tests, screen-space filters).
 
-use bytemuck::Pod;
-
-use super::{UniformSlots, slot_fullscreen_pipeline};
+use super::{UniformSlots, UniformValue, slot_fullscreen_pipeline};
 use crate::gpu::PassRecorder;
 use crate::technique::{RenderContext, TechniqueError};
 
@@ -11,7 +9,7 @@ use crate::technique::{RenderContext, TechniqueError};
 /// the frame (group 0), the G-buffer (group 1), one `T` per light (group 2, binding 0) and the
 /// technique's own `groups` from 3 on. The fragment returns the light's visibility in every
 /// channel (or discards to leave it lit).
-pub struct FullscreenLightPass<T: Pod> {
+pub struct FullscreenLightPass<T: UniformValue> {
     pipeline: wgpu::RenderPipeline,
     uniforms: UniformSlots<T>,
 }
@@ -22,7 +20,7 @@ pub fn light_pass_name(base: &str, light: usize) -> String {
     format!("{base}: light {light}")
 }
 
-impl<T: Pod> FullscreenLightPass<T> {
+impl<T: UniformValue> FullscreenLightPass<T> {
     /// Builds the pipeline from fragment `entry` of library shader `shader` (for example
     /// `"backfacing/mask.wgsl"`), with extra bind group layouts `groups` (3, 4, ...).
     pub fn new(

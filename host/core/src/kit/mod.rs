@@ -32,4 +32,4 @@ pub use layouts::{
 pub use lazy::LazyGpu;
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use slot::{LightSlot, slot_target};
-pub use uniforms::UniformSlots;
+pub use uniforms::{UniformSlots, UniformValue};

@@ -6,11 +6,27 @@ use bytemuck::Pod;
 
 use crate::GpuContext;
 
+/// A value [`UniformSlots`] holds: a [`gpu_struct!`](crate::gpu_struct) type (laid out by
+/// WGSL's rules) or a hand-laid-out [`Pod`] type (its bytes as they are).
+pub trait UniformValue {
+    /// Its size in bytes as the shader reads it.
+    const SIZE: usize;
+    /// Writes it at the start of `out` (at least [`Self::SIZE`] bytes).
+    fn write_bytes(&self, out: &mut [u8]);
+}
+
+impl<T: Pod> UniformValue for T {
+    const SIZE: usize = size_of::<T>();
+    fn write_bytes(&self, out: &mut [u8]) {
+        out[..size_of::<T>()].copy_from_slice(bytemuck::bytes_of(self));
+    }
+}
+
 /// `count` values of `T`, each at a multiple of the device's
 /// `min_uniform_buffer_offset_alignment`, with a bind group that exposes one value at a time
 /// (binding 0, dynamic offset). Write the values for a frame, then bind with
 /// [`Self::offset`] per draw.
-pub struct UniformSlots<T: Pod> {
+pub struct UniformSlots<T: UniformValue> {
     label: String,
     stride: u64,
     capacity: usize,
@@ -20,7 +36,7 @@ pub struct UniformSlots<T: Pod> {
     _value: PhantomData<T>,
 }
 
-impl<T: Pod> UniformSlots<T> {
+impl<T: UniformValue> UniformSlots<T> {
     /// Room for `capacity` values, visible to `visibility` stages.
     pub fn new(
         gpu: &GpuContext,
@@ -30,7 +46,7 @@ impl<T: Pod> UniformSlots<T> {
     ) -> UniformSlots<T> {
         let device = &gpu.device;
         let alignment = u64::from(device.limits().min_uniform_buffer_offset_alignment);
-        let stride = (size_of::<T>() as u64).max(1).div_ceil(alignment) * alignment;
+        let stride = (T::SIZE as u64).max(1).div_ceil(alignment) * alignment;
         let capacity = capacity.max(1);
         let buffer = Self::create_buffer(device, label, stride, capacity);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -41,7 +57,7 @@ impl<T: Pod> UniformSlots<T> {
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Uniform,
                     has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(size_of::<T>() as u64),
+                    min_binding_size: wgpu::BufferSize::new(T::SIZE as u64),
                 },
                 count: None,
             }],
@@ -86,7 +102,7 @@ impl<T: Pod> UniformSlots<T> {
                 resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                     buffer,
                     offset: 0,
-                    size: wgpu::BufferSize::new(size_of::<T>() as u64),
+                    size: wgpu::BufferSize::new(T::SIZE as u64),
                 }),
             }],
         })
@@ -104,7 +120,7 @@ impl<T: Pod> UniformSlots<T> {
         }
         let mut bytes = vec![0u8; self.stride as usize * values.len()];
         for (chunk, value) in bytes.chunks_exact_mut(self.stride as usize).zip(values) {
-            chunk[..size_of::<T>()].copy_from_slice(bytemuck::bytes_of(value));
+            value.write_bytes(chunk);
         }
         gpu.queue.write_buffer(&self.buffer, 0, &bytes);
     }
