@@ -12,21 +12,7 @@
 #import "common/lighting.wgsl"
 #import "common/vertices.wgsl"
 #import "common/materials.wgsl"
-
-struct RsmCamera {
-    view_proj: mat4x4<f32>,
-    // The light's position (perspective maps) and 1 when perspective.
-    eye: vec4<f32>,
-    // The map's axis, and the texel's world size per unit of distance along it
-    // (perspective) or absolute (orthographic).
-    axis: vec4<f32>,
-    // Positions are stored relative to this point (the scene's centre), for 16-bit floats.
-    origin: vec4<f32>,
-    light: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
+#import "lpv/rsm_camera.wgsl"
 
 @group(2) @binding(0) var<uniform> rsm_camera: RsmCamera;
 

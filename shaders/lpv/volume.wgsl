@@ -5,39 +5,10 @@
 
 const MAX_CASCADES: u32 = 4u;
 
-#import "lpv/params.wgsl"
-
-struct LpvSettings {
-    // The plugin's parameters the shaders read (generated from their declaration: grid size,
-    // occlusion, camera occluders, coverage gain and lookup blocking, damping, intensity, blend
-    // cells, coarse far light, emitter orientation and its cells, skipping dark cells).
-    params: LpvParams,
-    cascade_count: u32,
-    // Fixed-point scales of the injection sums (integer units per unit).
-    light_scale: f32,
-    occluder_scale: f32,
-    // The grid and volume the debug volume view shows (0 light, 1 occluders, 2 emitter normals).
-    debug_cascade: u32,
-    debug_source: u32,
-    // Reflective shadow maps injected (each sees the same surfaces: their surfels count
-    // once between them).
-    map_count: u32,
-    // To a multiple of 16 bytes (the origin after it is a vec4).
-    _pad0: u32,
-    _pad1: u32,
-}
-
-struct Cascade {
-    min: vec3<f32>,
-    cell: f32,
-}
-
-struct LpvData {
-    settings: LpvSettings,
-    // Where reflective-shadow-map positions are relative to (xyz).
-    origin: vec4<f32>,
-    cascades: array<Cascade, MAX_CASCADES>,
-}
+// `zoo_plugin_lpv::gpu::LpvData`: the settings (`LpvSettings`: the generated `LpvParams` and
+// the passes' own), where reflective-shadow-map positions are relative to, and each grid's
+// `GpuCascade`.
+#import "lpv/lpv_data.wgsl"
 
 // 1/(2 sqrt(pi)) and sqrt(3)/(2 sqrt(pi)).
 const SH_Y0: f32 = 0.2820948;

@@ -1,7 +1,8 @@
 //! The GPU side of the light propagation volumes: the reflective shadow maps and the pass that
 //! fills them, the grids' buffers and the compute passes over them.
 
-use zoo_host::glam::{UVec2, Vec3};
+use zoo_host::glam::{Mat4, UVec2, Vec3, Vec4};
+use zoo_host::gpu::GpuType;
 use zoo_host::kit::{self, UniformSlots};
 use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
@@ -14,42 +15,72 @@ use crate::cascades::Grid;
 /// Most grids (`MAX_CASCADES` in `lpv/volume.wgsl`).
 pub const MAX_CASCADES: usize = 4;
 
-/// `LpvSettings` in `lpv/volume.wgsl`.
-#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-pub struct LpvSettings {
-    /// The `flags(shader)` parameters (`LpvParams` in the generated `lpv/params.wgsl`).
-    pub params: [u32; PARAM_WORDS],
-    pub cascade_count: u32,
-    pub light_scale: f32,
-    pub occluder_scale: f32,
-    pub debug_cascade: u32,
-    pub debug_source: u32,
-    pub map_count: u32,
-    pub _pad: [u32; 2],
+/// The `flags(shader)` parameters as the shaders read them: `LpvParams` in the generated
+/// `lpv/params.wgsl`, one word each, padded to 16 bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShaderParams(pub [u32; PARAM_WORDS]);
+
+impl GpuType for ShaderParams {
+    const ALIGN: usize = 4;
+    const SIZE: usize = 4 * PARAM_WORDS;
+    fn wgsl_type() -> String {
+        "LpvParams".to_string()
+    }
+    fn imports() -> Vec<&'static str> {
+        vec!["lpv/params.wgsl"]
+    }
+    fn write(&self, out: &mut [u8]) {
+        self.0.write(out);
+    }
+}
+
+zoo_host::gpu_struct! {
+    "lpv/lpv_settings.wgsl" =>
+    /// The settings every LPV pass reads (`lpv/volume.wgsl`).
+    #[derive(Debug, Clone, Copy)]
+    pub struct LpvSettings {
+        /// The plugin's parameters the shaders read (generated from their declaration: grid
+        /// size, occlusion, camera occluders, coverage gain and lookup blocking, damping,
+        /// intensity, blend cells, coarse far light, emitter orientation and its cells, skipping
+        /// dark cells).
+        pub params: ShaderParams,
+        pub cascade_count: u32,
+        /// Fixed-point scales of the injection sums (integer units per unit).
+        pub light_scale: f32,
+        pub occluder_scale: f32,
+        /// The grid and volume the debug volume view shows (0 light, 1 occluders, 2 emitter
+        /// normals).
+        pub debug_cascade: u32,
+        pub debug_source: u32,
+        /// Reflective shadow maps injected (each sees the same surfaces: their surfels count
+        /// once between them).
+        pub map_count: u32,
+    }
 }
 
 /// Words of the parameters the shaders read.
 const PARAM_WORDS: usize = padded_words(<LpvParams as TechniqueParams>::SHADER_FIELDS);
 
-/// `Cascade` in `lpv/volume.wgsl`.
-#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-pub struct GpuCascade {
-    pub min: [f32; 3],
-    pub cell: f32,
+zoo_host::gpu_struct! {
+    "lpv/cascade.wgsl" =>
+    /// One grid in `lpv/volume.wgsl`: its minimum corner and its cell size.
+    #[derive(Debug, Clone, Copy, Default)]
+    pub struct GpuCascade {
+        pub min: Vec3,
+        pub cell: f32,
+    }
 }
 
-/// `LpvData` in `lpv/volume.wgsl`.
-#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-pub struct LpvData {
-    pub settings: LpvSettings,
-    pub origin: [f32; 4],
-    pub cascades: [GpuCascade; MAX_CASCADES],
+zoo_host::gpu_struct! {
+    "lpv/lpv_data.wgsl" =>
+    /// The data every LPV pass reads (`lpv/volume.wgsl`).
+    #[derive(Debug, Clone, Copy)]
+    pub struct LpvData {
+        pub settings: LpvSettings,
+        /// Where reflective-shadow-map positions are relative to (xyz).
+        pub origin: Vec4,
+        pub cascades: [GpuCascade; MAX_CASCADES],
+    }
 }
 
 impl LpvData {
@@ -58,29 +89,33 @@ impl LpvData {
         let mut cascades = [GpuCascade::default(); MAX_CASCADES];
         for (slot, grid) in cascades.iter_mut().zip(grids) {
             *slot = GpuCascade {
-                min: grid.min.to_array(),
+                min: grid.min,
                 cell: grid.cell,
             };
         }
         LpvData {
             settings,
-            origin: origin.extend(1.0).to_array(),
+            origin: origin.extend(1.0),
             cascades,
         }
     }
 }
 
-/// `RsmCamera` in `lpv/rsm.wgsl`.
-#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-pub struct RsmCamera {
-    pub view_proj: [[f32; 4]; 4],
-    pub eye: [f32; 4],
-    pub axis: [f32; 4],
-    pub origin: [f32; 4],
-    pub light: u32,
-    pub _pad: [u32; 3],
+zoo_host::gpu_struct! {
+    "lpv/rsm_camera.wgsl" =>
+    /// The camera of one reflective shadow map (`lpv/rsm.wgsl`).
+    #[derive(Debug, Clone, Copy)]
+    pub struct RsmCamera {
+        pub view_proj: Mat4,
+        /// The light's position (perspective maps) and 1 when perspective.
+        pub eye: Vec4,
+        /// The map's axis, and the texel's world size per unit of distance along it
+        /// (perspective) or absolute (orthographic).
+        pub axis: Vec4,
+        /// Positions are stored relative to this point (the scene's centre), for 16-bit floats.
+        pub origin: Vec4,
+        pub light: u32,
+    }
 }
 
 impl RsmCamera {
@@ -99,12 +134,11 @@ impl RsmCamera {
             Projection::Warped => (0.0, 0.0),
         };
         RsmCamera {
-            view_proj: frustum.view_proj.to_cols_array_2d(),
-            eye: eye.extend(perspective).to_array(),
-            axis: axis.extend(texel).to_array(),
-            origin: origin.extend(1.0).to_array(),
+            view_proj: frustum.view_proj,
+            eye: eye.extend(perspective),
+            axis: axis.extend(texel),
+            origin: origin.extend(1.0),
             light: light as u32,
-            _pad: [0; 3],
         }
     }
 }
