@@ -431,12 +431,32 @@ mod tests {
         }
     }
 
+    /// A tracing shader of this crate's own (a technique's, such as rt-shadows', needs modules
+    /// its crate registers).
+    const TRACING_SHADER: &str = "\
+// Each kind of shadow ray once.
+#import \"ray-tracing/trace.wgsl\"
+
+@fragment
+fn fs_main(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
+    let origin = vec3<f32>(p.xy, 0.0);
+    let dir = vec3<f32>(0.0, 1.0, 0.0);
+    let hit = rt_closest(origin, dir, 10.0);
+    let lit = select(1.0, 0.0, rt_occluded(origin, dir, 10.0));
+    return vec4<f32>(rt_transmittance(origin, dir, 10.0) * lit, hit.t);
+}
+";
+
     #[test]
     fn the_query_variant_of_a_tracing_shader_validates_and_errors_point_home() {
-        let library = ShaderLibrary::embedded();
-        let shader = "rt-shadows/shadows.wgsl";
+        let dir = std::env::temp_dir().join(format!("zoo-ray-tracing-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("test")).unwrap();
+        std::fs::write(dir.join("test/tracing.wgsl"), TRACING_SHADER).unwrap();
+        let library = ShaderLibrary::from_disk(dir.clone());
+        let shader = "test/tracing.wgsl";
         let portable = shader_source(&library, shader, Tracer::Compute).unwrap();
         assert_eq!(portable, library.source(shader).unwrap());
+        library.validate_source(shader, &portable).unwrap();
         let query = shader_source(&library, shader, Tracer::RayQuery).unwrap();
         assert!(query.contains("#import \"ray-tracing/query.wgsl\""));
         assert!(!query.contains(&format!("#import \"{TRACE_MODULE}\"")));
@@ -445,5 +465,6 @@ mod tests {
         // A shader that does not import the portable traversal is refused by name.
         let err = shader_source(&library, "common/frame.wgsl", Tracer::RayQuery).unwrap_err();
         assert!(err.to_string().contains("common/frame.wgsl"), "{err}");
+        std::fs::remove_dir_all(dir).unwrap();
     }
 }
