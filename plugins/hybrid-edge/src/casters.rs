@@ -55,20 +55,23 @@ pub(crate) fn caster_group(
     )
 }
 
-/// Draws every caster triangle with `pipeline` from the camera of `tile_pass`'s layer, each
-/// object's stored index range with the object as the instance.
+/// Draws every caster triangle `reaches(light, object)` accepts with `pipeline` from the
+/// camera of `tile_pass`'s layer, each object's stored index range with the object as the
+/// instance.
 pub(crate) fn draw_casters(
     ctx: &RenderContext<'_>,
     pass: &mut wgpu::RenderPass<'_>,
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
     tile_pass: &TilePass<'_>,
+    reaches: &dyn Fn(usize, usize) -> bool,
 ) {
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
     let offset = (tile_pass.layer as u64 * CAMERA_STRIDE) as u32;
     pass.set_bind_group(1, group, &[offset]);
-    for (indices, objects) in drawn_runs(ctx.scene, |_, o| o.casts_shadows) {
+    let light = tile_pass.maps.light;
+    for (indices, objects) in drawn_runs(ctx.scene, |i, o| o.casts_shadows && reaches(light, i)) {
         pass.draw(indices, objects);
     }
 }

@@ -171,13 +171,14 @@ impl CoverageMaps {
     }
 
     /// Renders the tile of each of `passes` into the coverage maps, one pass each named by
-    /// [`TilePass::name`] with `base`.
+    /// [`TilePass::name`] with `base`, drawing the casters `reaches(light, object)` accepts.
     pub(crate) fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         passes: &[TilePass<'_>],
         base: &str,
+        reaches: &dyn Fn(usize, usize) -> bool,
     ) -> TechniqueResult {
         let bound = self
             .bound
@@ -201,6 +202,7 @@ impl CoverageMaps {
                 &self.pipeline,
                 &bound.camera_group,
                 tile_pass,
+                reaches,
             );
         }
         Ok(())

@@ -159,7 +159,7 @@ impl IdMaps {
     }
 
     /// Renders the tile of each of `passes` into `depth` and the id maps, one pass each named
-    /// by [`TilePass::name`] with `base`.
+    /// by [`TilePass::name`] with `base`, drawing the casters `reaches(light, object)` accepts.
     pub(crate) fn record(
         &self,
         ctx: &RenderContext<'_>,
@@ -167,6 +167,7 @@ impl IdMaps {
         depth: &MapArray,
         passes: &[TilePass<'_>],
         base: &str,
+        reaches: &dyn Fn(usize, usize) -> bool,
     ) -> TechniqueResult {
         let bound = self
             .bound
@@ -194,6 +195,7 @@ impl IdMaps {
                 &self.pipeline,
                 &bound.camera_group,
                 tile_pass,
+                reaches,
             );
         }
         Ok(())

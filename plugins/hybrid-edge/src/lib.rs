@@ -454,15 +454,19 @@ impl ShadowTechnique for Hybrid {
         let exact = p.restriction == Restriction::TriangleIds;
         if exact {
             gpu.maps.begin_frame(ctx);
-            let depth = gpu.maps.maps().ok_or_else(TechniqueError::not_prepared)?;
-            let passes = gpu.maps.tile_passes();
-            gpu.ids.record(ctx, recorder, depth, &passes, IDS_PASS)?;
         } else {
             gpu.maps.record(ctx, recorder, MAP_PASS)?;
         }
+        let maps = &gpu.maps;
+        let reaches = |light, object| maps.reaches(&ctx.lights[light], object);
+        let passes = maps.tile_passes();
+        if exact {
+            let depth = maps.maps().ok_or_else(TechniqueError::not_prepared)?;
+            gpu.ids
+                .record(ctx, recorder, depth, &passes, IDS_PASS, &reaches)?;
+        }
         if p.coverage {
-            let passes = gpu.maps.tile_passes();
-            gpu.coverage.record(ctx, recorder, &passes, COVERAGE_PASS)?;
+            (gpu.coverage).record(ctx, recorder, &passes, COVERAGE_PASS, &reaches)?;
         }
         let restriction = gpu.restriction_codes.code(p.restriction.index());
         let uniform = |l: &LightMaps, _| Some(edge_light(p, l, restriction));
