@@ -1,27 +1,14 @@
 // Per-frame data shared by the host and every technique: bind group 0.
-// `Camera` mirrors `zoo_host::render::frame::CameraUniform`.
-
-struct Camera {
-    view: mat4x4<f32>,
-    proj: mat4x4<f32>,
-    view_proj: mat4x4<f32>,
-    inv_view_proj: mat4x4<f32>,
-    position: vec3<f32>,
-    near: f32,
-    size: vec2<f32>,
-    far: f32,
-    light_count: u32,
-    ambient: vec3<f32>,
-    _pad: f32,
-}
 
 const LIGHT_DIRECTIONAL: u32 = 0u;
 const LIGHT_POINT: u32 = 1u;
 const LIGHT_SPOT: u32 = 2u;
 
-// `zoo_host::render::frame::GpuLight` and `GpuObject`, by their WGSL names.
+// `zoo_host::render::frame::CameraUniform`, `GpuLight` and `GpuObject`, by their WGSL names.
+#import "common/camera.wgsl"
 #import "common/light.wgsl"
 #import "common/object.wgsl"
+alias Camera = CameraUniform;
 alias Light = GpuLight;
 alias Object = GpuObject;
 

@@ -68,14 +68,14 @@ fn shadow_depths(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(1.0, tap_near + m.depth * range, tap_near + stored_map_depth(m) * range);
 }
 
-fn split_visibility(s: Surface, split: u32, direction: vec3<f32>, r: mat2x2<f32>) -> f32 {
+fn split_visibility(s: Surface, split: u32, direction: vec3<f32>, noise: FilterNoise) -> f32 {
     tap_layer = pssm.first_layer + split;
     tap_near = pssm.depth_near[split / 4u][split % 4u];
     tap_far = pssm.depth_far[split / 4u][split % 4u];
     let texel = pssm.texel[split / 4u][split % 4u];
     let p = s.position + s.normal * (pssm.normal_offset * texel);
     let frame = tangent_frame(direction);
-    return filter_map(pssm.map_filter, TapPlane(p, s.normal, direction, true), frame, texel, r, tap_near, false);
+    return filter_map(pssm.map_filter, TapPlane(p, s.normal, direction, true), frame, texel, noise, tap_near, false);
 }
 
 struct Outputs {
@@ -102,8 +102,8 @@ fn fs_pssm(in: FullscreenOut) -> Outputs {
     while split + 1u < pssm.splits && depth > distance_at(split + 1u) {
         split += 1u;
     }
-    let r = rotation(in.position.xy);
-    var visibility = split_visibility(s, split, direction, r);
+    let noise = filter_noise(in.position.xy, camera.frame);
+    var visibility = split_visibility(s, split, direction, noise);
     var weight = 0.0;
     if split + 1u < pssm.splits {
         let end = distance_at(split + 1u);
@@ -112,7 +112,7 @@ fn fs_pssm(in: FullscreenOut) -> Outputs {
             weight = clamp((depth - (end - band)) / band, 0.0, 1.0);
         }
         if weight > 0.0 {
-            visibility = mix(visibility, split_visibility(s, split + 1u, direction, r), weight);
+            visibility = mix(visibility, split_visibility(s, split + 1u, direction, noise), weight);
         }
     }
     out.visibility = vec4<f32>(visibility);

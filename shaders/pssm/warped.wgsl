@@ -106,14 +106,14 @@ fn fs_warped(in: FullscreenOut) -> Outputs {
     let frame = tangent_frame(ray_direction(light, s.position));
     let texel = texel_world(s.position, frame);
     let p = s.position + s.normal * (warped.normal_offset * texel);
-    let r = rotation(in.position.xy);
+    let noise = filter_noise(in.position.xy, camera.frame);
     // A warped map has no single near plane to size the PCSS blocker search by: the search
     // takes the largest radius (`search_texels`). Distances are measured from the light
     // (spot) or along it (directional, where only differences matter).
     let spot = light.kind != LIGHT_DIRECTIONAL;
     let near = select(-1e30, 0.0, spot);
     let plane = TapPlane(p, s.normal, select(light.direction, light.position, spot), !spot);
-    let visibility = filter_map(warped.map_filter, plane, frame, texel, r, near, spot);
+    let visibility = filter_map(warped.map_filter, plane, frame, texel, noise, near, spot);
     out.visibility = vec4<f32>(visibility);
     if warped.diagnostics == 1u {
         let depth = -(camera.view * vec4<f32>(s.position, 1.0)).z;

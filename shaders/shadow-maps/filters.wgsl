@@ -83,6 +83,24 @@ fn rotation(pixel: vec2<f32>) -> mat2x2<f32> {
     return mat2x2<f32>(c, s, -s, c);
 }
 
+// A pixel's filter noise: the Poisson discs' rotation, the same every frame (so still frames
+// do not flicker), and for stochastic filters a point of [0, 1)^2 that moves every frame.
+struct FilterNoise {
+    rotation: mat2x2<f32>,
+    moving: vec2<f32>,
+}
+
+// Golden-ratio steps of the plastic-number (R2) sequence: consecutive frames' points of one
+// pixel spread evenly over the unit square.
+const R2_STEP: vec2<f32> = vec2<f32>(0.7548777, 0.5698403);
+
+// The noise of `pixel` in the renderer's frame `frame` (the `camera.frame` seed): the moving
+// point starts at two decorrelated interleaved-gradient values and walks the R2 sequence.
+fn filter_noise(pixel: vec2<f32>, frame: u32) -> FilterNoise {
+    let start = vec2<f32>(interleaved_gradient_noise(pixel), interleaved_gradient_noise(pixel.yx + vec2<f32>(47.0, 17.0)));
+    return FilterNoise(rotation(pixel), fract(start + f32(frame % 4096u) * R2_STEP));
+}
+
 // The receiver's tangent plane and the light's rays, for placing filter taps.
 struct TapPlane {
     // The lookup point (on the plane) and the receiver's normal there.
@@ -142,6 +160,24 @@ fn poisson_pcf(plane: TapPlane, frame: mat2x3<f32>, radius: f32, r: mat2x2<f32>)
     return sum / 32.0;
 }
 
+// Taps of the stochastic filter.
+const STOCHASTIC_TAPS: u32 = 4u;
+
+// Stochastic PCF: a few bilinear taps on the disc of world radius `radius`, one in each of
+// STOCHASTIC_TAPS rings of equal area, placed by the pixel's moving noise `u`. Each tap is
+// uniform over its ring as `u` is over the square, so the mean over frames is the whole disc's
+// filtered visibility (a Poisson kernel's limit) at an eighth of its taps; one frame is noisy.
+fn stochastic_pcf(plane: TapPlane, frame: mat2x3<f32>, radius: f32, u: vec2<f32>) -> f32 {
+    var sum = 0.0;
+    for (var k = 0u; k < STOCHASTIC_TAPS; k++) {
+        let ring = sqrt((f32(k) + u.x) / f32(STOCHASTIC_TAPS));
+        let angle = 6.2831853 * fract(u.y + f32(k) * 0.618034);
+        let offset = vec2<f32>(cos(angle), sin(angle)) * ring * radius;
+        sum += shadow_tap(plane_tap(plane, frame, offset), true);
+    }
+    return sum / f32(STOCHASTIC_TAPS);
+}
+
 // What PCSS needs to know about the light and the map.
 struct PcssLight {
     // Radius (point, spot) or tangent of the angular radius (directional).
@@ -197,6 +233,7 @@ const FILTER_PCF7X7: u32 = 4u;
 const FILTER_PCF9X9: u32 = 5u;
 const FILTER_POISSON: u32 = 6u;
 const FILTER_PCSS: u32 = 7u;
+const FILTER_STOCHASTIC: u32 = 8u;
 
 // One light's filter (`MapFilter` in the library's Rust, written by `MapFilters::filter`).
 struct MapFilter {
@@ -211,10 +248,11 @@ struct MapFilter {
 }
 
 // Visibility at the receiver `plane` (1 = lit) through filter `f`: `frame` spans the plane
-// across the light's rays, `texel` is a map texel's world size there and `r` the pixel's
-// rotation; PCSS sizes its search from the map's `near` plane (scaled by distance on
+// across the light's rays, `texel` is a map texel's world size there and `noise` the pixel's
+// (`filter_noise`); PCSS sizes its search from the map's `near` plane (scaled by distance on
 // `perspective` maps).
-fn filter_map(f: MapFilter, plane: TapPlane, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, near: f32, perspective: bool) -> f32 {
+fn filter_map(f: MapFilter, plane: TapPlane, frame: mat2x3<f32>, texel: f32, noise: FilterNoise, near: f32, perspective: bool) -> f32 {
+    let r = noise.rotation;
     var visibility = 1.0;
     switch f.mode {
         case FILTER_NONE: { visibility = shadow_tap(plane.point, false); }
@@ -224,6 +262,7 @@ fn filter_map(f: MapFilter, plane: TapPlane, frame: mat2x3<f32>, texel: f32, r: 
         case FILTER_PCF7X7: { visibility = grid_pcf(plane, frame, texel, 7); }
         case FILTER_PCF9X9: { visibility = grid_pcf(plane, frame, texel, 9); }
         case FILTER_POISSON: { visibility = poisson_pcf(plane, frame, f.kernel_texels * texel, r); }
+        case FILTER_STOCHASTIC: { visibility = stochastic_pcf(plane, frame, f.kernel_texels * texel, noise.moving); }
         default: {
             let light = PcssLight(f.light_size, near, perspective, f.search_texels);
             visibility = pcss(plane, frame, texel, r, light);

@@ -62,5 +62,5 @@ fn look_up(h: MapHeader, f: MapFilter, r: Receiver, pixel: vec2<f32>) -> f32 {
     let light = lights[h.light];
     let parallel = h.perspective == 0u;
     let plane = TapPlane(r.lookup, r.surface.normal, select(light.position, light.direction, parallel), parallel);
-    return filter_map(f, plane, frame, r.texel, rotation(pixel), h.near, h.perspective == 1u);
+    return filter_map(f, plane, frame, r.texel, filter_noise(pixel, camera.frame), h.near, h.perspective == 1u);
 }

@@ -14,8 +14,10 @@ const FILTERS: &str = "shadow-maps/header_lookup.wgsl";
 
 zoo_host::param_choice! {
     /// How shadow-map comparisons are filtered: one tap, the hardware's bilinear 2x2, an N x N
-    /// grid, a rotated Poisson disc, or PCSS (penumbrae sized by the blocker distance).
-    pub enum Filter { None, Hardware2x2, Pcf3x3, Pcf5x5, Pcf7x7, Pcf9x9, Poisson, Pcss }
+    /// grid, a rotated Poisson disc, PCSS (penumbrae sized by the blocker distance), or
+    /// stochastic PCF (four taps of the Poisson disc's area, moved every frame: noisy alone,
+    /// the disc's filtering on average over frames).
+    pub enum Filter { None, Hardware2x2, Pcf3x3, Pcf5x5, Pcf7x7, Pcf9x9, Poisson, Pcss, Stochastic }
 }
 
 /// One light's filter as a lookup reads it (`MapFilter` in `shadow-maps/filters.wgsl`).

@@ -20,9 +20,10 @@ zoo_host::technique_params! {
 zoo_host::technique_params! {
     /// How shadow-map lookups are filtered.
     pub struct FilterParams {
-        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, or PCSS.
+        /// Filter: none, hardware 2x2, N x N grid PCF, rotated Poisson disc, PCSS, or
+        /// stochastic PCF (four taps of the Poisson disc, moved every frame).
         filter: Filter = Filter::Pcf3x3;
-        /// Poisson disc radius in texels.
+        /// Poisson (and stochastic) disc radius in texels.
         kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
         /// Largest PCSS blocker search and penumbra radius, in texels.
         pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);

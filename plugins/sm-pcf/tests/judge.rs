@@ -172,6 +172,7 @@ fn every_filter_mode_renders_within_bounds() {
         "Pcf9x9",
         "Poisson",
         "Pcss",
+        "Stochastic",
     ] {
         let run = judge(
             "curved.ron",
@@ -256,4 +257,135 @@ fn contact_shadows_close_thin_shadows_small_maps_miss() {
             assert!(contact.metrics(sun).false_lit <= 0.75 * maps.metrics(sun).false_lit);
         }
     }
+}
+
+/// Stochastic PCF: four taps a pixel on the Poisson disc's area, moved every frame, judged
+/// beside the 32-tap Poisson disc of the same radius and the 5x5 grid (1024² maps, a disc of 4
+/// texels, so the kernels shape the penumbrae). One frame keeps sm-pcf's core bounds and the
+/// Poisson kernel's mae within 0.005; the mean of 16 frames converges on the Poisson kernel
+/// (the disc both estimate: its gap at most half of one frame's) with its mae.
+#[test]
+fn stochastic_pcf_averages_to_the_poisson_kernel() {
+    let size = UVec2::new(128, 128);
+    let with = |filter| {
+        [
+            ("map_size", "1024"),
+            ("kernel_radius", "4"),
+            ("filter", filter),
+        ]
+    };
+    for scene in ["soft.ron", "planar-room.ron"] {
+        let grid = judge(scene, "sm-pcf", &with("Pcf5x5"), size);
+        let poisson = judge(scene, "sm-pcf", &with("Poisson"), size);
+        let one = judge(scene, "sm-pcf", &with("Stochastic"), size);
+        let frames = mean_visibility(&one.loaded, &with("Stochastic"), size, 16);
+        for light in 0..one.loaded.lights.len() {
+            let (g, p, s) = (
+                grid.metrics(light),
+                poisson.metrics(light),
+                one.metrics(light),
+            );
+            let reference = &one.reference.lights[light];
+            let mean = zoo_host::judge::Metrics::compute(
+                reference,
+                &frames.mean[light],
+                size.x as usize,
+                size.y as usize,
+                None,
+            );
+            let poisson_visibility = &poisson.judged.visibility[light];
+            let single_gap = mean_gap(&one.judged.visibility[light], poisson_visibility);
+            let mean_gap = mean_gap(&frames.mean[light], poisson_visibility);
+            eprintln!(
+                "{scene} light {light}: mae 5x5 {:.4}, Poisson {:.4}, stochastic one frame {:.4} (core {:.4}/{:.4}), mean of 16 {:.4}; gap to Poisson {single_gap:.4} -> {mean_gap:.4}; {} pixels change between frames",
+                g.mae,
+                p.mae,
+                s.mae,
+                s.false_shadow_core,
+                s.false_lit_core,
+                mean.mae,
+                frames.changed[light]
+            );
+            one.assert_bounds(
+                light,
+                &s,
+                &[
+                    (Metric::FalseShadowCore, 0.005),
+                    (Metric::FalseLitCore, 0.01),
+                    (Metric::Mae, p.mae + 0.005),
+                ],
+            );
+            assert!(
+                frames.changed[light] > 0,
+                "{scene} light {light}: no tap moved"
+            );
+            assert!(
+                mean_gap <= 0.5 * single_gap,
+                "{scene} light {light}: the mean of frames does not converge"
+            );
+            assert!(
+                mean.mae <= p.mae + 0.001,
+                "{scene} light {light}: mean mae {}",
+                mean.mae
+            );
+        }
+    }
+}
+
+/// Per light: the mean visibility of `count` consecutive frames and the pixels whose
+/// visibility differs between the first two.
+struct Frames {
+    mean: Vec<Vec<f32>>,
+    changed: Vec<usize>,
+}
+
+/// Renders `count` frames of sm-pcf with `params` on `scene` and averages each light's
+/// visibility.
+fn mean_visibility(
+    scene: &zoo_host::Scene,
+    params: &[(&str, &str)],
+    size: UVec2,
+    count: usize,
+) -> Frames {
+    let schema = (zoo_host::find_technique("sm-pcf").unwrap().params)();
+    let mut values = zoo_host::params::defaults(&schema);
+    let assignments: Vec<_> = (params.iter())
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    zoo_host::params::apply_assignments(&schema, &mut values, &assignments).unwrap();
+    let mut renderer =
+        zoo_host::Renderer::new(zoo_host::test_support::gpu(), scene.clone(), size).unwrap();
+    renderer.set_technique("sm-pcf", &values).unwrap();
+    let lights = scene.lights.len();
+    let mut mean = vec![vec![0.0; (size.x * size.y) as usize]; lights];
+    let mut first = Vec::new();
+    let mut changed = vec![0; lights];
+    for frame in 0..count {
+        renderer.render(&zoo_host::View::Final).unwrap();
+        for (light, sum) in mean.iter_mut().enumerate() {
+            let visibility = renderer.read_visibility(light);
+            match frame {
+                0 => first.push(visibility.clone()),
+                1 => {
+                    changed[light] = (visibility.iter().zip(&first[light]))
+                        .filter(|(a, b)| a != b)
+                        .count()
+                }
+                _ => {}
+            }
+            for (s, v) in sum.iter_mut().zip(visibility) {
+                *s += v / count as f32;
+            }
+        }
+    }
+    Frames { mean, changed }
+}
+
+/// Mean absolute difference of two visibility images.
+fn mean_gap(a: &[f32], b: &[f32]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| f64::from((x - y).abs()))
+        .sum::<f64>()
+        / a.len() as f64
 }

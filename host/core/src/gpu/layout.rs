@@ -195,7 +195,6 @@ macro_rules! mirror_fields {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ShaderLibrary;
 
     #[test]
     fn choice_codes_come_from_the_shader() {
@@ -210,34 +209,6 @@ mod tests {
         let signed = "const MODE_A: i32 = 1;\n";
         assert!(ChoiceCodes::read(signed, "MODE", &["A"]).is_err());
     }
-    use crate::render::frame::CameraUniform;
-
-    fn frame() -> String {
-        ShaderLibrary::embedded()
-            .compose("common/frame.wgsl")
-            .unwrap()
-            .source
-    }
-
-    #[test]
-    fn frame_structs_mirror_their_wgsl() {
-        let source = frame();
-        let (size, fields) = crate::mirror_fields!(CameraUniform {
-            view,
-            proj,
-            view_proj,
-            inv_view_proj,
-            position,
-            near,
-            size,
-            far,
-            light_count,
-            ambient,
-            _pad
-        });
-        check_mirror(&source, "Camera", size, &fields, SizeRule::Equal).unwrap();
-    }
-
     #[repr(C)]
     struct PartialLight {
         position: [f32; 3],

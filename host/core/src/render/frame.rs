@@ -1,27 +1,31 @@
 //! Bind group 0: camera, lights and objects, laid out as in `shaders/common/frame.wgsl`.
 
-use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, UVec2, UVec4, Vec3, Vec4};
+use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
 use super::visibility::SlotAssignment;
 use crate::gpu::{GpuContext, GpuType, gpu_bytes};
 use crate::scene::{Camera, Light, LightKind, Scene};
 
-/// `Camera` in WGSL.
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-#[repr(C)]
-pub struct CameraUniform {
-    pub view: [[f32; 4]; 4],
-    pub proj: [[f32; 4]; 4],
-    pub view_proj: [[f32; 4]; 4],
-    pub inv_view_proj: [[f32; 4]; 4],
-    pub position: [f32; 3],
-    pub near: f32,
-    pub size: [f32; 2],
-    pub far: f32,
-    pub light_count: u32,
-    pub ambient: [f32; 3],
-    pub _pad: f32,
+crate::gpu_struct! {
+    "common/camera.wgsl" =>
+    /// `Camera` in WGSL (`common/frame.wgsl` aliases it).
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct CameraUniform {
+        pub view: Mat4,
+        pub proj: Mat4,
+        pub view_proj: Mat4,
+        pub inv_view_proj: Mat4,
+        pub position: Vec3,
+        pub near: f32,
+        /// Output size in pixels.
+        pub size: Vec2,
+        pub far: f32,
+        pub light_count: u32,
+        pub ambient: Vec3,
+        /// Frames this renderer rendered before this one: the per-frame seed of stochastic
+        /// filters (0 for the first frame, so a fresh renderer's frames repeat exactly).
+        pub frame: u32,
+    }
 }
 
 crate::gpu_struct! {
@@ -130,6 +134,8 @@ pub struct FrameBindings {
     pub object_buffer: wgpu::Buffer,
     /// Matrices last uploaded.
     pub matrices: CameraMatrices,
+    /// Frames uploaded so far (the next frame's [`CameraUniform::frame`]).
+    pub frames: u32,
 }
 
 /// Layout of bind group 0 (`common/frame.wgsl`).
@@ -178,7 +184,7 @@ impl FrameBindings {
         };
         let camera_buffer = buffer(
             "camera uniform",
-            size_of::<CameraUniform>(),
+            CameraUniform::SIZE,
             wgpu::BufferUsages::UNIFORM,
         );
         let object_buffer = buffer(
@@ -214,6 +220,7 @@ impl FrameBindings {
             light_buffer,
             object_buffer,
             matrices: CameraMatrices::new(&scene.camera, UVec2::ONE),
+            frames: 0,
         }
     }
 
@@ -229,7 +236,7 @@ impl FrameBindings {
         );
     }
 
-    /// Uploads the camera, ambient term and lights with their slots.
+    /// Uploads the camera, ambient term and lights with their slots, and counts the frame.
     pub fn update(
         &mut self,
         gpu: &GpuContext,
@@ -241,20 +248,21 @@ impl FrameBindings {
     ) {
         let m = CameraMatrices::new(camera, size);
         let uniform = CameraUniform {
-            view: m.view.to_cols_array_2d(),
-            proj: m.proj.to_cols_array_2d(),
-            view_proj: m.view_proj.to_cols_array_2d(),
-            inv_view_proj: m.view_proj.inverse().to_cols_array_2d(),
-            position: camera.position.to_array(),
+            view: m.view,
+            proj: m.proj,
+            view_proj: m.view_proj,
+            inv_view_proj: m.view_proj.inverse(),
+            position: camera.position,
             near: camera.near,
-            size: [size.x as f32, size.y as f32],
+            size: size.as_vec2(),
             far: camera.far,
             light_count: lights.len() as u32,
-            ambient: ambient.to_array(),
-            _pad: 0.0,
+            ambient,
+            frame: self.frames,
         };
+        self.frames = self.frames.wrapping_add(1);
         gpu.queue
-            .write_buffer(&self.camera_buffer, 0, bytemuck::bytes_of(&uniform));
+            .write_buffer(&self.camera_buffer, 0, &gpu_bytes(&[uniform]));
         let gpu_lights: Vec<GpuLight> = lights
             .iter()
             .enumerate()
