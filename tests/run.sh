@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Runs the whole test suite headless (README's test command; .ci/run calls it too).
+# Runs the test suite headless (README's test command; .ci/run calls it too). With `--long`
+# first, runs the long checks instead (the tests marked `#[ignore = "long check: ..."]`: limits,
+# scales and walks of many frames), which .ci/run runs after the suite.
 # On Linux without a Vulkan driver it installs Mesa's lavapipe software driver when run as
 # root, and otherwise stops with the command to run.
 set -euo pipefail
@@ -33,4 +35,9 @@ export RUST_LOG="${RUST_LOG:-warn}"
 
 # Without the viewer's window (the `window` feature): the tests drive the viewer headless, and
 # the windowing stack is about 80 s of a fresh build. CI's clippy still checks the window code.
+if [ "${1:-}" = --long ]; then
+    shift
+    # `--tests`: the long checks are tests; doc examples marked `ignore` are not checks.
+    exec cargo test --workspace --locked --no-default-features --tests "$@" -- --ignored
+fi
 exec cargo test --workspace --locked --no-default-features "$@"

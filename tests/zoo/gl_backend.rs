@@ -107,6 +107,7 @@ fn compare_backends(gl: &Arc<GpuContext>, scene: Scene) {
 }
 
 #[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
 fn the_default_render_on_gl_matches_vulkan() {
     let Some(gl) = gl() else { return };
     // The Vulkan sheet is the one the contact-sheet tests share.

@@ -29,6 +29,7 @@ fn splits_halve_the_core_error_of_one_map_at_the_same_texel_budget() {
 }
 
 #[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
 fn stabilised_splits_flicker_less_along_the_vista_walk() {
     let scene = scene_path("vista.ron");
     let plan = BenchPlan {

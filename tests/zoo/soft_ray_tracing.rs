@@ -35,6 +35,7 @@ fn mean_mae(judged: &Judged) -> f64 {
 }
 
 #[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
 fn accumulated_rays_keep_half_of_pcss_error_on_soft_scenes() {
     for scene in ["soft.ron", "many-lights.ron"] {
         let loaded = Scene::load(&scene_path(scene)).unwrap();

@@ -209,6 +209,7 @@ fn the_viewer_opens_on_a_shadowing_technique_then_on_the_last_one_used() {
 }
 
 #[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
 fn switching_two_hundred_times_frees_the_old_resources() {
     // A device of its own, so other tests' resources do not move the counts.
     let own = std::sync::Arc::new(GpuContext::new_headless().unwrap());

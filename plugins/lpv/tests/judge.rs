@@ -286,6 +286,7 @@ fn occlusion_stops_light_behind_a_wall() {
 }
 
 #[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
 fn rooms_lit_through_openings() {
     // The enclosed scenes: 0.2 m slabs under a skylight and in two rooms joined by a
     // doorway (thinner than the coarser cells), 0.7 m walls around a window (thicker than
