@@ -37,7 +37,7 @@ export RUST_LOG="${RUST_LOG:-warn}"
 # the windowing stack is about 80 s of a fresh build. CI's clippy still checks the window code.
 if [ "${1:-}" = --long ]; then
     shift
-    # `--tests`: the long checks are tests; doc examples marked `ignore` are not checks.
+    # `--tests`: the long checks are tests (the doc examples all run in the suite).
     exec cargo test --workspace --locked --no-default-features --tests "$@" -- --ignored
 fi
 exec cargo test --workspace --locked --no-default-features "$@"

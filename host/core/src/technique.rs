@@ -206,12 +206,33 @@ pub fn find_technique(id: &str) -> Result<&'static TechniqueRegistration, Techni
 /// id, name or light kinds); the others default to [`TechniqueRegistration::DEFAULTS`] (no
 /// features or downlevel needs, WebGPU's downlevel limits, no parameters):
 ///
-/// ```ignore
-/// zoo_host::register_technique! {
-///     id: "my-technique",
-///     name: "My technique",
-///     // ...
+/// ```
+/// use zoo_host::technique::{Changes, RenderContext, ShadowTechnique, TechniqueResult};
+/// use zoo_host::{LightKind, PassRecorder};
+///
+/// /// Leaves every light's visibility as the host cleared it (1: lit).
+/// struct AlwaysLit;
+///
+/// impl ShadowTechnique for AlwaysLit {
+///     fn prepare(&mut self, _: &RenderContext<'_>, _: Changes) -> TechniqueResult {
+///         Ok(())
+///     }
+///     fn record(&mut self, _: &RenderContext<'_>, _: &mut PassRecorder<'_>) -> TechniqueResult {
+///         Ok(())
+///     }
 /// }
+///
+/// zoo_host::register_technique! {
+///     id: "always-lit",
+///     name: "Always lit",
+///     description: "Every light visible everywhere",
+///     source: "the example of `register_technique!`",
+///     light_kinds: &[LightKind::Directional, LightKind::Point],
+///     create: |_, _| Ok(Box::new(AlwaysLit)),
+/// }
+///
+/// let registered = zoo_host::find_technique("always-lit").unwrap();
+/// assert_eq!(registered.package, "zoo-host");
 /// ```
 #[macro_export]
 macro_rules! register_technique {

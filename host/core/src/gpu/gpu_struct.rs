@@ -4,7 +4,10 @@
 //! exists to drift, so no mirror test is needed; one workspace test checks every registered
 //! struct's computed layout against naga's.
 //!
-//! ```ignore
+//! ```
+//! use zoo_host::glam::{Mat4, Vec3};
+//! use zoo_host::gpu::{GpuType, gpu_bytes};
+//!
 //! zoo_host::gpu_struct! {
 //!     "my-technique/light.wgsl" =>
 //!     /// One light as the lookup reads it.
@@ -15,8 +18,13 @@
 //!         pub cameras: [Mat4; 2],
 //!     }
 //! }
-//! // WGSL: #import "my-technique/light.wgsl", then `MyLight` is a struct there.
-//! queue.write_buffer(&buffer, 0, &gpu_bytes(&lights));
+//!
+//! // WGSL's layout, computed: 12 + 4 bytes, then two 64-byte matrices.
+//! let light = MyLight { direction: Vec3::Y, strength: 2.0, cameras: [Mat4::IDENTITY; 2] };
+//! assert_eq!((MyLight::SIZE, gpu_bytes(&[light]).len()), (144, 144));
+//! // Shaders `#import "my-technique/light.wgsl"` to declare it.
+//! let wgsl = zoo_host::ShaderLibrary::embedded().compose("my-technique/light.wgsl").unwrap();
+//! assert!(wgsl.source.contains("struct MyLight"));
 //! ```
 //!
 //! A `gpu_struct!` type is also a [`UniformValue`](crate::kit::UniformValue), so

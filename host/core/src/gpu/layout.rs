@@ -1,11 +1,20 @@
 //! Checks that a Rust struct uploaded to the GPU has the layout of the WGSL struct it mirrors
 //! (member offsets and size, read from the shader with naga), so the two cannot drift apart.
 //!
-//! ```ignore
-//! let wgsl = ShaderLibrary::embedded().compose("common/frame.wgsl")?.source;
-//! let (size, fields) = zoo_host::mirror_fields!(GpuLight { position, kind, direction });
-//! check_mirror(&wgsl, "Light", size, &fields, SizeRule::Equal)?;
 //! ```
+//! use zoo_host::gpu::layout::{SizeRule, check_mirror};
+//!
+//! #[repr(C)]
+//! struct Span {
+//!     start: [f32; 3],
+//!     length: f32,
+//! }
+//! let wgsl = "struct Span { start: vec3<f32>, length: f32 }";
+//! let (size, fields) = zoo_host::mirror_fields!(Span { start, length });
+//! check_mirror(wgsl, "Span", size, &fields, SizeRule::Equal).unwrap();
+//! ```
+//!
+//! Prefer [`gpu_struct!`](crate::gpu_struct), which leaves no second copy to check.
 
 /// The members (name, byte offset) and size of a WGSL struct.
 #[derive(Debug, Clone, PartialEq, Eq)]
