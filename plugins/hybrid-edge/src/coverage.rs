@@ -8,10 +8,9 @@
 use zoo_host::gpu::PassRecorder;
 use zoo_host::kit::{bind_group, bind_group_layout, storage, texture};
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
-use zoo_shadow_maps::{MAP_FORMAT, MapArray, TilePass};
+use zoo_shadow_maps::{DepthState, MapArray, TilePass};
 
-use crate::NO_TRIANGLE;
-use crate::casters::{caster_group, caster_layout, draw_casters};
+use crate::casters::CasterIdPass;
 
 /// The coverage maps of one set of depth maps.
 struct Bound {
@@ -27,8 +26,7 @@ struct Bound {
 
 /// The coverage pass's pipeline, its maps and the band pass's group over them.
 pub(crate) struct CoverageMaps {
-    pipeline: wgpu::RenderPipeline,
-    camera_layout: wgpu::BindGroupLayout,
+    pass: CasterIdPass,
     /// Group 4 of `fs_band`: the coverage maps' ids, the scene's vertices and indices.
     pub(crate) lookup_layout: wgpu::BindGroupLayout,
     bound: Option<Bound>,
@@ -64,49 +62,18 @@ pub(crate) fn coverage_resources<'a>(
 
 impl CoverageMaps {
     pub(crate) fn new(ctx: &RenderContext<'_>) -> TechniqueResult<CoverageMaps> {
-        let device = &ctx.gpu.device;
-        let module = ctx
-            .shaders
-            .create_module(device, "hybrid-edge/coverage.wgsl")?;
-        let camera_layout = caster_layout(device, "hybrid coverage camera layout");
-        let lookup_layout =
-            bind_group_layout(device, "hybrid coverage lookup layout", &coverage_entries());
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("hybrid coverage pipeline layout"),
-            bind_group_layouts: &[Some(&ctx.frame.layout), Some(&camera_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("hybrid coverage pipeline"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_coverage"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            // Both faces: a caster's every triangle counts, whichever way it faces.
-            primitive: Default::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: MAP_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_coverage"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let stages = ("vs_coverage", "fs_coverage");
+        let shader = "hybrid-edge/coverage.wgsl";
+        // Both faces, no bias: a caster's every triangle counts, whichever way it faces.
+        let state = DepthState::default();
+        let pass = CasterIdPass::new(ctx, "hybrid coverage", shader, stages, state)?;
+        let lookup_layout = bind_group_layout(
+            &ctx.gpu.device,
+            "hybrid coverage lookup layout",
+            &coverage_entries(),
+        );
         Ok(CoverageMaps {
-            pipeline,
-            camera_layout,
+            pass,
             lookup_layout,
             bound: None,
         })
@@ -141,8 +108,7 @@ impl CoverageMaps {
             depth.layers,
             wgpu::TextureFormat::R32Uint,
         );
-        let camera_group =
-            caster_group(ctx, "hybrid coverage cameras", &self.camera_layout, cameras);
+        let camera_group = (self.pass).camera_group(ctx, "hybrid coverage cameras", cameras);
         let lookup_group = bind_group(
             &ctx.gpu.device,
             "hybrid coverage lookup",
@@ -184,27 +150,9 @@ impl CoverageMaps {
             .bound
             .as_ref()
             .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
-        let none = wgpu::Color {
-            r: NO_TRIANGLE as f64,
-            ..wgpu::Color::TRANSPARENT
-        };
-        for tile_pass in passes {
-            let page = tile_pass.tile.page as usize;
-            let colors = [zoo_host::gpu::color_attachment(
-                &bound.ids.layer_views[page],
-                tile_pass.load_op(none),
-            )];
-            let depth = &bound.depth_maps.layer_views[page];
-            let mut pass = tile_pass.begin(recorder, base, &colors, depth, tile_pass.load_op(1.0));
-            draw_casters(
-                ctx,
-                &mut pass,
-                &self.pipeline,
-                &bound.camera_group,
-                tile_pass,
-                reaches,
-            );
-        }
+        let maps = (&bound.ids, &bound.depth_maps);
+        let cameras = &bound.camera_group;
+        (self.pass).record(ctx, recorder, maps, cameras, passes, base, reaches);
         Ok(())
     }
 }

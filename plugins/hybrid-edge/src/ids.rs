@@ -6,10 +6,9 @@
 use zoo_host::gpu::PassRecorder;
 use zoo_host::kit::{bind_group, bind_group_layout, texture};
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
-use zoo_shadow_maps::{DepthState, MAP_FORMAT, MapArray, TilePass};
+use zoo_shadow_maps::{DepthState, MapArray, TilePass};
 
-use crate::NO_TRIANGLE;
-use crate::casters::{caster_group, caster_layout, draw_casters};
+use crate::casters::CasterIdPass;
 use crate::coverage::{coverage_entries, coverage_resources};
 
 /// The id maps of one set of depth maps, and the bind groups over them.
@@ -26,8 +25,7 @@ struct Bound {
 
 /// The id pass's pipeline and its bindings.
 pub(crate) struct IdMaps {
-    pipeline: wgpu::RenderPipeline,
-    camera_layout: wgpu::BindGroupLayout,
+    pass: CasterIdPass,
     /// Group 4 of `fs_band_ids`: the coverage maps' ids, the scene's vertices and indices, and
     /// the triangle ids.
     pub(crate) lookup_layout: wgpu::BindGroupLayout,
@@ -38,8 +36,8 @@ impl IdMaps {
     /// Builds the pipeline with the depth maps' rasterisation `state`.
     pub(crate) fn new(ctx: &RenderContext<'_>, state: DepthState) -> TechniqueResult<IdMaps> {
         let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, "hybrid-edge/ids.wgsl")?;
-        let camera_layout = caster_layout(device, "hybrid id map camera layout");
+        let stages = ("vs_ids", "fs_ids");
+        let pass = CasterIdPass::new(ctx, "hybrid id map", "hybrid-edge/ids.wgsl", stages, state)?;
         let [coverage_ids, vertices, indices] = coverage_entries();
         let ids = texture(
             3,
@@ -52,48 +50,8 @@ impl IdMaps {
             "hybrid id lookup layout",
             &[coverage_ids, vertices, indices, ids],
         );
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("hybrid id map pipeline layout"),
-            bind_group_layouts: &[Some(&ctx.frame.layout), Some(&camera_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("hybrid id map pipeline"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_ids"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: state.cull_front.then_some(wgpu::Face::Front),
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: MAP_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: wgpu::DepthBiasState {
-                    constant: state.constant_bias,
-                    slope_scale: state.slope_bias,
-                    clamp: 0.0,
-                },
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_ids"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
         Ok(IdMaps {
-            pipeline,
-            camera_layout,
+            pass,
             lookup_layout,
             bound: None,
         })
@@ -126,7 +84,7 @@ impl IdMaps {
             wgpu::TextureFormat::R32Uint,
         );
         let buffers = ctx.scene_buffers;
-        let camera_group = caster_group(ctx, "hybrid id map cameras", &self.camera_layout, cameras);
+        let camera_group = (self.pass).camera_group(ctx, "hybrid id map cameras", cameras);
         let lookup_group = bind_group(
             device,
             "hybrid id lookup",
@@ -173,31 +131,9 @@ impl IdMaps {
             .bound
             .as_ref()
             .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
-        let none = NO_TRIANGLE as f64;
-        let clear = wgpu::Color {
-            r: none,
-            g: none,
-            b: none,
-            a: none,
-        };
-        for tile_pass in passes {
-            let page = tile_pass.tile.page as usize;
-            let colors = [zoo_host::gpu::color_attachment(
-                &bound.ids.layer_views[page],
-                tile_pass.load_op(clear),
-            )];
-            let depth_view = &depth.layer_views[page];
-            let mut pass =
-                tile_pass.begin(recorder, base, &colors, depth_view, tile_pass.load_op(1.0));
-            draw_casters(
-                ctx,
-                &mut pass,
-                &self.pipeline,
-                &bound.camera_group,
-                tile_pass,
-                reaches,
-            );
-        }
+        let maps = (&bound.ids, depth);
+        let cameras = &bound.camera_group;
+        (self.pass).record(ctx, recorder, maps, cameras, passes, base, reaches);
         Ok(())
     }
 }
