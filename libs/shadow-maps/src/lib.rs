@@ -24,6 +24,7 @@ pub mod light_space;
 pub mod lookup;
 pub mod lookup_pass;
 pub mod maps;
+pub mod moment_technique;
 pub mod moments;
 pub mod params;
 pub mod planning;
@@ -40,6 +41,7 @@ pub use filter::{Filter, MapFilter, MapFilters};
 pub use header::MapHeader;
 pub use lookup_pass::{Lookup, LookupPass, LookupShader};
 pub use maps::{CUBE_GUARD, MAP_FORMAT, MOMENTS_RG_FORMAT, MOMENTS_RGBA_FORMAT, MapArray};
+pub use moment_technique::{MomentChoice, MomentShadows};
 pub use moments::{MomentMaps, MomentMethod, MomentSettings};
 pub use params::{FilterParams, MapParams};
 pub use planning::{

@@ -8,9 +8,9 @@
 
 use zoo_host::params::{ParamSpec, TechniqueParams, find_spec};
 use zoo_host::prelude::*;
-use zoo_host::technique::{DebugImage, ResourceInfo};
 use zoo_shadow_maps::{
-    MOMENTS_RG_FORMAT, MOMENTS_RGBA_FORMAT, MomentMaps, MomentMethod, MomentSettings,
+    MOMENTS_RG_FORMAT, MOMENTS_RGBA_FORMAT, MomentChoice, MomentMethod, MomentSettings,
+    MomentShadows,
 };
 
 zoo_host::technique_params! {
@@ -127,55 +127,35 @@ impl Method {
     }
 }
 
-/// A moment method's technique.
-struct MomentShadows {
+/// A moment method with its parameters: its choice of the library's moment maps.
+struct MomentShadowing {
     method: &'static Method,
     params: MomentParams,
-    maps: LazyGpu<MomentMaps>,
 }
 
-fn settings(method: &Method, p: &MomentParams) -> MomentSettings {
-    MomentSettings {
-        map_size: p.map_size,
-        stable_fit: p.stable_fit,
-        blur_radius: p.blur_radius,
-        normal_offset: p.normal_offset,
-        bias: (method.bias)(p),
-        bleeding_reduction: p.bleeding_reduction,
-    }
-}
-
-impl ShadowTechnique for MomentShadows {
-    fn resources(&self) -> Vec<ResourceInfo> {
-        self.maps.built().map_or(Vec::new(), MomentMaps::resources)
+impl MomentChoice for MomentShadowing {
+    fn method(&self) -> MomentMethod {
+        MomentMethod {
+            label: self.method.label,
+            shader: self.method.shader,
+            prelude: Method::prelude(&self.params),
+            format: self.method.format(),
+        }
     }
 
-    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        let method = self.method;
-        let params = &self.params;
-        let maps = self.maps.prepare(false, || {
-            let maps = MomentMethod {
-                label: method.label,
-                shader: method.shader,
-                prelude: Method::prelude(params),
-                format: method.format(),
-            };
-            MomentMaps::new(ctx, &maps)
-        })?;
-        maps.prepare(ctx, changes, &settings(method, &self.params));
-        Ok(())
+    fn settings(&self) -> MomentSettings {
+        let p = &self.params;
+        MomentSettings {
+            map_size: p.map_size,
+            stable_fit: p.stable_fit,
+            blur_radius: p.blur_radius,
+            normal_offset: p.normal_offset,
+            bias: (self.method.bias)(p),
+            bleeding_reduction: p.bleeding_reduction,
+        }
     }
 
-    fn record(
-        &mut self,
-        ctx: &RenderContext<'_>,
-        recorder: &mut PassRecorder<'_>,
-    ) -> TechniqueResult {
-        let maps = self.maps.get_mut()?;
-        maps.record(ctx, recorder, &settings(self.method, &self.params))
-    }
-
-    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+    fn update(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
         // The exponents are WGSL constants of the passes (`flags(rebuild)`).
         let next = self.method.params(values)?;
         if next.rebuilds_from(&self.params) {
@@ -184,25 +164,14 @@ impl ShadowTechnique for MomentShadows {
         self.params = next;
         Ok(ParamUpdate::Applied)
     }
-
-    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        self.maps.built()?.debug_view(resource)
-    }
-
-    fn counters(&self) -> Vec<(String, f64)> {
-        self.maps.built().map_or(Vec::new(), MomentMaps::counters)
-    }
 }
 
 fn create(
     method: &'static Method,
     values: &ParamValues,
 ) -> TechniqueResult<Box<dyn ShadowTechnique>> {
-    Ok(Box::new(MomentShadows {
-        method,
-        params: method.params(values)?,
-        maps: LazyGpu::default(),
-    }))
+    let params = method.params(values)?;
+    Ok(MomentShadows::boxed(MomentShadowing { method, params }))
 }
 
 /// Registers one method as its own technique.

@@ -6,8 +6,9 @@
 //! maps (spot cones, directional boxes, point cubes).
 
 use zoo_host::prelude::*;
-use zoo_host::technique::{DebugImage, ResourceInfo};
-use zoo_shadow_maps::{MOMENTS_RG_FORMAT, MomentMaps, MomentMethod, MomentSettings};
+use zoo_shadow_maps::{
+    MOMENTS_RG_FORMAT, MomentChoice, MomentMethod, MomentSettings, MomentShadows,
+};
 
 zoo_host::technique_params! {
     /// Parameters of variance shadow maps.
@@ -27,71 +28,39 @@ zoo_host::technique_params! {
     }
 }
 
-struct Vsm {
-    params: VsmParams,
-    maps: LazyGpu<MomentMaps>,
-}
+/// VSM's choice of the library's moment maps.
+struct Vsm(VsmParams);
 
-/// The moment maps' settings for `p`.
-fn settings(p: &VsmParams) -> MomentSettings {
-    MomentSettings {
-        map_size: p.map_size,
-        stable_fit: p.stable_fit,
-        blur_radius: p.blur_radius,
-        normal_offset: p.normal_offset,
-        bias: p.min_variance,
-        bleeding_reduction: p.bleeding_reduction,
-    }
-}
-
-impl ShadowTechnique for Vsm {
-    fn resources(&self) -> Vec<ResourceInfo> {
-        self.maps.built().map_or(Vec::new(), MomentMaps::resources)
+impl MomentChoice for Vsm {
+    fn method(&self) -> MomentMethod {
+        MomentMethod {
+            label: "VSM",
+            shader: "vsm/vsm.wgsl",
+            prelude: String::new(),
+            format: MOMENTS_RG_FORMAT,
+        }
     }
 
-    fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        let maps = self.maps.prepare(false, || {
-            let method = MomentMethod {
-                label: "VSM",
-                shader: "vsm/vsm.wgsl",
-                prelude: String::new(),
-                format: MOMENTS_RG_FORMAT,
-            };
-            MomentMaps::new(ctx, &method)
-        })?;
-        maps.prepare(ctx, changes, &settings(&self.params));
-        Ok(())
+    fn settings(&self) -> MomentSettings {
+        let p = &self.0;
+        MomentSettings {
+            map_size: p.map_size,
+            stable_fit: p.stable_fit,
+            blur_radius: p.blur_radius,
+            normal_offset: p.normal_offset,
+            bias: p.min_variance,
+            bleeding_reduction: p.bleeding_reduction,
+        }
     }
 
-    fn record(
-        &mut self,
-        ctx: &RenderContext<'_>,
-        recorder: &mut PassRecorder<'_>,
-    ) -> TechniqueResult {
-        let maps = self.maps.get_mut()?;
-        maps.record(ctx, recorder, &settings(&self.params))
-    }
-
-    fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
+    fn update(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
         // Everything, map size included, applies at the next `prepare`.
-        Ok(self.params.update(values)?)
-    }
-
-    fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        self.maps.built()?.debug_view(resource)
-    }
-
-    fn counters(&self) -> Vec<(String, f64)> {
-        self.maps.built().map_or(Vec::new(), MomentMaps::counters)
+        Ok(self.0.update(values)?)
     }
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
-    let params = VsmParams::from_values(values)?;
-    Ok(Box::new(Vsm {
-        params,
-        maps: LazyGpu::default(),
-    }))
+    Ok(MomentShadows::boxed(Vsm(VsmParams::from_values(values)?)))
 }
 
 zoo_host::register_technique! {
