@@ -21,16 +21,9 @@
 #import "shadow-maps/receiver.wgsl"
 #import "shadow-maps/depth_lookup.wgsl"
 
-struct EdgeLight {
-    map: MapHeader,
-    // Neighbourhood radius r in texels.
-    radius: u32,
-    // Restriction (RESTRICTION_* below).
-    restriction: u32,
-    // 1: pixels the coverage maps cannot clear join the band.
-    coverage: u32,
-    _pad: u32,
-}
+// One light's header, band radius, restriction and coverage switch (`EdgeLight` in the
+// plugin's Rust).
+#import "hybrid-edge/edge_light.wgsl"
 
 // Restrictions, one per variant of the Rust `Restriction` parameter.
 const RESTRICTION_DEPTHBAND: u32 = 0u;

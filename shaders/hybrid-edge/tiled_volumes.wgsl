@@ -5,13 +5,8 @@ enable clip_distances;
 
 #import "common/frame.wgsl"
 
-struct TileParams {
-    // Tile side in pixels (a multiple of 8).
-    tile_size: u32,
-    tiles_x: u32,
-    tiles_y: u32,
-    _pad: u32,
-}
+// The tile grid (`TileParams` in the plugin's Rust).
+#import "hybrid-edge/tile_params.wgsl"
 
 @group(2) @binding(0) var<storage, read> tile_list: array<u32>;
 @group(2) @binding(1) var<uniform> params: TileParams;

@@ -6,13 +6,8 @@
 // Invocations along each side of a tile's scan (`SCAN_SIDE` in `tiles.rs`).
 const SCAN_SIDE: u32 = 8u;
 
-struct TileParams {
-    // Tile side in pixels (a multiple of SCAN_SIDE).
-    tile_size: u32,
-    tiles_x: u32,
-    tiles_y: u32,
-    _pad: u32,
-}
+// The tile grid (`TileParams` in the plugin's Rust).
+#import "hybrid-edge/tile_params.wgsl"
 
 @group(0) @binding(0) var band_depth: texture_depth_2d;
 // Active tiles, packed as x | y << 16.

@@ -8,19 +8,8 @@
 #import "shadow-maps/filters.wgsl"
 #import "shadow-maps/depth_lookup.wgsl"
 
-struct LpvShadow {
-    first_layer: u32,
-    // 1 (spot, directional) or 6 (point: cube faces).
-    layer_count: u32,
-    light: u32,
-    perspective: u32,
-    // World size of a texel: per unit of distance along the face axis (perspective) or
-    // absolute (orthographic).
-    texel_scale: f32,
-    normal_offset: f32,
-    _pad0: f32,
-    _pad1: f32,
-}
+// One light's maps (`LpvShadow` in the plugin's Rust).
+#import "lpv/lpv_shadow.wgsl"
 
 @group(2) @binding(0) var<uniform> shadow: LpvShadow;
 

@@ -10,26 +10,8 @@
 #import "shadow-maps/depth_lookup.wgsl"
 #import "pssm/density.wgsl"
 
-struct PssmLight {
-    // Index of the scene light (directional).
-    light: u32,
-    first_layer: u32,
-    splits: u32,
-    // 1 when this light's diagnostics are written.
-    diagnostics: u32,
-    map_filter: MapFilter,
-    // Fraction of each split blended into the next.
-    blend: f32,
-    // Normal offset in texels of the split's map.
-    normal_offset: f32,
-    _pad: vec2<u32>,
-    // Split distances C_0..C_8 (view depths), four per vector.
-    distances: array<vec4<f32>, 3>,
-    // Per split: world size of one texel, and the map's depth range.
-    texel: array<vec4<f32>, 2>,
-    depth_near: array<vec4<f32>, 2>,
-    depth_far: array<vec4<f32>, 2>,
-}
+// One light's splits, filter and diagnostics switch (`PssmLight` in the plugin's Rust).
+#import "pssm/pssm_light.wgsl"
 
 @group(2) @binding(0) var<uniform> pssm: PssmLight;
 

@@ -13,20 +13,7 @@
 // Per-light settings; everything that changes from frame to frame (the layer's matrices)
 // is read from the layer cameras instead, because lavapipe recompiles a shader whose
 // uniforms it inlined whenever their values change.
-struct WarpedLight {
-    // Index of the scene light.
-    light: u32,
-    layer: u32,
-    // 1 when this light's diagnostics are written.
-    diagnostics: u32,
-    // Map resolution in texels.
-    resolution: f32,
-    map_filter: MapFilter,
-    normal_offset: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
-}
+#import "pssm/warped_light.wgsl"
 
 @group(2) @binding(0) var<uniform> warped: WarpedLight;
 

@@ -8,17 +8,9 @@
 #import "common/fullscreen.wgsl"
 #import "shadow-maps/layers.wgsl"
 
-struct BlurParams {
-    // The tile read (its page of `source`).
-    tile: MapTile,
-    // Taps on each side of the centre; the kernel has 2 * radius + 1.
-    radius: u32,
-    // Standard deviation in texels.
-    sigma: f32,
-    // 1 for the vertical pass, 0 for the horizontal one.
-    vertical: u32,
-    _pad: u32,
-}
+// The step's tile, kernel radius and sigma, and direction (`BlurParams` in the library's
+// Rust).
+#import "shadow-maps/blur_params.wgsl"
 
 @group(0) @binding(0) var source: texture_2d_array<u32>;
 

@@ -236,16 +236,7 @@ const FILTER_PCSS: u32 = 7u;
 const FILTER_STOCHASTIC: u32 = 8u;
 
 // One light's filter (`MapFilter` in the library's Rust, written by `MapFilters::filter`).
-struct MapFilter {
-    // One of the FILTER_* constants.
-    mode: u32,
-    // Poisson disc radius, in texels.
-    kernel_texels: f32,
-    // Largest PCSS blocker search and penumbra radius, in texels.
-    search_texels: f32,
-    // Radius (point, spot) or tangent of the angular radius (directional), for PCSS.
-    light_size: f32,
-}
+#import "shadow-maps/map_filter.wgsl"
 
 // Visibility at the receiver `plane` (1 = lit) through filter `f`: `frame` spans the plane
 // across the light's rays, `texel` is a map texel's world size there and `noise` the pixel's

@@ -2,26 +2,11 @@
 // depth that moment maps store, the cube face a direction falls in, and a tangent frame across
 // a light ray. No bindings: the importer binds the cameras.
 
-// Where one layer's map lies in the atlas (the library's `MapTile`).
-struct MapTile {
-    // Texel of the page the tile starts at.
-    origin: vec2<u32>,
-    // Texels per side.
-    size: u32,
-    // Array layer of the atlas.
-    page: u32,
-}
-
-// One layer's camera (the depth pass's uniform; an array element of 256-byte slots for
-// lookups).
-struct LayerCamera {
-    view_proj: mat4x4<f32>,
-    // Perspective layers: the light's position and 1 / far. Orthographic layers: w = 0.
-    eye: vec4<f32>,
-    // Clip space back to world space (to unproject stored depths).
-    inv_view_proj: mat4x4<f32>,
-    tile: MapTile,
-}
+// Where one layer's map lies in the atlas (`MapTile`) and one layer's camera (`LayerCamera`:
+// the depth pass's uniform; an array element of 256-byte slots for lookups), both of the
+// library's Rust.
+#import "shadow-maps/map_tile.wgsl"
+#import "shadow-maps/layer_camera.wgsl"
 
 // Page coordinates in [0, 1] of tile coordinates `uv`, kept half a texel inside the tile so
 // bilinear taps never read a neighbouring tile (edges repeat, like a clamping sampler).

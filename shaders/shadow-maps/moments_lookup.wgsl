@@ -10,14 +10,9 @@
 
 #import "common/fullscreen.wgsl"
 #import "shadow-maps/color_lookup.wgsl"
-
-struct MomentLight {
-    map: MapHeader,
-    // The method's bias in its own units (smallest variance, moment bias).
-    bias: f32,
-    bleeding_reduction: f32,
-    _pad: vec2<f32>,
-}
+// One light's maps, the method's bias and the bleeding reduction (`MomentLight` in the
+// library's Rust).
+#import "shadow-maps/moment_light.wgsl"
 
 @group(2) @binding(0) var<uniform> moment_light: MomentLight;
 

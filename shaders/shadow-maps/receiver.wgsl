@@ -6,23 +6,7 @@
 #import "common/gbuffer.wgsl"
 #import "shadow-maps/layers.wgsl"
 
-struct MapHeader {
-    // Index of the scene light.
-    light: u32,
-    first_layer: u32,
-    // 1 (spot, directional) or 6 (point: cube faces).
-    layer_count: u32,
-    // 1 for perspective layers (spot, point), 0 for orthographic ones.
-    perspective: u32,
-    // World size of a texel: per unit of distance along the layer's axis (perspective) or
-    // absolute (orthographic).
-    texel_scale: f32,
-    // Lookups move off the surface by this many texels along its normal.
-    normal_offset: f32,
-    // The layers' near and far planes along their axis.
-    near: f32,
-    far: f32,
-}
+#import "shadow-maps/map_header.wgsl"
 
 // World size of one of the header's map texels at p.
 fn header_texel_world(h: MapHeader, p: vec3<f32>) -> f32 {

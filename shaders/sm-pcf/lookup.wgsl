@@ -8,17 +8,9 @@
 #import "shadow-maps/header_lookup.wgsl"
 #import "common/screen_space.wgsl"
 
-struct ShadowLight {
-    map: MapHeader,
-    map_filter: MapFilter,
-    // 1 when this light's diagnostics are written.
-    debug: u32,
-    // Contact shadows: the march's length in map texels at the receiver, its samples (0: no
-    // march) and the thickness assumed of what the depth buffer shows, in march lengths.
-    contact_texels: f32,
-    contact_steps: u32,
-    contact_thickness: f32,
-}
+// One light's maps, filter, diagnostics switch and contact march (`ShadowLight` in the
+// plugin's Rust).
+#import "sm-pcf/shadow_light.wgsl"
 
 // The light being looked up; the maps come from `shadow-maps/depth_lookup.wgsl` (group 3).
 @group(2) @binding(0) var<uniform> shadow_light: ShadowLight;

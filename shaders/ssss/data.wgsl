@@ -8,54 +8,11 @@
 const MAX_GROUPS: u32 = 16u;
 const MAX_WORDS: u32 = 2u;
 
-#import "ssss/params.wgsl"
-
-struct Settings {
-    // The plugin's parameters the shaders read (generated from their declaration, with the
-    // `ESTIMATE_*` constants of its `estimate` choice).
-    params: SsssParams,
-    // Layers in use.
-    layer_count: u32,
-    // Blur taps on each side of the centre (kernel = 2 * half_taps + 1).
-    half_taps: u32,
-    // 1 when the scene has translucent casters.
-    translucent: u32,
-    // Pixels per world unit at unit view depth: proj[1][1] * height / 2.
-    pixel_scale: f32,
-    // What the debug pass shows (`DEBUG_*` in `ssss/debug.wgsl`).
-    debug_mode: u32,
-    // The batch's first layer among all (a multiple of four): the passes run once per batch
-    // of at most 64 layers, each over its own layers 0..layer_count.
-    layer_base: u32,
-    // To 64 bytes, where the light array starts (its 16-byte alignment).
-    _pad1: u32,
-    _pad2: u32,
-}
-
-// One scene light's maps and layer in the batch (indexed like the scene's lights).
-struct SsssLight {
-    first_layer: u32,
-    // 0 when the light is culled, not shadowed or in another batch; 1 or 6 (cube faces).
-    layer_count: u32,
-    // Its screen-space layer in the batch (visibility slot layer_base + layer).
-    layer: u32,
-    perspective: u32,
-    near: f32,
-    far: f32,
-    // World size of a texel: per unit of distance along the face axis (perspective) or
-    // absolute (orthographic).
-    texel_scale: f32,
-    // Radius (point, spot) or tangent of the angular radius (directional).
-    size: f32,
-    // Screen rectangle its influence can reach: x, y, width, height in pixels.
-    scissor: vec4<u32>,
-    // Bit k set when its layer first_layer + k was rendered this frame (culled layers hold
-    // stale depths and are never read).
-    kept_faces: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
+// The settings every pass reads (the plugin's parameters, then what each frame derives) and
+// one scene light's maps and layer in the batch (indexed like the scene's lights):
+// `Settings` and `SsssLight` in the plugin's Rust.
+#import "ssss/settings.wgsl"
+#import "ssss/ssss_light.wgsl"
 
 struct SsssData {
     settings: Settings,

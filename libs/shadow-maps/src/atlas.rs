@@ -202,7 +202,7 @@ fn pack(layers: &[u32], tiers: &[u32], limits: &AtlasLimits) -> (Vec<MapTile>, u
         }
         let [x, y] = z_order((offset % page_texels) / area);
         tiles[(first_layer[light] + k) as usize] = MapTile {
-            origin: [x * size, y * size],
+            origin: UVec2::new(x, y) * size,
             size,
             page: page as u32,
         };
@@ -271,7 +271,7 @@ mod tests {
         assert_eq!(
             a.tiles[7],
             MapTile {
-                origin: [1024, 0],
+                origin: UVec2::new(1024, 0),
                 size: 256,
                 page: 6
             }

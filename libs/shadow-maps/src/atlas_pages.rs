@@ -1,7 +1,7 @@
 //! The shadow atlas's pages and tiles: how many pages of what size the device and the memory
 //! budget allow ([`AtlasLimits`]) and where a layer's map lies on them ([`MapTile`]).
 
-use bytemuck::{Pod, Zeroable};
+use zoo_host::glam::UVec2;
 use zoo_host::wgpu;
 
 /// Shadow maps are kept under this many bytes (the atlas pages, with their depth scratch).
@@ -14,22 +14,24 @@ pub const MIN_TILE: u32 = 16;
 /// Tiles are multiples of this many texels per side (min-filtered maps read blocks of it).
 pub const TILE_ALIGN: u32 = 8;
 
-/// Where one layer's map lies in the atlas (`MapTile` in `shadow-maps/layers.wgsl`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Pod, Zeroable)]
-#[repr(C)]
-pub struct MapTile {
-    /// Texel of the page the tile starts at.
-    pub origin: [u32; 2],
-    /// Texels per side.
-    pub size: u32,
-    /// Array layer of the atlas.
-    pub page: u32,
+zoo_host::gpu_struct! {
+    "shadow-maps/map_tile.wgsl" =>
+    /// Where one layer's map lies in the atlas (`shadow-maps/layers.wgsl` reads it).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+    pub struct MapTile {
+        /// Texel of the page the tile starts at.
+        pub origin: UVec2,
+        /// Texels per side.
+        pub size: u32,
+        /// Array layer of the atlas.
+        pub page: u32,
+    }
 }
 
 impl MapTile {
     /// Restricts a render pass to the tile.
     pub fn restrict(&self, pass: &mut wgpu::RenderPass<'_>) {
-        let [x, y] = self.origin;
+        let UVec2 { x, y } = self.origin;
         let size = self.size as f32;
         pass.set_viewport(x as f32, y as f32, size, size, 0.0, 1.0);
         pass.set_scissor_rect(x, y, self.size, self.size);

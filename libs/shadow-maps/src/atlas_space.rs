@@ -3,6 +3,8 @@
 //! `page_size >> l` (a tile of tier `l`), numbered along the Z-order curve, so a free square
 //! of any tier is found by descending the tree instead of scanning texels.
 
+use zoo_host::glam::UVec2;
+
 use crate::atlas_pages::{AtlasLimits, MapTile};
 
 /// What a node's square holds.
@@ -51,7 +53,7 @@ impl AtlasSpace {
         let aligned = tile.size == size
             && size > 0
             && tile.page < self.limits.max_pages
-            && (tile.origin.iter())
+            && (tile.origin.to_array().iter())
                 .all(|&o| o.is_multiple_of(size) && o + size <= self.limits.page_size);
         if !aligned {
             return false;
@@ -87,7 +89,7 @@ impl AtlasSpace {
                 let size = self.limits.tile_size(tier);
                 let [x, y] = z_order(index as u64);
                 let tile = MapTile {
-                    origin: [x * size, y * size],
+                    origin: UVec2::new(x, y) * size,
                     size,
                     page: page as u32,
                 };
@@ -162,30 +164,32 @@ mod tests {
         let mut s = space(1024, 2);
         // A 512² tile kept in the second quadrant of page 0.
         let kept = MapTile {
-            origin: [512, 0],
+            origin: UVec2::new(512, 0),
             size: 512,
             page: 0,
         };
         assert!(s.reserve(kept, 1));
         assert!(!s.reserve(kept, 1), "twice");
         let inside = MapTile {
-            origin: [768, 256],
+            origin: UVec2::new(768, 256),
             size: 256,
             page: 0,
         };
         assert!(!s.reserve(inside, 2), "inside a kept tile");
         let misaligned = MapTile {
-            origin: [128, 0],
+            origin: UVec2::new(128, 0),
             size: 256,
             page: 0,
         };
         assert!(!s.reserve(misaligned, 2));
         // The first free 512² square is the first quadrant, then the third and fourth.
-        let placed: Vec<[u32; 2]> = (0..3).map(|_| s.place(1).unwrap().origin).collect();
+        let placed: Vec<[u32; 2]> = (0..3)
+            .map(|_| s.place(1).unwrap().origin.to_array())
+            .collect();
         assert_eq!(placed, [[0, 0], [0, 512], [512, 512]]);
         // Page 0 is full: a 256² tile goes to page 1, and a full page fits only there.
         let next = s.place(2).unwrap();
-        assert_eq!((next.page, next.origin), (1, [0, 0]));
+        assert_eq!((next.page, next.origin), (1, UVec2::ZERO));
         assert_eq!(s.place(0), None, "page 1 holds a tile already");
         let mut fresh = space(1024, 2);
         assert!(fresh.reserve(next, 2));

@@ -2,9 +2,8 @@
 //! camera (`shaders/shadow-maps/depth.wgsl`), optionally with a fragment stage that writes a
 //! colour map as well (moments for variance shadow maps, fluxes for reflective ones).
 
-use bytemuck::{Pod, Zeroable};
-use zoo_host::glam::Vec4;
-use zoo_host::gpu::PassRecorder;
+use zoo_host::glam::{Mat4, Vec4};
+use zoo_host::gpu::{GpuType, PassRecorder, gpu_bytes_padded};
 use zoo_host::render::SceneBuffers;
 use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
 
@@ -18,18 +17,25 @@ use crate::tile_pass::TilePass;
 /// element for lookups that project into any layer.
 pub const CAMERA_STRIDE: u64 = 256;
 
-/// `LayerCamera` in `shadow-maps/layers.wgsl`: one layer's camera.
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct LayerCamera {
-    pub view_proj: [f32; 16],
-    /// Perspective layers: the light's position and 1 / far; orthographic layers: w = 0.
-    pub eye: [f32; 4],
-    /// Clip space back to world space (to unproject stored depths).
-    pub inv_view_proj: [f32; 16],
-    /// Where the layer's map lies in the atlas.
-    pub tile: MapTile,
+zoo_host::gpu_struct! {
+    "shadow-maps/layer_camera.wgsl" =>
+    /// One layer's camera (`shadow-maps/layers.wgsl` reads it): the depth pass's uniform, and
+    /// an array element of [`CAMERA_STRIDE`]-byte slots for lookups.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct LayerCamera {
+        pub view_proj: Mat4,
+        /// Perspective layers: the light's position and 1 / far; orthographic layers: w = 0.
+        pub eye: Vec4,
+        /// Clip space back to world space (to unproject stored depths).
+        pub inv_view_proj: Mat4,
+        /// Where the layer's map lies in the atlas.
+        pub tile: MapTile,
+    }
 }
+
+// A camera fills at most its slot, a dynamic offset's multiple.
+const _: () = assert!(CAMERA_STRIDE.is_multiple_of(256));
+const _: () = assert!(LayerCamera::SIZE <= CAMERA_STRIDE as usize);
 
 impl LayerCamera {
     /// The camera of `frustum`, rendering into `tile`.
@@ -41,9 +47,9 @@ impl LayerCamera {
             Projection::Orthographic { .. } | Projection::Warped => Vec4::ZERO,
         };
         LayerCamera {
-            view_proj: frustum.view_proj.to_cols_array(),
-            eye: eye.to_array(),
-            inv_view_proj: frustum.view_proj.inverse().to_cols_array(),
+            view_proj: frustum.view_proj,
+            eye,
+            inv_view_proj: frustum.view_proj.inverse(),
             tile,
         }
     }
@@ -119,7 +125,7 @@ impl DepthPass {
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Uniform,
                     has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
+                    min_binding_size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
                 },
                 count: None,
             }],
@@ -193,10 +199,8 @@ impl DepthPass {
         let mut bytes = Vec::new();
         let layers = lights.iter().flat_map(|l| l.frustums.iter().zip(&l.tiles));
         for (frustum, &tile) in layers {
-            let mut slot = [0u8; CAMERA_STRIDE as usize];
             let camera = LayerCamera::new(frustum, tile);
-            slot[..size_of::<LayerCamera>()].copy_from_slice(bytemuck::bytes_of(&camera));
-            bytes.extend_from_slice(&slot);
+            bytes.extend(gpu_bytes_padded(&camera, CAMERA_STRIDE as usize));
         }
         let needed = (bytes.len() as u64).max(CAMERA_STRIDE);
         let replaced = self
@@ -220,7 +224,7 @@ impl DepthPass {
                     resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &buffer,
                         offset: 0,
-                        size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
+                        size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
                     }),
                 }],
             });
@@ -349,25 +353,4 @@ fn depth_pipeline(
         multiview_mask: None,
         cache: None,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_embedded_mirror};
-
-    #[test]
-    fn layer_cameras_mirror_the_shader() {
-        let mirror = zoo_host::mirror_fields!(LayerCamera {
-            view_proj,
-            eye,
-            inv_view_proj,
-            tile
-        });
-        let size = mirror.0;
-        let shader = "shadow-maps/depth.wgsl";
-        check_embedded_mirror(shader, "LayerCamera", mirror, SizeRule::Equal).unwrap();
-        assert_eq!(CAMERA_STRIDE % 256, 0, "a dynamic-offset slot");
-        assert!(size as u64 <= CAMERA_STRIDE);
-    }
 }

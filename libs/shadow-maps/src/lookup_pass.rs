@@ -5,8 +5,9 @@
 //! `map_receiver` and ends with `look_up` (`shaders/shadow-maps/header_lookup.wgsl`); the
 //! diagnostics targets after the slot are written only for the debug light.
 
-use zoo_host::bytemuck::Pod;
-use zoo_host::kit::{SlotPipeline, UniformSlots, diagnostics_pipelines, light_pass_name};
+use zoo_host::kit::{
+    SlotPipeline, UniformSlots, UniformValue, diagnostics_pipelines, light_pass_name,
+};
 use zoo_host::prelude::*;
 
 use crate::{LightMaps, ShadowMapSet};
@@ -35,14 +36,14 @@ pub struct Lookup<'s> {
 }
 
 /// Pipelines (without and with diagnostics) and per-light uniforms of a lookup.
-pub struct LookupPass<U: Pod> {
+pub struct LookupPass<U: UniformValue> {
     /// Pass family name: each pass is `"{name}: light {l}"`.
     name: String,
     uniforms: UniformSlots<U>,
     pipelines: [wgpu::RenderPipeline; 2],
 }
 
-impl<U: Pod> LookupPass<U> {
+impl<U: UniformValue> LookupPass<U> {
     /// The pass family `name` (also the label of its pipelines and uniforms) reading `set`.
     pub fn new(
         ctx: &RenderContext<'_>,

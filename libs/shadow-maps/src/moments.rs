@@ -37,15 +37,16 @@ const ONE_BITS: wgpu::Color = {
     }
 };
 
-/// `MomentLight` in `shadow-maps/moments_lookup.wgsl`: one light's lookup.
-#[derive(Debug, Clone, Copy, zoo_host::bytemuck::Pod, zoo_host::bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-struct MomentLight {
-    map: MapHeader,
-    bias: f32,
-    bleeding_reduction: f32,
-    _pad: [f32; 2],
+zoo_host::gpu_struct! {
+    "shadow-maps/moment_light.wgsl" =>
+    /// One light's lookup (`shadow-maps/moments_lookup.wgsl`).
+    #[derive(Debug, Clone, Copy)]
+    struct MomentLight {
+        map: MapHeader,
+        /// The method's bias in its own units (smallest variance, moment bias).
+        bias: f32,
+        bleeding_reduction: f32,
+    }
 }
 
 /// A moment method: its WGSL and the map format it stores.
@@ -148,7 +149,6 @@ impl MomentMaps {
             map: MapHeader::new(&lights[light], s.normal_offset),
             bias: s.bias,
             bleeding_reduction: s.bleeding_reduction,
-            _pad: [0.0; 2],
         };
         let bind = |_, pass: &mut wgpu::RenderPass<'_>| pass.set_bind_group(3, group, &[]);
         let lookup = format!("{label} lookup");
@@ -186,28 +186,5 @@ impl MomentMaps {
     /// The format the maps store.
     pub fn format(&self) -> Option<wgpu::TextureFormat> {
         self.maps.maps().map(|m| m.texture.format())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror};
-
-    #[test]
-    fn moment_light_mirrors_the_shader() {
-        let source = zoo_host::ShaderLibrary::embedded()
-            .compose_source(
-                "test.wgsl",
-                "#import \"vsm/vsm.wgsl\"\n#import \"shadow-maps/moments_lookup.wgsl\"\n",
-            )
-            .unwrap()
-            .source;
-        let (size, fields) = zoo_host::mirror_fields!(MomentLight {
-            map,
-            bias,
-            bleeding_reduction
-        });
-        check_mirror(&source, "MomentLight", size, &fields, SizeRule::Equal).unwrap();
     }
 }

@@ -8,7 +8,7 @@
 //! gets the darkest one's colour in each channel, not their product (exact for one object,
 //! however many of its surfaces the ray crosses).
 
-use zoo_host::gpu::PassRecorder;
+use zoo_host::gpu::{GpuType, PassRecorder};
 use zoo_host::render::SceneBuffers;
 use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
@@ -43,7 +43,7 @@ impl TranslucentPass {
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Uniform,
                     has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
+                    min_binding_size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
                 },
                 count: None,
             }],
@@ -132,7 +132,7 @@ impl TranslucentPass {
                         resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                             buffer: cameras,
                             offset: 0,
-                            size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
+                            size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
                         }),
                     }],
                 });

@@ -3,7 +3,7 @@
 //! triangle-id maps and the coverage maps. Group 1 holds the layer camera (a dynamic offset
 //! into the map set's camera buffer) and the scene's vertices and indices.
 
-use zoo_host::gpu::PassRecorder;
+use zoo_host::gpu::{GpuType, PassRecorder};
 use zoo_host::kit::{bind_group, bind_group_layout, storage};
 use zoo_host::render::drawn_runs;
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
@@ -131,7 +131,7 @@ fn caster_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Uniform,
                     has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
+                    min_binding_size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
                 },
                 count: None,
             },
@@ -157,7 +157,7 @@ fn caster_group(
             wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                 buffer: cameras,
                 offset: 0,
-                size: wgpu::BufferSize::new(size_of::<LayerCamera>() as u64),
+                size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
             }),
             buffers.vertices.as_entire_binding(),
             buffers.indices.as_entire_binding(),

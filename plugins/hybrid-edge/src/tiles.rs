@@ -5,20 +5,22 @@
 
 use zoo_host::bytemuck;
 use zoo_host::glam::UVec2;
-use zoo_host::gpu::PassRecorder;
+use zoo_host::gpu::{GpuType, PassRecorder, gpu_bytes};
 use zoo_host::kit::{bind_group, bind_group_layout, pipeline_layout, storage, texture, uniform};
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
 use zoo_shadow_volumes::band_volume_pipeline;
 
-/// `TileParams` in the tile shaders.
-#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-pub(crate) struct TileParams {
-    tile_size: u32,
-    tiles_x: u32,
-    tiles_y: u32,
-    _pad: u32,
+zoo_host::gpu_struct! {
+    "hybrid-edge/tile_params.wgsl" =>
+    /// The tile grid every tile shader reads (`hybrid-edge/tiles.wgsl`,
+    /// `hybrid-edge/tiled_volumes.wgsl`, `hybrid-edge/tile_overlay.wgsl`).
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub(crate) struct TileParams {
+        /// Tile side in pixels (a multiple of `SCAN_SIDE`).
+        tile_size: u32,
+        tiles_x: u32,
+        tiles_y: u32,
+    }
 }
 
 /// The tile list and draw arguments for one screen size and tile size.
@@ -138,7 +140,7 @@ impl Tiles {
         });
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("hybrid tile parameters"),
-            size: size_of::<TileParams>() as u64,
+            size: TileParams::SIZE as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -169,7 +171,6 @@ impl Tiles {
             tile_size,
             tiles_x: tiles.x.ceil() as u32,
             tiles_y: tiles.y.ceil() as u32,
-            _pad: 0,
         };
         if self
             .bound
@@ -181,7 +182,7 @@ impl Tiles {
         let device = &ctx.gpu.device;
         ctx.gpu
             .queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+            .write_buffer(&self.params, 0, &gpu_bytes(&[params]));
         let list = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("hybrid tile list"),
             size: (params.tiles_x * params.tiles_y).max(1) as u64 * 4,
@@ -322,24 +323,6 @@ impl Tiles {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror};
-
-    #[test]
-    fn tile_params_mirror_both_shaders() {
-        let (size, fields) = zoo_host::mirror_fields!(TileParams {
-            tile_size,
-            tiles_x,
-            tiles_y
-        });
-        for shader in ["hybrid-edge/tiles.wgsl", "hybrid-edge/tiled_volumes.wgsl"] {
-            let source = zoo_host::ShaderLibrary::embedded()
-                .compose(shader)
-                .unwrap()
-                .source;
-            check_mirror(&source, "TileParams", size, &fields, SizeRule::Equal).unwrap();
-        }
-    }
-
     #[test]
     fn the_scan_side_is_the_shader_s() {
         let source = zoo_host::ShaderLibrary::embedded()

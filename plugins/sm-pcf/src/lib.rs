@@ -42,18 +42,22 @@ zoo_host::technique_params! {
     }
 }
 
-/// `ShadowLight` in `sm-pcf/lookup.wgsl`: one light's lookup, at a dynamic offset.
-#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-struct ShadowLight {
-    map: MapHeader,
-    map_filter: MapFilter,
-    debug: u32,
-    contact_texels: f32,
-    /// 0: no contact march.
-    contact_steps: u32,
-    contact_thickness: f32,
+zoo_host::gpu_struct! {
+    "sm-pcf/shadow_light.wgsl" =>
+    /// One light's lookup (`sm-pcf/lookup.wgsl`), at a dynamic offset.
+    #[derive(Debug, Clone, Copy)]
+    struct ShadowLight {
+        map: MapHeader,
+        map_filter: MapFilter,
+        /// 1 when this light's diagnostics are written.
+        debug: u32,
+        /// Contact shadows: the march's length in map texels at the receiver, its samples (0:
+        /// no march) and the thickness assumed of what the depth buffer shows, in march
+        /// lengths.
+        contact_texels: f32,
+        contact_steps: u32,
+        contact_thickness: f32,
+    }
 }
 
 const SHADER: &str = "sm-pcf/lookup.wgsl";
@@ -267,30 +271,4 @@ zoo_host::register_technique! {
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     params: SmParams::schema,
     create: create,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror};
-
-    fn shader() -> String {
-        zoo_host::ShaderLibrary::embedded()
-            .compose(SHADER)
-            .unwrap()
-            .source
-    }
-
-    #[test]
-    fn shadow_light_mirrors_the_shader() {
-        let (size, fields) = zoo_host::mirror_fields!(ShadowLight {
-            map,
-            map_filter,
-            debug,
-            contact_texels,
-            contact_steps,
-            contact_thickness
-        });
-        check_mirror(&shader(), "ShadowLight", size, &fields, SizeRule::Equal).unwrap();
-    }
 }

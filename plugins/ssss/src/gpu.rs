@@ -1,8 +1,10 @@
 //! The GPU side of the layered soft shadows: the layered targets and the compute passes
 //! (penumbra, two blur passes, debug views) with their bind groups.
 
-use zoo_host::glam::UVec2;
+use zoo_host::glam::{UVec2, UVec4};
 use zoo_host::gpu::array_layers;
+use zoo_host::gpu::gpu_struct::round_up;
+use zoo_host::gpu::{GpuStruct, GpuType};
 use zoo_host::kit::{ComputeStage, StageGroups};
 use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
@@ -14,43 +16,89 @@ use crate::SsssParams;
 /// `ssss/params.wgsl`).
 const PARAM_WORDS: usize = padded_words(<SsssParams as TechniqueParams>::SHADER_FIELDS);
 
-/// `Settings` in `ssss/data.wgsl`: the `flags(shader)` parameters, then what each frame
-/// derives.
-#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-pub struct Settings {
-    pub params: [u32; PARAM_WORDS],
-    pub layer_count: u32,
-    pub half_taps: u32,
-    pub translucent: u32,
-    pub pixel_scale: f32,
-    pub debug_mode: u32,
-    /// The batch's first layer among all (a multiple of four).
-    pub layer_base: u32,
-    pub _pad: [u32; 2],
+/// The `flags(shader)` parameters as the shaders read them: `SsssParams` in the generated
+/// `ssss/params.wgsl`, one word each, padded to 16 bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ShaderParams(pub [u32; PARAM_WORDS]);
+
+impl GpuType for ShaderParams {
+    const ALIGN: usize = 4;
+    const SIZE: usize = 4 * PARAM_WORDS;
+    fn wgsl_type() -> String {
+        "SsssParams".to_string()
+    }
+    fn imports() -> Vec<&'static str> {
+        vec!["ssss/params.wgsl"]
+    }
+    fn write(&self, out: &mut [u8]) {
+        self.0.write(out);
+    }
 }
 
-/// `SsssLight` in `ssss/data.wgsl`.
-#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-pub struct SsssLight {
-    pub first_layer: u32,
-    pub layer_count: u32,
-    pub layer: u32,
-    pub perspective: u32,
-    pub near: f32,
-    pub far: f32,
-    pub texel_scale: f32,
-    pub size: f32,
-    pub scissor: [u32; 4],
-    pub kept_faces: u32,
-    pub _pad: [u32; 3],
+zoo_host::gpu_struct! {
+    "ssss/settings.wgsl" =>
+    /// The settings every pass reads, first in the data buffer (`ssss/data.wgsl`): the
+    /// `flags(shader)` parameters, then what each frame derives.
+    #[derive(Debug, Clone, Copy, Default)]
+    pub struct Settings {
+        /// The plugin's parameters the shaders read (generated from their declaration, with
+        /// the `ESTIMATE_*` constants of its `estimate` choice).
+        pub params: ShaderParams,
+        /// Layers in use.
+        pub layer_count: u32,
+        /// Blur taps on each side of the centre (kernel = 2 * half_taps + 1).
+        pub half_taps: u32,
+        /// 1 when the scene has translucent casters.
+        pub translucent: u32,
+        /// Pixels per world unit at unit view depth: proj[1][1] * height / 2.
+        pub pixel_scale: f32,
+        /// What the debug pass shows (`DEBUG_*` in `ssss/debug.wgsl`).
+        pub debug_mode: u32,
+        /// The batch's first layer among all (a multiple of four): the passes run once per
+        /// batch of at most 64 layers, each over its own layers 0..layer_count.
+        pub layer_base: u32,
+    }
 }
+
+zoo_host::gpu_struct! {
+    "ssss/ssss_light.wgsl" =>
+    /// One scene light's maps and layer in the batch (`ssss/data.wgsl`; indexed like the
+    /// scene's lights).
+    #[derive(Debug, Clone, Copy, Default)]
+    pub struct SsssLight {
+        pub first_layer: u32,
+        /// 0 when the light is culled, not shadowed or in another batch; 1 or 6 (cube faces).
+        pub layer_count: u32,
+        /// Its screen-space layer in the batch (visibility slot layer_base + layer).
+        pub layer: u32,
+        pub perspective: u32,
+        pub near: f32,
+        pub far: f32,
+        /// World size of a texel: per unit of distance along the face axis (perspective) or
+        /// absolute (orthographic).
+        pub texel_scale: f32,
+        /// Radius (point, spot) or tangent of the angular radius (directional).
+        pub size: f32,
+        /// Screen rectangle its influence can reach: x, y, width, height in pixels.
+        pub scissor: UVec4,
+        /// Bit k set when its layer first_layer + k was rendered this frame (culled layers
+        /// hold stale depths and are never read).
+        pub kept_faces: u32,
+    }
+}
+
+/// Where the light records start in the data buffer: after the settings, at their alignment.
+pub const LIGHTS_OFFSET: usize = round_up(<Settings as GpuType>::SIZE, SsssLight::ALIGN);
+
+/// Bytes of one light record in the data buffer.
+pub const LIGHT_STRIDE: usize = round_up(<SsssLight as GpuType>::SIZE, SsssLight::ALIGN);
 
 /// Byte offset of `debug_mode` in the data buffer.
-pub const DEBUG_MODE_OFFSET: u64 = std::mem::offset_of!(Settings, debug_mode) as u64;
+pub fn debug_mode_offset() -> u64 {
+    let members = <Settings as GpuStruct>::members();
+    let member = members.iter().find(|m| m.name == "debug_mode");
+    member.expect("a member of the settings").offset as u64
+}
 
 /// A layered screen-size target: its texture and an array view.
 pub struct Layered {
