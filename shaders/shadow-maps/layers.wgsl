@@ -64,8 +64,7 @@ fn light_layer(first_layer: u32, layer_count: u32, light_position: vec3<f32>, p:
 // One layer's camera in a 256-byte slot of the depth pass's uniform buffer, as lookups read
 // the cameras (`CAMERA_STRIDE` in the library).
 struct CameraSlot {
-    camera: LayerCamera,
-    _pad: array<vec4<f32>, 6>,
+    @size(256) camera: LayerCamera,
 }
 
 // World size of one map texel at p, across the light's rays: `texel_scale` itself for
