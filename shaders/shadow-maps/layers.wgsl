@@ -62,9 +62,12 @@ fn light_layer(first_layer: u32, layer_count: u32, light_position: vec3<f32>, p:
 }
 
 // One layer's camera in a 256-byte slot of the depth pass's uniform buffer, as lookups read
-// the cameras (`CAMERA_STRIDE` in the library).
+// the cameras (`CAMERA_STRIDE` in the library). The padding is a member: naga's GLSL output
+// drops `@size`, and GL then read the cameras at the wrong stride (the GL parity test in
+// `tests/zoo/gl_backend.rs` caught it).
 struct CameraSlot {
-    @size(256) camera: LayerCamera,
+    camera: LayerCamera,
+    _pad: array<vec4<f32>, 6>,
 }
 
 // World size of one map texel at p, across the light's rays: `texel_scale` itself for
