@@ -5,11 +5,8 @@
 #import "common/lighting.wgsl"
 #import "common/fullscreen.wgsl"
 
-// Mirrors `Pass` in examples/backfacing/src/lib.rs.
-struct Pass {
-    light: u32,
-    darkness: f32,
-}
+// `Pass`, declared in examples/backfacing/src/lib.rs.
+#import "backfacing/pass.wgsl"
 
 @group(2) @binding(0) var<uniform> pass_data: Pass;
 

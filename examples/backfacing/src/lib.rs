@@ -10,11 +10,15 @@ zoo_host::technique_params! {
     }
 }
 
-/// `Pass` in `shaders/backfacing/mask.wgsl`: the light and the darkness to write.
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-#[bytemuck(crate = "zoo_host::bytemuck")]
-#[repr(C)]
-pub struct Pass(pub u32, pub f32);
+zoo_host::gpu_struct! {
+    "backfacing/pass.wgsl" =>
+    /// The uniform of `shaders/backfacing/mask.wgsl`: the light and the darkness to write.
+    #[derive(Debug, Clone, Copy)]
+    pub struct Pass {
+        pub light: u32,
+        pub darkness: f32,
+    }
+}
 
 const NAME: &str = "Back-facing test";
 
@@ -31,11 +35,11 @@ impl ShadowTechnique for Backfacing {
 
     fn record(&mut self, ctx: &RenderContext<'_>, rec: &mut PassRecorder<'_>) -> TechniqueResult {
         let darkness = self.params.darkness;
-        let pass = self
-            .pass
-            .as_mut()
-            .ok_or_else(TechniqueError::not_prepared)?;
-        pass.record(ctx, rec, NAME, |light| Pass(light as u32, darkness));
+        let pass = (self.pass.as_mut()).ok_or_else(TechniqueError::not_prepared)?;
+        pass.record(ctx, rec, NAME, |light| Pass {
+            light: light as u32,
+            darkness,
+        });
         Ok(())
     }
 }

@@ -95,18 +95,3 @@ fn the_docs_show_this_crate_and_its_shader_verbatim() {
         "the example has {lines} lines of Rust (at most 60)"
     );
 }
-
-#[test]
-fn the_pass_uniform_mirrors_the_shader() {
-    use zoo_example_backfacing::Pass;
-    use zoo_host::gpu::layout::{SizeRule, check_mirror};
-    let source = zoo_host::ShaderLibrary::embedded()
-        .compose("backfacing/mask.wgsl")
-        .unwrap()
-        .source;
-    let (size, fields) = zoo_host::mirror_fields!(Pass {
-        light: 0,
-        darkness: 1
-    });
-    check_mirror(&source, "Pass", size, &fields, SizeRule::Equal).unwrap();
-}
