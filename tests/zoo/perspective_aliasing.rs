@@ -110,6 +110,7 @@ fn warped_and_split_maps_put_more_texels_near_the_viewer() {
                     splits: 4,
                     lambda: 0.5,
                     blend: 0.1,
+                    range: None,
                 };
                 let c = cascades.distances(&camera, 1.0, &objects, true);
                 let depth =

@@ -140,6 +140,7 @@ impl Pssm {
             splits: self.params.splits,
             lambda: self.params.lambda,
             blend: self.params.blend,
+            range: None,
         }
     }
 }
