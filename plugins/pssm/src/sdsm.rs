@@ -128,5 +128,6 @@ zoo_host::register_technique! {
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional],
     params: PssmParams::schema,
+    required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS,
     create: create,
 }
