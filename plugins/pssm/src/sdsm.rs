@@ -44,10 +44,16 @@ impl Reduction {
         })
     }
 
-    /// Records the reduction; returns the newest range, this frame's when none has arrived.
-    fn record(&mut self, ctx: &RenderContext<'_>, rec: &mut PassRecorder<'_>) -> Option<Vec<f32>> {
+    /// Records the reduction; returns the newest range (this frame's when none has arrived),
+    /// `None` for a view without surfaces.
+    fn record(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        rec: &mut PassRecorder<'_>,
+    ) -> Option<(f32, f32)> {
         let (gpu, extent) = (ctx.gpu, [ctx.size.x, ctx.size.y, 1]);
         let mut latest = self.ring.latest(&gpu.device).map(|(_, b)| f32s(b));
+        // Nearest from the largest bits down, farthest from 0 up.
         let start: &[u32] = &[u32::MAX, 0];
         gpu.queue
             .write_buffer(&self.range, 0, bytemuck::cast_slice(start));
@@ -64,60 +70,69 @@ impl Reduction {
                 latest = self.ring.latest(&gpu.device).map(|(_, b)| f32s(b));
             }
         }
-        latest
+        // Without surfaces the bits stay (u32::MAX, 0): NaN and 0.
+        let range = latest.filter(|d| d[1] > 0.0);
+        range.map(|d| (d[0], d[1].max(d[0] * 1.001)))
     }
 }
 
-struct Sdsm(Pssm, Option<Reduction>);
+struct Sdsm {
+    pssm: Pssm,
+    reduction: Option<Reduction>,
+}
 
 impl ShadowTechnique for Sdsm {
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        if changes.scene || changes.resolution || self.1.is_none() {
-            self.1 = Some(Reduction::new(ctx)?); // no range yet
+        if changes.scene || changes.resolution || self.reduction.is_none() {
+            // A new ring: the first frame waits for its range.
+            self.reduction = Some(Reduction::new(ctx)?);
         }
-        self.0.prepare(ctx, changes)
+        self.pssm.prepare(ctx, changes)
     }
 
     fn record(&mut self, ctx: &RenderContext<'_>, rec: &mut PassRecorder<'_>) -> TechniqueResult {
-        let reduction = self.1.as_mut().ok_or_else(TechniqueError::not_prepared)?;
-        // Without surfaces the bits stay (u32::MAX, 0): NaN and 0.
-        let range = (reduction.record(ctx, rec).filter(|d| d[1] > 0.0))
-            .map(|d| (d[0], d[1].max(d[0] * 1.001)));
-        if range != self.0.range {
-            self.0.range = range;
-            let mut moved = Changes::default();
-            moved.camera = true;
-            self.0.prepare(ctx, moved)?;
+        let reduction = (self.reduction.as_mut()).ok_or_else(TechniqueError::not_prepared)?;
+        let range = reduction.record(ctx, rec);
+        if range != self.pssm.range {
+            self.pssm.range = range;
+            let moved = Changes {
+                camera: true,
+                ..Changes::default()
+            };
+            self.pssm.prepare(ctx, moved)?;
         }
-        self.0.record(ctx, rec)
+        self.pssm.record(ctx, rec)
     }
 
+    /// pssm's, and the range the splits cover.
     fn counters(&self) -> Vec<(String, f64)> {
-        let mut out = self.0.counters();
-        if let Some((near, far)) = self.0.range {
-            out.extend([
-                ("sdsm near".into(), near.into()),
-                ("sdsm far".into(), far.into()),
-            ]);
+        let mut out = self.pssm.counters();
+        if let Some((near, far)) = self.pssm.range {
+            out.push(("sdsm near".into(), near.into()));
+            out.push(("sdsm far".into(), far.into()));
         }
         out
     }
 
     fn resources(&self) -> Vec<ResourceInfo> {
-        self.0.resources()
+        self.pssm.resources()
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
-        self.0.update_params(values)
+        self.pssm.update_params(values)
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        self.0.debug_view(resource)
+        self.pssm.debug_view(resource)
     }
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
-    Ok(Box::new(Sdsm(Pssm::new(values)?, None)))
+    let pssm = Pssm::new(values)?;
+    Ok(Box::new(Sdsm {
+        pssm,
+        reduction: None,
+    }))
 }
 
 zoo_host::register_technique! {
