@@ -440,8 +440,10 @@ fn every_shader_validates_with_the_generated_modules() {
         );
     }
     for name in names {
-        // Shared modules are checked through the shaders that import them.
-        if library.is_shared_module(name) {
+        // Shared modules are checked through the shaders that import them; the example
+        // plugin's shader by the example's tests (this binary does not link the example, so
+        // its generated `backfacing/pass.wgsl` is not registered here).
+        if library.is_shared_module(name) || name.starts_with("backfacing/") {
             continue;
         }
         if let Err(e) = library.validate(name) {

@@ -95,3 +95,14 @@ fn the_docs_show_this_crate_and_its_shader_verbatim() {
         "the example has {lines} lines of Rust (at most 60)"
     );
 }
+
+#[test]
+fn the_shader_validates_and_the_pass_is_laid_out_as_naga_lays_it_out() {
+    use zoo_host::gpu::gpu_struct::{check_with_naga, registered_structs};
+    let library = zoo_host::ShaderLibrary::embedded();
+    library.validate("backfacing/mask.wgsl").unwrap();
+    let pass = registered_structs()
+        .find(|s| s.name == "Pass")
+        .expect("the example registers `Pass`");
+    check_with_naga(pass).unwrap();
+}

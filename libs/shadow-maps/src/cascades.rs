@@ -14,8 +14,9 @@ use crate::light_space::{
 use crate::planning::{LayerPlan, PlanInputs};
 
 /// The cascade plan: `splits` layers for every directional light (none for other lights),
-/// split by [`split_distances`] over [`visible_depth_range`]. Each split's crop also covers
-/// the last `blend` fraction of the split before it, where lookups blend the two.
+/// split by [`split_distances`] over `range`, or without one over [`visible_depth_range`].
+/// Each split's crop also covers the last `blend` fraction of the split before it, where
+/// lookups blend the two.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cascades {
     pub splits: u32,
@@ -23,10 +24,14 @@ pub struct Cascades {
     pub lambda: f32,
     /// Fraction of each split blended into the next, in [0, 1).
     pub blend: f32,
+    /// The view depths [near, far] to split, measured elsewhere (the depth buffer's, for
+    /// sample-distribution shadow maps); `None` fits them to the objects' boxes.
+    pub range: Option<(f32, f32)>,
 }
 
 impl Cascades {
-    /// The split distances C_0..C_m for `camera` (of `aspect`) over the scene's `objects`.
+    /// The split distances C_0..C_m for `camera` (of `aspect`) over `range` or the scene's
+    /// `objects`.
     /// With `stable`, the fitted range is widened to quarter-octave steps of the scene's size (near down, far up)
     /// so that it, and with it every split's crop, changes only now and then as the camera
     /// moves.
@@ -37,7 +42,8 @@ impl Cascades {
         objects: &[Aabb],
         stable: bool,
     ) -> Vec<f32> {
-        let (mut near, mut far) = visible_depth_range(camera, aspect, objects);
+        let (mut near, mut far) =
+            (self.range).unwrap_or_else(|| visible_depth_range(camera, aspect, objects));
         if stable {
             // Octaves of the scene's size, so a scaled scene gets the same splits, scaled.
             let unit = scene_unit(objects);
@@ -319,6 +325,7 @@ mod tests {
                 splits: 4,
                 lambda: 0.5,
                 blend: 0.0,
+                range: None,
             };
             let d = cascades.distances(&camera, 1.5, &[ground], true);
             let corners = slice_corners(&camera, 1.5, d[0], d[1]);

@@ -7,6 +7,7 @@
 //! shadow-map library's (PCF, Poisson, PCSS). Spot and point lights are not shadowed (they
 //! are declared unsupported).
 
+mod sdsm;
 mod top_view;
 mod warped;
 
@@ -146,14 +147,25 @@ impl Gpu {
 pub struct Pssm {
     params: PssmParams,
     gpu: LazyGpu<Gpu>,
+    /// The depth range to split (sdsm's, from the depth buffer); `None` fits it to the boxes.
+    range: Option<(f32, f32)>,
 }
 
 impl Pssm {
+    fn new(values: &ParamValues) -> TechniqueResult<Pssm> {
+        Ok(Pssm {
+            params: PssmParams::from_values(values)?,
+            gpu: LazyGpu::default(),
+            range: None,
+        })
+    }
+
     fn cascades(&self) -> Cascades {
         Cascades {
             splits: self.params.splits,
             lambda: self.params.lambda,
             blend: self.params.blend,
+            range: self.range,
         }
     }
 }
@@ -314,11 +326,7 @@ fn write_top_view(gpu: &GpuContext, texture: &wgpu::Texture, pixels: &[u8]) {
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
-    let params = PssmParams::from_values(values)?;
-    Ok(Box::new(Pssm {
-        params,
-        gpu: LazyGpu::default(),
-    }))
+    Ok(Box::new(Pssm::new(values)?))
 }
 
 zoo_host::register_technique! {

@@ -332,7 +332,9 @@ impl<'a> PassRecorder<'a> {
     }
 
     /// Submits recorded work (in CPU-timing mode, time it and charge it to the previous pass).
-    fn flush(&mut self) {
+    /// A technique that must read back results of this frame's passes before recording the
+    /// rest (sdsm's depth range) calls it, then waits for the GPU.
+    pub fn flush(&mut self) {
         let Some(encoder) = self.encoder.take() else {
             return;
         };
