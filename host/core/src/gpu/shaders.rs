@@ -164,6 +164,20 @@ impl ShaderLibrary {
         })
     }
 
+    /// Whether `name` imports a module of its own folder that neither a file nor a crate
+    /// linked into this build provides: the generated module (`gpu_struct!`) of a plugin this
+    /// build does not link, such as the example plugin's in the application. Such a shader
+    /// cannot be composed here and no registered technique uses it.
+    pub fn needs_unlinked_module(&self, name: &str) -> bool {
+        let folder = |path: &str| path.split('/').next().map(str::to_string);
+        self.source(name).is_ok_and(|text| {
+            text.lines()
+                .filter_map(|line| line.trim_start().strip_prefix("#import"))
+                .map(|rest| rest.trim().trim_matches('"'))
+                .any(|target| folder(target) == folder(name) && self.source(target).is_err())
+        })
+    }
+
     /// Resolves the imports of `name`.
     pub fn compose(&self, name: &str) -> Result<ComposedShader, ShaderError> {
         let text = self.source(name)?;
@@ -397,6 +411,10 @@ mod tests {
             err,
             "shaders/missing.wgsl:2: cannot import `common/nope.wgsl`: no such shader"
         );
+        // A missing import of another folder is an error to report, not an unlinked plugin's
+        // own module.
+        assert!(!library.needs_unlinked_module("missing.wgsl"));
+        assert!(!library.needs_unlinked_module("main.wgsl"));
     }
 
     #[test]

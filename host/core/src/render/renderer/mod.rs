@@ -595,8 +595,10 @@ impl Renderer {
     /// the previous pipelines keep running.
     pub fn reload_shaders(&mut self) -> Result<(), RenderError> {
         for name in self.shaders.file_names() {
-            // Shared modules are checked through the shaders that import them.
-            if !self.shaders.is_shared_module(&name) {
+            // Shared modules are checked through the shaders that import them; shaders of
+            // plugins this build does not link cannot be composed and are not used.
+            let unused = self.shaders.needs_unlinked_module(&name);
+            if !self.shaders.is_shared_module(&name) && !unused {
                 self.shaders.validate(&name)?;
             }
         }
