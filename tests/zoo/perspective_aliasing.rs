@@ -28,24 +28,27 @@ fn splits_halve_the_core_error_of_one_map_at_the_same_texel_budget() {
     assert!(split <= 0.5 * one, "pssm {split} against one map {one}");
 }
 
-#[test]
-#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
-fn stabilised_splits_flicker_less_along_the_vista_walk() {
+/// The flicker index of each configuration of `techniques` (1024² maps) along vista's camera
+/// path (96 frames at 160x120), with `stabilise` of `swept` on and off, by its bench label.
+fn vista_walk_flicker(techniques: &[&str], swept: &str) -> std::collections::HashMap<String, f64> {
     let scene = scene_path("vista.ron");
+    let stabilise = format!("{swept}.stabilise");
     let plan = BenchPlan {
         run: "vista-walk".into(),
         description: zoo_host::scene::read_description(&scene).unwrap(),
         scene_path: scene,
-        techniques: ["pssm", "sm-pcf"]
-            .iter()
+        techniques: (techniques.iter())
             .map(|t| zoo_host::find_technique(t).unwrap())
             .collect(),
         size: UVec2::new(160, 120),
         frames: 96,
         warmup: 0,
         path: PathMode::Camera,
-        sweeps: vec![parse_sweep("pssm.stabilise", &["true".into(), "false".into()]).unwrap()],
-        set: vec![("pssm".into(), "map_size".into(), "1024".into())],
+        sweeps: vec![parse_sweep(&stabilise, &["true".into(), "false".into()]).unwrap()],
+        set: (techniques.iter())
+            .filter(|t| **t != "sm-pcf")
+            .map(|t| (t.to_string(), "map_size".into(), "1024".into()))
+            .collect(),
         flicker: true,
         cpu_timing: false,
         reuse_unchanged: false,
@@ -58,6 +61,13 @@ fn stabilised_splits_flicker_less_along_the_vista_walk() {
         eprintln!("{}: flicker {:?}", config.label(), result.flicker);
         flicker.insert(config.label(), result.flicker.unwrap());
     }
+    flicker
+}
+
+#[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
+fn stabilised_splits_flicker_less_along_the_vista_walk() {
+    let flicker = vista_walk_flicker(&["pssm", "sm-pcf"], "pssm");
     let stable = flicker["pssm [pssm.stabilise=true]"];
     let unstable = flicker["pssm [pssm.stabilise=false]"];
     let single = flicker["sm-pcf"];
@@ -76,35 +86,7 @@ fn stabilised_sdsm_flickers_less_than_unstabilised_along_the_vista_walk() {
     // quarter-octave steps and the crops by whole texels, as pssm's do; it still flickers a
     // little more than stabilised pssm, whose range (from the objects' boxes) moves less
     // (0.0104 against 0.0094 here; unstabilised both about 0.0112).
-    let scene = scene_path("vista.ron");
-    let plan = BenchPlan {
-        run: "vista-walk".into(),
-        description: zoo_host::scene::read_description(&scene).unwrap(),
-        scene_path: scene,
-        techniques: ["sdsm", "pssm"]
-            .iter()
-            .map(|t| zoo_host::find_technique(t).unwrap())
-            .collect(),
-        size: UVec2::new(160, 120),
-        frames: 96,
-        warmup: 0,
-        path: PathMode::Camera,
-        sweeps: vec![parse_sweep("sdsm.stabilise", &["true".into(), "false".into()]).unwrap()],
-        set: ["sdsm", "pssm"]
-            .map(|t| (t.into(), "map_size".into(), "1024".into()))
-            .to_vec(),
-        flicker: true,
-        cpu_timing: false,
-        reuse_unchanged: false,
-    };
-    let gpu = gpu();
-    let mut flicker = std::collections::HashMap::new();
-    for config in bench::expand(&plan).unwrap() {
-        let result =
-            run_configuration(&gpu, &ShaderLibrary::embedded(), &plan, &config, || {}).unwrap();
-        eprintln!("{}: flicker {:?}", config.label(), result.flicker);
-        flicker.insert(config.label(), result.flicker.unwrap());
-    }
+    let flicker = vista_walk_flicker(&["sdsm", "pssm"], "sdsm");
     let stable = flicker["sdsm [sdsm.stabilise=true]"];
     let unstable = flicker["sdsm [sdsm.stabilise=false]"];
     let pssm = flicker["pssm"];
