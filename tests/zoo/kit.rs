@@ -3,7 +3,8 @@
 
 use zoo_host::ShaderLibrary;
 use zoo_host::gpu::ShaderError;
-use zoo_host::kit::{LightSlot, UniformSlots};
+use zoo_host::kit::{LightSlot, UniformSlots, UniformValue};
+use zoo_host::render::frame::GpuLight;
 use zoo_host::test_support::gpu;
 
 #[test]
@@ -11,12 +12,15 @@ fn uniform_slots_follow_the_device_alignment_and_grow() {
     let gpu = gpu();
     let alignment = u64::from(gpu.device.limits().min_uniform_buffer_offset_alignment);
     let stages = zoo_host::wgpu::ShaderStages::FRAGMENT;
-    let mut slots = UniformSlots::<[f32; 5]>::new(&gpu, "kit test", 2, stages);
+    let mut slots = UniformSlots::<GpuLight>::new(&gpu, "kit test", 2, stages);
     assert_eq!(slots.stride() % alignment, 0);
-    assert!(slots.stride() >= 20);
+    assert!(slots.stride() >= <GpuLight as UniformValue>::SIZE as u64);
     assert_eq!(slots.offset(3) as u64, 3 * slots.stride());
     // More values than room: the buffer grows and keeps the stride.
-    slots.write(&gpu, &[[1.0; 5]; 9]);
+    let scene =
+        zoo_host::Scene::load(&zoo_host::test_support::scene_path("planar-room.ron")).unwrap();
+    let light = GpuLight::new(&scene.lights[0], (0, 0));
+    slots.write(&gpu, &[light; 9]);
     assert!(slots.buffer().size() >= 9 * slots.stride());
     assert!(gpu.take_uncaptured_errors().is_empty());
 }

@@ -22,6 +22,7 @@ mod plugin_failure;
 mod recorder;
 mod slots;
 mod soft_ray_tracing;
+mod stage;
 mod techniques;
 mod viewer;
 

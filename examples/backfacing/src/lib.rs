@@ -39,8 +39,7 @@ impl ShadowTechnique for Backfacing {
         pass.record(ctx, rec, NAME, |light| Pass {
             light: light as u32,
             darkness,
-        });
-        Ok(())
+        })
     }
 }
 

@@ -21,8 +21,8 @@
 //! the judge does (`ray-tracing/translucent.wgsl`).
 //!
 //! A shader imports `ray-tracing/trace.wgsl`; [`shader_source`] swaps the import for the
-//! chosen tracer (both define the same three functions). The bindings are one group: bind [`RayTracing::bind_group`] as group
-//! [`GROUP`] (a [`zoo_host::kit::FullscreenLightPass`]'s first own group).
+//! chosen tracer (both define the same three functions). The bindings are one group, group
+//! [`GROUP`], which stages share as [`Tracer::group`].
 
 use zoo_host::glam::{Mat4, Vec2, Vec3};
 use zoo_host::gpu::{GpuType, gpu_bytes};
@@ -99,6 +99,43 @@ impl Tracer {
         match self {
             Tracer::Compute => compute::layout(device),
             Tracer::RayQuery => query::layout(device),
+        }
+    }
+
+    /// The variables its module declares in group [`GROUP`] (a test checks them).
+    pub fn variables(self) -> &'static [&'static str] {
+        match self {
+            Tracer::Compute => &[
+                "rt_nodes",
+                "rt_triangles",
+                "rt_texcoords",
+                "rt_textures",
+                "rt_sampler",
+                "rt_translucent",
+                "rt_instances",
+                "rt_roots",
+            ],
+            Tracer::RayQuery => &[
+                "rt_scene",
+                "rt_masked",
+                "rt_textures",
+                "rt_sampler",
+                "rt_translucent",
+            ],
+        }
+    }
+
+    /// Its group as stages share it: `layout` ([`Self::layout`]) and, once uploaded,
+    /// `tracing`'s bind group.
+    pub fn group<'a>(
+        self,
+        layout: &'a wgpu::BindGroupLayout,
+        tracing: Option<&'a RayTracing>,
+    ) -> zoo_host::kit::NamedGroup<'a> {
+        zoo_host::kit::NamedGroup {
+            names: self.variables(),
+            layout,
+            group: tracing.map(|t| &t.bind_group),
         }
     }
 
@@ -388,6 +425,8 @@ mod tests {
         ] {
             let composed = ShaderLibrary::embedded().compose(module).unwrap();
             let parsed = naga::front::wgsl::parse_str(&composed.source).unwrap();
+            let names = zoo_host::kit::reflect::declared_variables(&parsed, GROUP);
+            assert_eq!(names, tracer.variables(), "{module}");
             let mut declared: Vec<(u32, String)> = (parsed.global_variables.iter())
                 .filter_map(|(_, var)| {
                     let binding = var.binding.as_ref().filter(|b| b.group == GROUP)?;

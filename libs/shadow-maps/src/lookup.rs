@@ -7,10 +7,22 @@
 //!   linear and nearest comparison samplers, the layer cameras, the maps as plain floats, and
 //!   the maps again for the nearest sampler (GLSL pairs each texture with one sampler).
 
-use zoo_host::kit::{bind_group, bind_group_layout, sampler, storage, texture};
+use zoo_host::kit::{NamedGroup, bind_group, bind_group_layout, sampler, storage, texture};
 use zoo_host::wgpu;
 
 use crate::maps::MapArray;
+
+/// The variables of the depth maps' lookup group as `depth_lookup.wgsl` declares them.
+const DEPTH_VARIABLES: &[&str] = &[
+    "depth_maps",
+    "depth_compare_linear",
+    "depth_compare_nearest",
+    "layer_cameras",
+    "depth_values",
+    "depth_maps_nearest",
+];
+/// The variables of the colour maps' lookup group as `color_lookup.wgsl` declares them.
+const COLOR_VARIABLES: &[&str] = &["color_maps", "layer_cameras"];
 
 /// Layout, samplers and the current bind group.
 pub(crate) struct LookupGroup {
@@ -75,6 +87,19 @@ impl LookupGroup {
         }
     }
 
+    /// The group as stages share it.
+    pub(crate) fn shared(&self) -> NamedGroup<'_> {
+        NamedGroup {
+            names: if self.depth {
+                DEPTH_VARIABLES
+            } else {
+                COLOR_VARIABLES
+            },
+            layout: &self.layout,
+            group: self.group.as_ref(),
+        }
+    }
+
     /// Rebuilds the bind group over `maps` and `cameras`.
     pub(crate) fn bind(&mut self, device: &wgpu::Device, maps: &MapArray, cameras: &wgpu::Buffer) {
         let view = wgpu::BindingResource::TextureView(&maps.array_view);
@@ -98,6 +123,20 @@ impl LookupGroup {
 #[cfg(test)]
 mod tests {
     use zoo_host::gpu::layout::wgsl_struct;
+    use zoo_host::kit::reflect::declared_variables;
+
+    #[test]
+    fn the_variable_names_are_the_shaders() {
+        let library = zoo_host::ShaderLibrary::embedded();
+        for (shader, names) in [
+            ("shadow-maps/depth_lookup.wgsl", super::DEPTH_VARIABLES),
+            ("shadow-maps/color_lookup.wgsl", super::COLOR_VARIABLES),
+        ] {
+            let text = format!("#import \"{shader}\"\n");
+            let (_, module) = library.validate_source("test.wgsl", &text).unwrap();
+            assert_eq!(declared_variables(&module, 3), names, "{shader}");
+        }
+    }
 
     #[test]
     fn lookup_camera_slots_are_the_depth_pass_stride() {

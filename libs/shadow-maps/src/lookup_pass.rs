@@ -1,12 +1,11 @@
 //! The per-light lookup pass of a shadow-map technique: one full-screen draw per shaded light
 //! into its visibility slot, inside the light's screen scissor, with the technique's per-light
-//! uniform (group 2, at a dynamic offset), the map set's lookup group (group 3) and the
-//! technique's own groups from 4 on. Its fragment shader usually starts with the library's
+//! uniform, the map set's lookup group and the technique's own groups. Its fragment shader usually starts with the library's
 //! `map_receiver` and ends with `look_up` (`shaders/shadow-maps/header_lookup.wgsl`); the
 //! diagnostics targets after the slot are written only for the debug light.
 
 use zoo_host::kit::{
-    SlotPipeline, UniformSlots, UniformValue, diagnostics_pipelines, light_pass_name,
+    SharedGroup, Stage, StageBindGroup, UniformSlots, UniformValue, light_pass_name,
 };
 use zoo_host::prelude::*;
 
@@ -21,8 +20,8 @@ pub struct LookupShader<'a> {
     pub diagnostics: &'a [wgpu::TextureFormat],
     /// For passes that write a depth-stencil attachment of their own.
     pub depth_stencil: Option<wgpu::DepthStencilState>,
-    /// The technique's own bind group layouts: groups 4, 5, ...
-    pub groups: &'a [&'a wgpu::BindGroupLayout],
+    /// Groups others own that the shader reads besides the uniform and the maps.
+    pub shared: &'a [&'a dyn SharedGroup],
 }
 
 /// One light's lookup this frame.
@@ -35,12 +34,12 @@ pub struct Lookup<'s> {
     slot: usize,
 }
 
-/// Pipelines (without and with diagnostics) and per-light uniforms of a lookup.
+/// Stages (without and with diagnostics) and per-light uniforms of a lookup.
 pub struct LookupPass<U: UniformValue> {
     /// Pass family name: each pass is `"{name}: light {l}"`.
     name: String,
     uniforms: UniformSlots<U>,
-    pipelines: [wgpu::RenderPipeline; 2],
+    stages: [Stage; 2],
 }
 
 impl<U: UniformValue> LookupPass<U> {
@@ -54,23 +53,35 @@ impl<U: UniformValue> LookupPass<U> {
         let stage = wgpu::ShaderStages::FRAGMENT;
         let label = format!("{name} uniforms");
         let uniforms = UniformSlots::new(ctx.gpu, &label, ctx.lights.len(), stage);
-        let module = ctx.shaders.create_module(&ctx.gpu.device, shader.shader)?;
-        let mut groups = vec![uniforms.layout(), set.lookup_layout()];
-        groups.extend_from_slice(shader.groups);
-        let pipeline = SlotPipeline {
-            label: name,
-            module: &module,
-            entry: shader.entry,
-            groups: &groups,
-            more_targets: &[],
-            depth_stencil: shader.depth_stencil,
-        };
-        let pipelines = diagnostics_pipelines(ctx, pipeline, shader.diagnostics);
+        let stages = [wgpu::ColorWrites::empty(), wgpu::ColorWrites::ALL].map(|write_mask| {
+            let targets: Vec<_> = (shader.diagnostics.iter())
+                .map(|&format| {
+                    Some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask,
+                    })
+                })
+                .collect();
+            Stage::fullscreen(shader.shader, shader.entry)
+                .targets(&targets)
+                .depth_stencil(shader.depth_stencil.clone())
+                .shared(&[&uniforms.at(0), &set.lookup()])
+                .shared(shader.shared)
+                .build(ctx)
+        });
+        let [without, with] = stages;
         Ok(LookupPass {
             name: name.to_string(),
             uniforms,
-            pipelines,
+            stages: [without?, with?],
         })
+    }
+
+    /// The stage without diagnostics, for binding the technique's own groups
+    /// ([`Stage::bind`]; the stage with diagnostics has the same groups).
+    pub fn stage(&self) -> &Stage {
+        &self.stages[0]
     }
 
     /// The name of light `light`'s pass.
@@ -106,8 +117,8 @@ impl<U: UniformValue> LookupPass<U> {
         lookups
     }
 
-    /// Records `lookup` with `colors` after the light's slot and `depth_stencil`; `bind` sets
-    /// the technique's own groups.
+    /// Records `lookup` with `colors` after the light's slot and `depth_stencil`, and the
+    /// technique's `own` and further `shared` groups.
     #[allow(clippy::too_many_arguments)]
     pub fn record_one(
         &self,
@@ -117,19 +128,15 @@ impl<U: UniformValue> LookupPass<U> {
         lookup: &Lookup<'_>,
         colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
         depth_stencil: Option<wgpu::RenderPassDepthStencilAttachment<'_>>,
-        bind: impl FnOnce(&mut wgpu::RenderPass<'_>),
+        (own, shared): (&[&StageBindGroup], &[&dyn SharedGroup]),
     ) -> TechniqueResult {
-        let group = set
-            .lookup_group()
-            .ok_or_else(TechniqueError::not_prepared)?;
         let light = lookup.maps.light;
         let name = self.pass_name(light);
         let mut pass = ctx.light_pass_with(recorder, &name, light, colors, depth_stencil);
-        pass.set_pipeline(&self.pipelines[usize::from(lookup.debug)]);
-        let offset = self.uniforms.offset(lookup.slot);
-        pass.set_bind_group(2, self.uniforms.bind_group(), &[offset]);
-        pass.set_bind_group(3, group, &[]);
-        bind(&mut pass);
+        let (slot, maps) = (self.uniforms.at(lookup.slot), set.lookup());
+        let mut all: Vec<&dyn SharedGroup> = vec![&slot, &maps];
+        all.extend_from_slice(shared);
+        self.stages[usize::from(lookup.debug)].set_on(ctx, &mut pass, own, &all)?;
         let [x, y, width, height] = lookup.maps.scissor;
         if width > 0 && height > 0 {
             pass.set_scissor_rect(x, y, width, height);
@@ -155,7 +162,7 @@ impl<U: UniformValue> LookupPass<U> {
             let colors: Vec<_> = (diagnostics.iter())
                 .map(|view| zoo_host::gpu::color_attachment(view, clear))
                 .collect();
-            self.record_one(ctx, recorder, set, lookup, &colors, None, |_| ())?;
+            self.record_one(ctx, recorder, set, lookup, &colors, None, (&[], &[]))?;
         }
         Ok(())
     }

@@ -13,7 +13,7 @@
 //! clear to white. The lookup (`shadow-maps/moments_lookup.wgsl`) reads the method's settings
 //! from `MomentLight` and applies the light-bleeding reduction to every method alike.
 
-use zoo_host::kit::FullscreenLightPass;
+use zoo_host::kit::{FullscreenLightPass, SharedGroup};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 
@@ -113,7 +113,7 @@ impl MomentMaps {
             &format!("{} lookup", method.label),
             &compose(LOOKUP_SHADER, LOOKUP_ENTRY),
             "fs_moment_lookup",
-            &[maps.lookup_layout()],
+            &[&maps.lookup()],
         )?;
         Ok(MomentMaps {
             label: method.label,
@@ -138,7 +138,7 @@ impl MomentMaps {
         let label = self.label;
         self.maps
             .record(ctx, recorder, &format!("{label} moments"))?;
-        let (Some(maps), Some(group)) = (self.maps.maps(), self.maps.lookup_group()) else {
+        let Some(maps) = self.maps.maps() else {
             return Err(TechniqueError::not_prepared());
         };
         let lights = self.maps.lights();
@@ -150,10 +150,9 @@ impl MomentMaps {
             bias: s.bias,
             bleeding_reduction: s.bleeding_reduction,
         };
-        let bind = |_, pass: &mut wgpu::RenderPass<'_>| pass.set_bind_group(3, group, &[]);
         let lookup = format!("{label} lookup");
-        (self.lookup).record_with(ctx, recorder, &lookup, uniform, bind);
-        Ok(())
+        let shared = [&self.maps.lookup() as &dyn SharedGroup];
+        (self.lookup).record_with(ctx, recorder, &lookup, uniform, &[], &shared)
     }
 
     /// The moment maps and layer cameras.

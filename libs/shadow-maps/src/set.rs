@@ -209,15 +209,9 @@ impl ShadowMapSet {
         limits
     }
 
-    /// The layout of [`Self::lookup_group`] (see [`crate::lookup`]), for the lookup's
-    /// pipeline layout.
-    pub fn lookup_layout(&self) -> &wgpu::BindGroupLayout {
-        &self.lookup.layout
-    }
-
-    /// Once prepared: the lookup's bind group over the current maps and layer cameras.
-    pub fn lookup_group(&self) -> Option<&wgpu::BindGroup> {
-        self.lookup.group.as_ref()
+    /// The lookup group (see [`crate::lookup`]) as stages share it; bound once prepared.
+    pub fn lookup(&self) -> zoo_host::kit::NamedGroup<'_> {
+        self.lookup.shared()
     }
 
     fn update_bounds(&mut self, ctx: &RenderContext<'_>, changes: Changes) {

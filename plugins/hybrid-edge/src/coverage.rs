@@ -131,9 +131,13 @@ impl CoverageMaps {
         self.bound.as_ref().map(|b| &b.ids)
     }
 
-    /// The band pass's group 4, once prepared.
-    pub(crate) fn lookup_group(&self) -> Option<&wgpu::BindGroup> {
-        self.bound.as_ref().map(|b| &b.lookup_group)
+    /// The band pass's group over the maps and the scene's triangles (bound once prepared).
+    pub(crate) fn lookup(&self) -> zoo_host::kit::NamedGroup<'_> {
+        zoo_host::kit::NamedGroup {
+            names: &["coverage_ids", "scene_vertices", "scene_indices"],
+            layout: &self.lookup_layout,
+            group: self.bound.as_ref().map(|b| &b.lookup_group),
+        }
     }
 
     /// Renders the tile of each of `passes` into the coverage maps, one pass each named by

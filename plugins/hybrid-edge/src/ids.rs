@@ -106,9 +106,18 @@ impl IdMaps {
         });
     }
 
-    /// The band pass's group 4, once prepared.
-    pub(crate) fn lookup_group(&self) -> Option<&wgpu::BindGroup> {
-        self.bound.as_ref().map(|b| &b.lookup_group)
+    /// The band pass's group over the maps and the scene's triangles (bound once prepared).
+    pub(crate) fn lookup(&self) -> zoo_host::kit::NamedGroup<'_> {
+        zoo_host::kit::NamedGroup {
+            names: &[
+                "coverage_ids",
+                "scene_vertices",
+                "scene_indices",
+                "triangle_ids",
+            ],
+            layout: &self.lookup_layout,
+            group: self.bound.as_ref().map(|b| &b.lookup_group),
+        }
     }
 
     /// The id maps, once prepared.

@@ -31,7 +31,7 @@ mod tiles;
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{SlotPipeline, light_pass_name, pipeline_layout};
+use zoo_host::kit::{SharedGroup, Stage, light_pass_name, pipeline_layout};
 use zoo_host::prelude::*;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
@@ -162,7 +162,7 @@ struct Gpu {
     /// The band shader's value of each `Restriction`.
     restriction_codes: ChoiceCodes,
     volume: wgpu::RenderPipeline,
-    resolve: wgpu::RenderPipeline,
+    resolve: Stage,
     /// The count view: any non-zero count, then one level at a time.
     count_any: wgpu::RenderPipeline,
     count_equal: wgpu::RenderPipeline,
@@ -201,19 +201,18 @@ impl Gpu {
         let source = ctx.shaders.compose(SHADER)?.source;
         let restriction_codes = ChoiceCodes::read(&source, "RESTRICTION", Restriction::NAMES)
             .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
-        let band_pass = |entry, groups| {
+        let band_pass = |entry, shared: &dyn SharedGroup| {
             let shader = LookupShader {
                 shader: SHADER,
                 entry,
                 diagnostics: &[CLASS_FORMAT],
                 depth_stencil: Some(band_depth_state()),
-                groups,
+                shared: &[shared],
             };
             LookupPass::new(ctx, &maps, BAND_PASS, shader)
         };
-        let (band_groups, id_groups) = ([&coverage.lookup_layout], [&ids.lookup_layout]);
-        let band = band_pass("fs_band", &band_groups)?;
-        let band_ids = band_pass("fs_band_ids", &id_groups)?;
+        let band = band_pass("fs_band", &coverage.lookup())?;
+        let band_ids = band_pass("fs_band_ids", &ids.lookup())?;
         let bias = wgpu::DepthBiasState {
             constant: p.volume_bias as i32,
             slope_scale: 0.0,
@@ -235,20 +234,14 @@ impl Gpu {
             pass_op: keep,
         };
         let always = wgpu::CompareFunction::Always;
-        let resolve = SlotPipeline {
-            label: "hybrid resolve",
-            module: &module,
-            entry: "fs_shadowed",
-            groups: &[],
-            more_targets: &[],
-            depth_stencil: Some(stencil_state(
+        let resolve = Stage::fullscreen(SHADER, "fs_shadowed")
+            .depth_stencil(stencil_state(
                 always,
                 not_zero,
                 not_zero,
                 Default::default(),
-            )),
-        }
-        .build(ctx);
+            ))
+            .build(ctx)?;
         let count = |compare| {
             let face = wgpu::StencilFaceState {
                 compare,
@@ -478,10 +471,9 @@ impl ShadowTechnique for Hybrid {
         };
         let band_pass = if exact { &gpu.band_ids } else { &gpu.band };
         let group = match exact {
-            true => gpu.ids.lookup_group(),
-            false => gpu.coverage.lookup_group(),
-        }
-        .ok_or_else(TechniqueError::not_prepared)?;
+            true => gpu.ids.lookup(),
+            false => gpu.coverage.lookup(),
+        };
         for (k, lookup) in lookups.iter().enumerate() {
             let light = lookup.maps.light;
             let band = &gpu.targets.band.1;
@@ -499,7 +491,7 @@ impl ShadowTechnique for Hybrid {
                         store: wgpu::StoreOp::Store,
                     }),
                 };
-                let bind = |pass: &mut wgpu::RenderPass<'_>| pass.set_bind_group(4, group, &[]);
+                let groups = (&[] as &[_], &[&group as &dyn SharedGroup] as &[_]);
                 band_pass.record_one(
                     ctx,
                     recorder,
@@ -507,7 +499,7 @@ impl ShadowTechnique for Hybrid {
                     lookup,
                     &class,
                     Some(depth),
-                    bind,
+                    groups,
                 )?;
             }
             if exact {
@@ -556,7 +548,7 @@ impl ShadowTechnique for Hybrid {
                 pass.set_vertex_buffer(0, volume.slice(..));
                 pass.draw_indirect(args, 0);
             }
-            pass.set_pipeline(&gpu.resolve);
+            gpu.resolve.set_on(ctx, &mut pass, &[], &[])?;
             pass.set_stencil_reference(0);
             pass.draw(0..3, 0..1);
             drop(pass);

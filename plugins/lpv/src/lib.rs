@@ -23,7 +23,7 @@ pub mod sh;
 
 use zoo_host::glam::Vec3;
 use zoo_host::gpu::{GpuStruct, GpuType, gpu_bytes};
-use zoo_host::kit::{ComputeStage, FullscreenLightPass, StageGroups};
+use zoo_host::kit::{FullscreenLightPass, SharedGroup, Stage, StageBindGroup};
 use zoo_host::prelude::*;
 use zoo_host::technique::{
     DebugImage, DebugVolume, ResourceInfo, ViewMapping, VolumeAxis, VolumeSlice,
@@ -156,53 +156,51 @@ const RSM_VIEWS: [&str; 3] = ["RSM flux", "RSM normals", "RSM positions"];
 
 /// The compute stages.
 struct Stages {
-    inject: ComputeStage,
-    camera_occluders: ComputeStage,
-    resolve: ComputeStage,
-    propagate: ComputeStage,
-    lookup: ComputeStage,
-    debug_volume: ComputeStage,
-    debug_bounds: ComputeStage,
+    inject: Stage,
+    camera_occluders: Stage,
+    resolve: Stage,
+    propagate: Stage,
+    lookup: Stage,
+    debug_volume: Stage,
+    debug_bounds: Stage,
     /// The emitters' moments over the box, along x, y and z.
-    spread: [ComputeStage; 3],
+    spread: [Stage; 3],
 }
 
 impl Stages {
-    /// Every stage's pipeline, its group as the shader declares it.
+    /// Every stage's pipeline, its groups as the shader declares them.
     fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Stages> {
-        let alone = |shader, entry| ComputeStage::new(ctx, shader, entry, StageGroups::Alone, &[]);
-        let screen =
-            |shader, entry| ComputeStage::new(ctx, shader, entry, StageGroups::AfterHost, &[]);
-        let spread = |entry| alone("lpv/spread.wgsl", entry);
+        let stage = |shader, entry| Stage::compute(shader, entry).build(ctx);
+        let spread = |entry| stage("lpv/spread.wgsl", entry);
         Ok(Stages {
-            inject: alone("lpv/inject.wgsl", "cs_inject")?,
-            camera_occluders: screen("lpv/inject_camera.wgsl", "cs_inject_camera")?,
-            resolve: alone("lpv/resolve.wgsl", "cs_resolve")?,
+            inject: stage("lpv/inject.wgsl", "cs_inject")?,
+            camera_occluders: stage("lpv/inject_camera.wgsl", "cs_inject_camera")?,
+            resolve: stage("lpv/resolve.wgsl", "cs_resolve")?,
             spread: [
                 spread("cs_spread_x")?,
                 spread("cs_spread_y")?,
                 spread("cs_spread_z")?,
             ],
-            propagate: alone("lpv/propagate.wgsl", "cs_propagate")?,
-            lookup: screen("lpv/lookup.wgsl", "cs_lookup")?,
-            debug_volume: screen("lpv/debug.wgsl", "cs_volume")?,
-            debug_bounds: screen("lpv/debug.wgsl", "cs_bounds")?,
+            propagate: stage("lpv/propagate.wgsl", "cs_propagate")?,
+            lookup: stage("lpv/lookup.wgsl", "cs_lookup")?,
+            debug_volume: stage("lpv/debug.wgsl", "cs_volume")?,
+            debug_bounds: stage("lpv/debug.wgsl", "cs_bounds")?,
         })
     }
 }
 
 /// Bind groups over the current buffers and targets.
 struct Groups {
-    inject: wgpu::BindGroup,
-    camera_occluders: wgpu::BindGroup,
-    resolve: wgpu::BindGroup,
+    inject: StageBindGroup,
+    camera_occluders: StageBindGroup,
+    resolve: StageBindGroup,
     /// Step a to b, and b to a.
-    propagate: [wgpu::BindGroup; 2],
+    propagate: [StageBindGroup; 2],
     /// Moments a to b, and b to a.
-    spread: [wgpu::BindGroup; 2],
-    lookup: wgpu::BindGroup,
-    debug_volume: wgpu::BindGroup,
-    debug_bounds: wgpu::BindGroup,
+    spread: [StageBindGroup; 2],
+    lookup: StageBindGroup,
+    debug_volume: StageBindGroup,
+    debug_bounds: StageBindGroup,
 }
 
 /// Everything built at the first `prepare`.
@@ -230,7 +228,7 @@ impl Gpu {
             ctx,
             "lpv/visibility.wgsl",
             "fs_visibility",
-            &[maps.lookup_layout()],
+            &[&maps.lookup()],
         )?;
         let data = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("lpv data"),
@@ -425,10 +423,10 @@ impl ShadowTechnique for Lpv {
                 ctx,
                 recorder,
                 gpu::INJECT_PASS,
-                &groups.inject,
+                &[&groups.inject],
                 &[],
                 [targets.resolution, targets.resolution, layers],
-            );
+            )?;
         } else {
             drop(recorder.compute_pass(gpu::INJECT_PASS));
         }
@@ -438,20 +436,20 @@ impl ShadowTechnique for Lpv {
                 ctx,
                 recorder,
                 gpu::CAMERA_OCCLUDERS_PASS,
-                &groups.camera_occluders,
+                &[&groups.camera_occluders],
                 &[],
                 screen,
-            );
+            )?;
         }
         let entries = (volumes.cells * 3) as u32;
         s.resolve.dispatch(
             ctx,
             recorder,
             gpu::RESOLVE_PASS,
-            &groups.resolve,
+            &[&groups.resolve],
             &[],
             [entries, 1, 1],
-        );
+        )?;
         let n = p.grid_size;
         if p.emitter_orientation {
             // Two boxes along each axis make a tent: a -> b -> a -> b -> a -> b -> a, so the
@@ -459,7 +457,7 @@ impl ShadowTechnique for Lpv {
             for (i, name) in spread_pass_names().iter().enumerate() {
                 let stage = &s.spread[i % 3];
                 let group = &groups.spread[i % 2];
-                stage.dispatch(ctx, recorder, name, group, &[], [n, n, n * p.cascades]);
+                stage.dispatch(ctx, recorder, name, &[group], &[], [n, n, n * p.cascades])?;
             }
         }
         // Coarser grids keep what they hold after half the steps: the share of their light
@@ -475,16 +473,19 @@ impl ShadowTechnique for Lpv {
             let name = format!("{} {}", gpu::PROPAGATE_PASS, i + 1);
             let group = &groups.propagate[(i % 2) as usize];
             s.propagate
-                .dispatch(ctx, recorder, &name, group, &[], [n, n, n * p.cascades]);
+                .dispatch(ctx, recorder, &name, &[group], &[], [n, n, n * p.cascades])?;
             if keep_near && i + 1 == near_steps {
                 copy_whole(recorder.encoder(), &volumes.accumulated, &volumes.near);
             }
         }
-        s.lookup
-            .dispatch(ctx, recorder, gpu::LOOKUP_PASS, &groups.lookup, &[], screen);
-        let Some(lookup_group) = gpu.maps.lookup_group() else {
-            return Err(TechniqueError::not_prepared());
-        };
+        s.lookup.dispatch(
+            ctx,
+            recorder,
+            gpu::LOOKUP_PASS,
+            &[&groups.lookup],
+            &[],
+            screen,
+        )?;
         let lights = gpu.maps.lights().to_vec();
         let shadow = |light: usize| {
             let maps = &lights[light];
@@ -498,9 +499,8 @@ impl ShadowTechnique for Lpv {
                 normal_offset: 1.5,
             }
         };
-        let bind = |_, pass: &mut wgpu::RenderPass<'_>| pass.set_bind_group(3, lookup_group, &[]);
-        gpu.shadows
-            .record_with(ctx, recorder, SHADOW_PASS, shadow, bind);
+        let lookup = [&gpu.maps.lookup() as &dyn SharedGroup];
+        (gpu.shadows).record_with(ctx, recorder, SHADOW_PASS, shadow, &[], &lookup)?;
         // Debug views.
         let shown = ctx.debug_view;
         if let Some(name) = shown {
@@ -518,20 +518,20 @@ impl ShadowTechnique for Lpv {
                     ctx,
                     recorder,
                     gpu::DEBUG_VOLUME_PASS,
-                    &groups.debug_volume,
+                    &[&groups.debug_volume],
                     &[],
                     [g, g, g],
-                );
+                )?;
             } else if name == "cascade bounds" {
                 let stage = &gpu.stages.debug_bounds;
                 stage.dispatch(
                     ctx,
                     recorder,
                     gpu::DEBUG_BOUNDS_PASS,
-                    &groups.debug_bounds,
+                    &[&groups.debug_bounds],
                     &[],
                     screen,
-                );
+                )?;
             }
         }
         Ok(())

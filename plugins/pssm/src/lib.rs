@@ -132,7 +132,7 @@ impl Gpu {
             // Split colours and texel density.
             diagnostics: &[DIAGNOSTICS_FORMAT, DIAGNOSTICS_FORMAT],
             depth_stencil: None,
-            groups: &[],
+            shared: &[],
         };
         Ok(Gpu {
             lookup: LookupPass::new(ctx, &maps, LOOKUP_PASS, shader)?,

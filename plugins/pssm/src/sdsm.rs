@@ -7,7 +7,7 @@
 //! a single frame is exact; a view without surfaces keeps pssm's range (the objects' boxes).
 
 use zoo_host::gpu::readback::{ReadbackRing, f32s};
-use zoo_host::kit::{ComputeStage, StageGroups};
+use zoo_host::kit::{Stage, StageBindGroup};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo};
 
@@ -16,16 +16,15 @@ use crate::{Pssm, PssmParams};
 /// The reduction's pipeline, its bind group over `range` (the depths' f32 bits), and the ring
 /// reading `range` back a frame late.
 struct Reduction {
-    stage: ComputeStage,
-    group: wgpu::BindGroup,
+    stage: Stage,
+    group: StageBindGroup,
     range: wgpu::Buffer,
     ring: ReadbackRing,
 }
 
 impl Reduction {
     fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Reduction> {
-        let groups = StageGroups::AfterHost;
-        let stage = ComputeStage::new(ctx, "pssm/sdsm.wgsl", "cs_depth_range", groups, &[])?;
+        let stage = Stage::compute("pssm/sdsm.wgsl", "cs_depth_range").build(ctx)?;
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let range = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("sdsm depth range"),
@@ -50,14 +49,14 @@ impl Reduction {
         &mut self,
         ctx: &RenderContext<'_>,
         rec: &mut PassRecorder<'_>,
-    ) -> Option<(f32, f32)> {
+    ) -> TechniqueResult<Option<(f32, f32)>> {
         let (gpu, extent) = (ctx.gpu, [ctx.size.x, ctx.size.y, 1]);
         let mut latest = self.ring.latest(&gpu.device).map(|(_, b)| f32s(b));
         // Nearest from the largest bits down, farthest from 0 up.
         let start: &[u32] = &[u32::MAX, 0];
         gpu.queue
             .write_buffer(&self.range, 0, bytemuck::cast_slice(start));
-        (self.stage).dispatch(ctx, rec, "SDSM depth range", &self.group, &[], extent);
+        (self.stage).dispatch(ctx, rec, "SDSM depth range", &[&self.group], &[], extent)?;
         if let Some(target) = self.ring.target() {
             rec.encoder()
                 .copy_buffer_to_buffer(&self.range, 0, target, 0, 8);
@@ -72,7 +71,7 @@ impl Reduction {
         }
         // Without surfaces the bits stay (u32::MAX, 0): NaN and 0.
         let range = latest.filter(|d| d[1] > 0.0);
-        range.map(|d| (d[0], d[1].max(d[0] * 1.001)))
+        Ok(range.map(|d| (d[0], d[1].max(d[0] * 1.001))))
     }
 }
 
@@ -92,7 +91,7 @@ impl ShadowTechnique for Sdsm {
 
     fn record(&mut self, ctx: &RenderContext<'_>, rec: &mut PassRecorder<'_>) -> TechniqueResult {
         let reduction = (self.reduction.as_mut()).ok_or_else(TechniqueError::not_prepared)?;
-        let range = reduction.record(ctx, rec);
+        let range = reduction.record(ctx, rec)?;
         if range != self.pssm.range {
             self.pssm.range = range;
             let moved = Changes {

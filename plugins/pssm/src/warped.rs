@@ -260,7 +260,7 @@ impl Gpu {
             entry: "fs_warped",
             diagnostics: &[DIAGNOSTICS_FORMAT],
             depth_stencil: None,
-            groups: &[],
+            shared: &[],
         };
         Ok(Gpu {
             lookup: LookupPass::new(ctx, &maps, &format!("{} lookup", id.to_uppercase()), shader)?,

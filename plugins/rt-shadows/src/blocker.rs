@@ -18,7 +18,8 @@ const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The distances and the pass that traces them, both made when first asked for.
 pub struct BlockerView {
-    module: wgpu::ShaderModule,
+    /// The tracing shader's text for the chosen tracer.
+    text: String,
     pass: Option<TracePass>,
     target: Option<(wgpu::Texture, wgpu::TextureView)>,
     /// The farthest distance shown white (the scene's diagonal).
@@ -26,10 +27,10 @@ pub struct BlockerView {
 }
 
 impl BlockerView {
-    /// The view of fragment `fs_blocker_distance` of the tracing `module`.
-    pub fn new(module: &wgpu::ShaderModule) -> BlockerView {
+    /// The view of fragment `fs_blocker_distance` of the tracing shader `text`.
+    pub fn new(text: &str) -> BlockerView {
         BlockerView {
-            module: module.clone(),
+            text: text.to_string(),
             pass: None,
             target: None,
             far: 1.0,
@@ -37,20 +38,22 @@ impl BlockerView {
     }
 
     /// Traces light `light`'s blocker distances at the output's size, with the ray-tracing
-    /// group `tracing` (of layout `tracing_layout`).
+    /// group `tracing` of shader `shader`.
     pub fn record(
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-        (tracing, tracing_layout): (&wgpu::BindGroup, &wgpu::BindGroupLayout),
+        (shader, tracing): (&str, &dyn kit::SharedGroup),
         per_light: impl Fn(usize) -> RtLight,
         light: usize,
-    ) {
-        let pass = self.pass.get_or_insert_with(|| {
-            let entry = (&self.module, "fs_blocker_distance");
+    ) -> TechniqueResult {
+        if self.pass.is_none() {
+            let entry = (shader, self.text.as_str(), "fs_blocker_distance");
             let target = TracePass::replace(FORMAT);
-            TracePass::new(ctx, "Blocker distance", entry, target, tracing_layout)
-        });
+            let pass = TracePass::new(ctx, "Blocker distance", entry, target, tracing)?;
+            self.pass = Some(pass);
+        }
+        let pass = self.pass.as_mut().expect("made above");
         let size = ctx.visibility.texture.size();
         let fits = |(texture, _): &(wgpu::Texture, wgpu::TextureView)| {
             texture.width() == size.width && texture.height() == size.height
@@ -80,7 +83,7 @@ impl BlockerView {
         let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
         let target = |l: usize| (l == light).then_some((view, clear));
         let no_blend = |_| None;
-        pass.record(ctx, recorder, tracing, per_light, target, no_blend);
+        pass.record(ctx, recorder, tracing, per_light, target, no_blend)
     }
 
     /// The distances as a viewable resource, once traced.

@@ -11,14 +11,14 @@ const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub struct History {
     pub texture: wgpu::Texture,
     layer_views: Vec<wgpu::TextureView>,
-    /// The history as the filter pass reads it (its group 3).
-    pub group: wgpu::BindGroup,
+    /// The history as the filter pass reads it.
+    pub group: kit::StageBindGroup,
 }
 
 impl History {
-    /// A history shaped like `ctx`'s visibility slots, bound with `layout` (one unfilterable
-    /// 2D array texture at binding 0).
-    pub fn new(ctx: &RenderContext<'_>, layout: &wgpu::BindGroupLayout) -> History {
+    /// A history shaped like `ctx`'s visibility slots, bound as the `history` of the filter
+    /// pass's `stage`.
+    pub fn new(ctx: &RenderContext<'_>, stage: &kit::Stage) -> TechniqueResult<History> {
         let device = &ctx.gpu.device;
         let size = ctx.visibility.texture.size();
         let texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -47,17 +47,13 @@ impl History {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        let group = kit::bind_group(
-            device,
-            "rt-shadows history",
-            layout,
-            &[wgpu::BindingResource::TextureView(&view)],
-        );
-        History {
+        let history = ("history", wgpu::BindingResource::TextureView(&view));
+        let group = stage.bind(ctx, "rt-shadows history", &[history])?;
+        Ok(History {
             texture,
             layer_views,
             group,
-        }
+        })
     }
 
     /// Whether it still has the slots' shape.

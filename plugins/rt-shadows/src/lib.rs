@@ -76,7 +76,6 @@ struct Gpu {
     tracer: Tracer,
     tracing_layout: wgpu::BindGroupLayout,
     trace: FullscreenLightPass<RtLight>,
-    history_layout: wgpu::BindGroupLayout,
     accumulation: TracePass,
     denoise: FullscreenLightPass<RtLight>,
     transmittance: TracePass,
@@ -91,42 +90,31 @@ impl Gpu {
         let tracer = Tracer::choose(traversal, device, "rt-shadows")?;
         let tracing_layout = tracer.layout(device);
         let trace_text = zoo_ray_tracing::shader_source(ctx.shaders, TRACE_SHADER, tracer)?;
-        let groups = [&tracing_layout];
+        let tracing = tracer.group(&tracing_layout, None);
+        let shared = [&tracing as &dyn kit::SharedGroup];
         let trace =
-            FullscreenLightPass::from_source(ctx, TRACE_SHADER, &trace_text, "fs_main", &groups)?;
-        let history_layout = kit::bind_group_layout(
-            device,
-            "rt-shadows history layout",
-            &[kit::texture(
-                0,
-                wgpu::ShaderStages::FRAGMENT,
-                wgpu::TextureSampleType::Float { filterable: false },
-                wgpu::TextureViewDimension::D2Array,
-            )],
-        );
-        let module = (ctx.shaders).create_module_from_source(device, TRACE_SHADER, &trace_text)?;
+            FullscreenLightPass::from_source(ctx, TRACE_SHADER, &trace_text, "fs_main", &shared)?;
+        let entry = |entry| (TRACE_SHADER, trace_text.as_str(), entry);
         let accumulation = TracePass::new(
             ctx,
             "Accumulate",
-            (&module, "fs_accumulate"),
+            entry("fs_accumulate"),
             history::accumulation_target(),
-            &tracing_layout,
-        );
-        let denoise =
-            FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[&history_layout])?;
+            &tracing,
+        )?;
+        let denoise = FullscreenLightPass::new(ctx, DENOISE_SHADER, "fs_denoise", &[])?;
         let transmittance = TracePass::new(
             ctx,
             "Transmittance",
-            (&module, "fs_transmittance"),
+            entry("fs_transmittance"),
             TracePass::replace(VISIBILITY_FORMAT),
-            &tracing_layout,
-        );
-        let blocker = BlockerView::new(&module);
+            &tracing,
+        )?;
+        let blocker = BlockerView::new(&trace_text);
         Ok(Gpu {
             tracer,
             tracing_layout,
             trace,
-            history_layout,
             accumulation,
             denoise,
             transmittance,
@@ -179,7 +167,7 @@ impl ShadowTechnique for RtShadows {
             gpu.history = None;
         }
         if self.soft_lights && gpu.history.is_none() {
-            gpu.history = Some(History::new(ctx, &gpu.history_layout));
+            gpu.history = Some(History::new(ctx, gpu.denoise.stage())?);
             self.frames = 0;
         }
         // The n-th frame since a change weighs 1/n; past `accumulation`, a moving average.
@@ -200,28 +188,19 @@ impl ShadowTechnique for RtShadows {
                 frame,
             }
         };
-        let tracing = gpu
-            .tracing
-            .as_ref()
-            .ok_or_else(TechniqueError::not_prepared)?;
-        gpu.trace
-            .record_with(ctx, rec, TRACE_PASS, per_light, |_, pass| {
-                pass.set_bind_group(zoo_ray_tracing::GROUP, &tracing.bind_group, &[]);
-            });
+        let traced = gpu.tracing.as_ref();
+        let tracing = gpu.tracer.group(&gpu.tracing_layout, traced);
+        let tracing: &dyn kit::SharedGroup = &tracing;
+        (gpu.trace).record_with(ctx, rec, TRACE_PASS, per_light, &[], &[tracing])?;
         if let Some(history) = &gpu.history {
             let layer =
                 |light: usize| (soft_lights.contains(&light)).then(|| history.target(ctx, light));
             let blend = |light| Some(History::blend(ctx, light, new_frame_weight));
-            let tracing = &tracing.bind_group;
-            (gpu.accumulation).record(ctx, rec, tracing, per_light, layer, blend);
-            let group = &history.group;
-            gpu.denoise
-                .record_with(ctx, rec, DENOISE_PASS, per_light, |_, pass| {
-                    pass.set_bind_group(3, group, &[]);
-                });
+            (gpu.accumulation).record(ctx, rec, tracing, per_light, layer, blend)?;
+            let own = [&history.group];
+            (gpu.denoise).record_with(ctx, rec, DENOISE_PASS, per_light, &own, &[])?;
             self.frames = self.frames.saturating_add(1);
         }
-        let tracing = &tracing.bind_group;
         if ctx.transmittance.in_use {
             // Each light's colour into its transmittance slot (white until written).
             let slot = |light| {
@@ -229,13 +208,12 @@ impl ShadowTechnique for RtShadows {
                 view.map(|view| (view, wgpu::LoadOp::Load))
             };
             let no_blend = |_| None;
-            (gpu.transmittance).record(ctx, rec, tracing, per_light, slot, no_blend);
+            (gpu.transmittance).record(ctx, rec, tracing, per_light, slot, no_blend)?;
         }
         let debug_light = p.debug_light as usize;
         if p.blocker_distance && debug_light < ctx.lights.len() {
-            let tracing = (tracing, &gpu.tracing_layout);
-            gpu.blocker
-                .record(ctx, rec, tracing, per_light, debug_light);
+            let tracing = (TRACE_SHADER, tracing);
+            (gpu.blocker).record(ctx, rec, tracing, per_light, debug_light)?;
         }
         Ok(())
     }

@@ -9,45 +9,44 @@ use zoo_host::prelude::*;
 
 use crate::RtLight;
 
-/// The pipeline of one fragment entry of the tracing shader, and its per-light uniforms.
+/// The stage of one fragment entry of the tracing shader, and its per-light uniforms.
 pub struct TracePass {
     label: &'static str,
-    pipeline: wgpu::RenderPipeline,
+    stage: kit::Stage,
     uniforms: kit::UniformSlots<RtLight>,
 }
 
+/// A fragment entry of a tracing shader: the shader's name, its text for the chosen tracer
+/// and the entry.
+pub type TraceEntry<'a> = (&'a str, &'a str, &'a str);
+
 impl TracePass {
-    /// The pipeline of fragment `entry` of the tracing `module` writing `target`, after the
-    /// frame and G-buffer groups: the per-light uniform (2) and the ray-tracing group (3).
-    /// `label` names it and its passes.
+    /// The stage of fragment `entry` of the tracing shader writing `target`, reading the
+    /// per-light uniform and the ray-tracing group `tracing`. `label` names it and its passes.
     pub fn new(
         ctx: &RenderContext<'_>,
         label: &'static str,
-        (module, entry): (&wgpu::ShaderModule, &str),
+        (shader, text, entry): TraceEntry<'_>,
         target: wgpu::ColorTargetState,
-        tracing: &wgpu::BindGroupLayout,
-    ) -> TracePass {
+        tracing: &dyn kit::SharedGroup,
+    ) -> TechniqueResult<TracePass> {
         let uniforms = kit::UniformSlots::new(
             ctx.gpu,
             &format!("rt-shadows {label}"),
             ctx.lights.len(),
             wgpu::ShaderStages::FRAGMENT,
         );
-        let groups = [uniforms.layout(), tracing];
-        let layout = kit::pipeline_layout(ctx, &format!("rt-shadows {label} layout"), &groups);
-        let pipeline = zoo_host::gpu::fullscreen_pipeline(
-            &ctx.gpu.device,
-            &format!("rt-shadows {label}"),
-            Some(&layout),
-            module,
-            entry,
-            target,
-        );
-        TracePass {
+        let stage = kit::Stage::render(shader, "fullscreen_vs")
+            .text(text)
+            .fragment(entry)
+            .targets(&[Some(target)])
+            .shared(&[&uniforms.at(0), tracing])
+            .build(ctx)?;
+        Ok(TracePass {
             label,
-            pipeline,
+            stage,
             uniforms,
-        }
+        })
     }
 
     /// A target state writing `format` as it is (no blend).
@@ -66,11 +65,11 @@ impl TracePass {
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-        tracing: &wgpu::BindGroup,
+        tracing: &dyn kit::SharedGroup,
         per_light: impl Fn(usize) -> RtLight,
         target: impl Fn(usize) -> Option<(&'t wgpu::TextureView, wgpu::LoadOp<wgpu::Color>)>,
         blend: impl Fn(usize) -> Option<wgpu::Color>,
-    ) {
+    ) -> TechniqueResult {
         let values: Vec<RtLight> = (0..ctx.lights.len()).map(per_light).collect();
         self.uniforms.write(ctx.gpu, &values);
         for light in 0..ctx.lights.len() {
@@ -89,16 +88,10 @@ impl TracePass {
             if let Some(constant) = blend(light) {
                 pass.set_blend_constant(constant);
             }
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
-            pass.set_bind_group(
-                2,
-                self.uniforms.bind_group(),
-                &[self.uniforms.offset(light)],
-            );
-            pass.set_bind_group(zoo_ray_tracing::GROUP, tracing, &[]);
+            let shared = [&self.uniforms.at(light) as &dyn kit::SharedGroup, tracing];
+            self.stage.set_on(ctx, &mut pass, &[], &shared)?;
             pass.draw(0..3, 0..1);
         }
+        Ok(())
     }
 }

@@ -100,7 +100,7 @@ impl Gpu {
             entry: "fs_lookup",
             diagnostics: &[DIAGNOSTICS_FORMAT],
             depth_stencil: None,
-            groups: &[],
+            shared: &[],
         };
         Ok(Gpu {
             lookup: LookupPass::new(ctx, &maps, LOOKUP_PASS, shader)?,

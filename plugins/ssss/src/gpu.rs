@@ -5,7 +5,7 @@ use zoo_host::glam::{UVec2, UVec4};
 use zoo_host::gpu::array_layers;
 use zoo_host::gpu::gpu_struct::round_up;
 use zoo_host::gpu::{GpuStruct, GpuType};
-use zoo_host::kit::{ComputeStage, StageGroups};
+use zoo_host::kit::{SharedGroup, Stage, StageBindGroup};
 use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
 use zoo_shadow_maps::{ShadowMapSet, TranslucentPass};
@@ -227,13 +227,13 @@ impl Targets {
 
 /// The compute passes after the maps and their current bind groups.
 pub struct Passes {
-    penumbra: ComputeStage,
-    blur_first: ComputeStage,
-    blur_second: ComputeStage,
-    resolve: ComputeStage,
-    debug: ComputeStage,
+    penumbra: Stage,
+    blur_first: Stage,
+    blur_second: Stage,
+    resolve: Stage,
+    debug: Stage,
     /// Per batch of layers: the groups of the penumbra, blur, resolve and debug passes.
-    groups: Vec<[wgpu::BindGroup; 5]>,
+    groups: Vec<[StageBindGroup; 5]>,
 }
 
 /// The penumbra pass: hard shadows, penumbra sizes and tints of every light.
@@ -251,15 +251,15 @@ impl Passes {
     /// Builds every pass's pipeline (their groups as the shaders declare them); the penumbra
     /// pass reads `maps` through their lookup group.
     pub fn new(ctx: &RenderContext<'_>, maps: &ShadowMapSet) -> TechniqueResult<Passes> {
-        let stage = |shader, entry, more: &[&wgpu::BindGroupLayout]| {
-            ComputeStage::new(ctx, shader, entry, StageGroups::AfterHost, more)
-        };
+        let stage = |shader, entry| Stage::compute(shader, entry).build(ctx);
         Ok(Passes {
-            penumbra: stage("ssss/penumbra.wgsl", "cs_penumbra", &[maps.lookup_layout()])?,
-            blur_first: stage("ssss/blur_first.wgsl", "cs_blur_first", &[])?,
-            blur_second: stage("ssss/blur_second.wgsl", "cs_blur_second", &[])?,
-            resolve: stage("ssss/resolve.wgsl", "cs_resolve", &[])?,
-            debug: stage("ssss/debug.wgsl", "cs_debug", &[])?,
+            penumbra: Stage::compute("ssss/penumbra.wgsl", "cs_penumbra")
+                .shared(&[&maps.lookup()])
+                .build(ctx)?,
+            blur_first: stage("ssss/blur_first.wgsl", "cs_blur_first")?,
+            blur_second: stage("ssss/blur_second.wgsl", "cs_blur_second")?,
+            resolve: stage("ssss/resolve.wgsl", "cs_resolve")?,
+            debug: stage("ssss/debug.wgsl", "cs_debug")?,
             groups: Vec::new(),
         })
     }
@@ -286,7 +286,7 @@ impl Passes {
         targets: &Targets,
         translucency: &wgpu::TextureView,
         min_maps: &wgpu::TextureView,
-    ) -> TechniqueResult<[wgpu::BindGroup; 5]> {
+    ) -> TechniqueResult<[StageBindGroup; 5]> {
         let view = wgpu::BindingResource::TextureView;
         let data = || ("data", data.as_entire_binding());
         let t = targets;
@@ -367,9 +367,10 @@ impl Passes {
         half_resolution: bool,
         debug: bool,
     ) -> TechniqueResult {
-        let (false, Some(lookup)) = (self.groups.is_empty(), maps.lookup_group()) else {
+        if self.groups.is_empty() {
             return Err(TechniqueError::not_prepared());
-        };
+        }
+        let lookup = maps.lookup();
         let full = ctx.size;
         let grid = if half_resolution {
             ctx.size.map(|side| side.div_ceil(2))
@@ -377,7 +378,12 @@ impl Passes {
             full
         };
         let stages = [
-            (PENUMBRA_PASS, &self.penumbra, Some(lookup), full),
+            (
+                PENUMBRA_PASS,
+                &self.penumbra,
+                Some(&lookup as &dyn SharedGroup),
+                full,
+            ),
             (BLUR_FIRST_PASS, &self.blur_first, None, grid),
             (BLUR_SECOND_PASS, &self.blur_second, None, grid),
             (RESOLVE_PASS, &self.resolve, None, full),
@@ -393,9 +399,9 @@ impl Passes {
                     (1, _) | (_, DEBUG_PASS) => name.to_string(),
                     _ => format!("{name} (batch {b})"),
                 };
-                let more: Vec<&wgpu::BindGroup> = lookup.iter().copied().collect();
+                let shared: Vec<&dyn SharedGroup> = lookup.iter().copied().collect();
                 let extent = [extent.x, extent.y, 1];
-                stage.dispatch(ctx, recorder, &name, &groups[k], &more, extent);
+                stage.dispatch(ctx, recorder, &name, &[&groups[k]], &shared, extent)?;
             }
         }
         Ok(())
@@ -405,12 +411,12 @@ impl Passes {
 /// Min-filtered depth maps: each texel the nearest depth of an 8 x 8 block of its map layer
 /// (`ssss/min_depth.wgsl`), for the min-filter penumbra estimate.
 pub struct MinFilter {
-    stage: ComputeStage,
+    stage: Stage,
     /// (maps, array view, resolution, layers) once made.
     maps: Option<(wgpu::Texture, wgpu::TextureView, u32, u32)>,
     kept: Option<wgpu::Buffer>,
     kept_count: u32,
-    group: Option<wgpu::BindGroup>,
+    group: Option<StageBindGroup>,
 }
 
 /// Full-resolution texels per min-map texel along each side (`MIN_BLOCK` in the shader).
@@ -421,13 +427,7 @@ pub const MIN_FILTER_PASS: &str = "SSSS min filter";
 impl MinFilter {
     /// Builds the reduction pipeline.
     pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<MinFilter> {
-        let stage = ComputeStage::new(
-            ctx,
-            "ssss/min_depth.wgsl",
-            "cs_min_depth",
-            StageGroups::Alone,
-            &[],
-        )?;
+        let stage = Stage::compute("ssss/min_depth.wgsl", "cs_min_depth").build(ctx)?;
         Ok(MinFilter {
             stage,
             maps: None,
@@ -518,9 +518,7 @@ impl MinFilter {
             return Ok(());
         }
         let extent = [maps.2, maps.2, self.kept_count];
-        self.stage
-            .dispatch(ctx, recorder, MIN_FILTER_PASS, group, &[], extent);
-        Ok(())
+        (self.stage).dispatch(ctx, recorder, MIN_FILTER_PASS, &[group], &[], extent)
     }
 }
 

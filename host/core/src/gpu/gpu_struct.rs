@@ -311,6 +311,7 @@ macro_rules! gpu_struct {
 
         impl $crate::kit::UniformValue for $name {
             const SIZE: usize = <$name as $crate::gpu::gpu_struct::GpuType>::SIZE;
+            const WGSL_TYPE: &'static str = stringify!($name);
             fn write_bytes(&self, out: &mut [u8]) {
                 $crate::gpu::gpu_struct::GpuType::write(self, out);
             }

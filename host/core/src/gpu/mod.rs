@@ -15,7 +15,7 @@ pub use recorder::{
     FrameTimings, PASSES_PER_CHUNK, PassOwner, PassRecorder, PassTiming, RecordedComputePass,
     RecordedRenderPass, StatisticsQueries, TimestampQueries, TimingSource,
 };
-pub use shaders::{ComposedShader, ShaderError, ShaderLibrary};
+pub use shaders::{ComposedShader, LoadedShader, ShaderError, ShaderLibrary};
 pub use targets::{
     array_layers, clear_first, color_attachment, color_pass, fullscreen_pipeline, render_target,
     stencil_attachment,

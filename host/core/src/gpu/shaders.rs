@@ -323,12 +323,37 @@ impl ShaderLibrary {
         Self::module_from(device, name, self.compose_source(name, text)?)
     }
 
+    /// Composes `name` (from WGSL `text` where given, else the library's file), validates it
+    /// and creates its module, with naga's IR and analysis for reflection.
+    pub fn load(
+        &self,
+        device: &wgpu::Device,
+        name: &str,
+        text: Option<&str>,
+    ) -> Result<LoadedShader, ShaderError> {
+        let composed = match text {
+            Some(text) => self.compose_source(name, text)?,
+            None => self.compose(name)?,
+        };
+        let (composed, ir, info) = Self::validated(composed)?;
+        let module = Self::create_validated(device, name, composed)?;
+        Ok(LoadedShader { module, ir, info })
+    }
+
     fn module_from(
         device: &wgpu::Device,
         name: &str,
         composed: ComposedShader,
     ) -> Result<wgpu::ShaderModule, ShaderError> {
         let (composed, _, _) = Self::validated(composed)?;
+        Self::create_validated(device, name, composed)
+    }
+
+    fn create_validated(
+        device: &wgpu::Device,
+        name: &str,
+        composed: ComposedShader,
+    ) -> Result<wgpu::ShaderModule, ShaderError> {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),
@@ -342,6 +367,13 @@ impl ShaderLibrary {
             }),
         }
     }
+}
+
+/// A shader module with naga's IR and analysis of it (which globals each entry point uses).
+pub struct LoadedShader {
+    pub module: wgpu::ShaderModule,
+    pub ir: naga::Module,
+    pub info: naga::valid::ModuleInfo,
 }
 
 /// Appends the `/`-separated paths of `.wgsl` files under `dir`, relative to `root`.

@@ -1,16 +1,17 @@
 //! A full-screen pass per light with per-light uniforms: the shape of most screen-space
 //! visibility passes (shadow-map lookups, back-facing tests, screen-space filters).
 
-use super::{UniformSlots, UniformValue, slot_fullscreen_pipeline};
+use super::stage::{SharedGroup, Stage, StageBindGroup, StageBuilder};
+use super::{UniformSlots, UniformValue};
 use crate::gpu::PassRecorder;
 use crate::technique::{RenderContext, TechniqueError};
 
-/// A full-screen fragment shader run once per light into that light's visibility slot, with
-/// the frame (group 0), the G-buffer (group 1), one `T` per light (group 2, binding 0) and the
-/// technique's own `groups` from 3 on. The fragment returns the light's visibility in every
-/// channel (or discards to leave it lit).
+/// A full-screen fragment shader run once per light into that light's visibility slot (a
+/// full-screen [`Stage`]), with one `T` per light (the uniform of type `T` it declares) and
+/// the technique's own and shared groups. The fragment returns the light's visibility in
+/// every channel (or discards to leave it lit).
 pub struct FullscreenLightPass<T: UniformValue> {
-    pipeline: wgpu::RenderPipeline,
+    stage: Stage,
     uniforms: UniformSlots<T>,
 }
 
@@ -21,16 +22,15 @@ pub fn light_pass_name(base: &str, light: usize) -> String {
 }
 
 impl<T: UniformValue> FullscreenLightPass<T> {
-    /// Builds the pipeline from fragment `entry` of library shader `shader` (for example
-    /// `"backfacing/mask.wgsl"`), with extra bind group layouts `groups` (3, 4, ...).
+    /// Builds the pass from fragment `entry` of library shader `shader` (for example
+    /// `"backfacing/mask.wgsl"`), with `shared` groups besides the host's.
     pub fn new(
         ctx: &RenderContext<'_>,
         shader: &str,
         entry: &str,
-        groups: &[&wgpu::BindGroupLayout],
+        shared: &[&dyn SharedGroup],
     ) -> Result<FullscreenLightPass<T>, TechniqueError> {
-        let module = ctx.shaders.create_module(&ctx.gpu.device, shader)?;
-        Ok(Self::with_module(ctx, shader, &module, entry, groups))
+        Self::build(ctx, Stage::fullscreen(shader, entry), shader, shared)
     }
 
     /// As [`Self::new`] with WGSL `text` (its `#import`s resolved from the library) instead of
@@ -40,25 +40,26 @@ impl<T: UniformValue> FullscreenLightPass<T> {
         label: &str,
         text: &str,
         entry: &str,
-        groups: &[&wgpu::BindGroupLayout],
+        shared: &[&dyn SharedGroup],
     ) -> Result<FullscreenLightPass<T>, TechniqueError> {
-        let module = (ctx.shaders).create_module_from_source(&ctx.gpu.device, label, text)?;
-        Ok(Self::with_module(ctx, label, &module, entry, groups))
+        Self::build(
+            ctx,
+            Stage::fullscreen(label, entry).text(text),
+            label,
+            shared,
+        )
     }
 
-    fn with_module(
+    fn build(
         ctx: &RenderContext<'_>,
+        stage: StageBuilder<'_>,
         label: &str,
-        module: &wgpu::ShaderModule,
-        entry: &str,
-        groups: &[&wgpu::BindGroupLayout],
-    ) -> FullscreenLightPass<T> {
+        shared: &[&dyn SharedGroup],
+    ) -> Result<FullscreenLightPass<T>, TechniqueError> {
         let stages = wgpu::ShaderStages::FRAGMENT;
         let uniforms = UniformSlots::new(ctx.gpu, label, ctx.lights.len(), stages);
-        let mut layouts = vec![uniforms.layout()];
-        layouts.extend_from_slice(groups);
-        let pipeline = slot_fullscreen_pipeline(ctx, label, module, entry, &layouts);
-        FullscreenLightPass { pipeline, uniforms }
+        let stage = stage.shared(&[&uniforms.at(0)]).shared(shared).build(ctx)?;
+        Ok(FullscreenLightPass { stage, uniforms })
     }
 
     /// The pass in `slot`, built there first if it is empty (a technique's `prepare` keeps
@@ -75,6 +76,11 @@ impl<T: UniformValue> FullscreenLightPass<T> {
         Ok(slot.as_mut().expect("just filled"))
     }
 
+    /// The stage, for binding its own groups ([`Stage::bind`]).
+    pub fn stage(&self) -> &Stage {
+        &self.stage
+    }
+
     /// Records one pass per light, named `"{base}: light {l}"` ([`light_pass_name`]), with
     /// the uniform `per_light(light)`. Once per frame (see [`UniformSlots::write`]).
     pub fn record(
@@ -83,29 +89,31 @@ impl<T: UniformValue> FullscreenLightPass<T> {
         recorder: &mut PassRecorder<'_>,
         base: &str,
         per_light: impl Fn(usize) -> T,
-    ) {
-        self.record_with(ctx, recorder, base, per_light, |_, _| ());
+    ) -> Result<(), TechniqueError> {
+        self.record_with(ctx, recorder, base, per_light, &[], &[])
     }
 
-    /// As [`Self::record`], with `bind(light, pass)` setting the technique's own groups.
+    /// As [`Self::record`], with the stage's `own` bind groups and `shared` groups.
     pub fn record_with(
         &mut self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         base: &str,
         per_light: impl Fn(usize) -> T,
-        bind: impl Fn(usize, &mut wgpu::RenderPass<'_>),
-    ) {
+        own: &[&StageBindGroup],
+        shared: &[&dyn SharedGroup],
+    ) -> Result<(), TechniqueError> {
         let values: Vec<T> = (0..ctx.lights.len()).map(per_light).collect();
         self.uniforms.write(ctx.gpu, &values);
         for light in 0..values.len() {
             let name = light_pass_name(base, light);
             let mut pass = ctx.light_pass(recorder, &name, light, None);
-            pass.set_pipeline(&self.pipeline);
-            let offset = self.uniforms.offset(light);
-            pass.set_bind_group(2, self.uniforms.bind_group(), &[offset]);
-            bind(light, &mut pass);
+            let slot = self.uniforms.at(light);
+            let mut all: Vec<&dyn SharedGroup> = vec![&slot];
+            all.extend_from_slice(shared);
+            self.stage.set_on(ctx, &mut pass, own, &all)?;
             pass.draw(0..3, 0..1);
         }
+        Ok(())
     }
 }

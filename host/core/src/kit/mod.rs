@@ -9,27 +9,26 @@
 //! - [`lazy`]: GPU state built at the first `prepare`, with the not-prepared error once.
 //! - [`light_pass`]: a full-screen fragment shader run once per light into its slot, with
 //!   per-light uniforms.
-//! - [`compute`]: a compute pass with the technique's own group, after the host's groups or
-//!   alone, its layout and workgroup size read from the WGSL ([`reflect`]) and its resources
-//!   bound by name.
+//! - [`stage`]: the one way to write a pass: a compute, full-screen or raster pipeline whose
+//!   groups, layouts and workgroup size are read from the WGSL ([`reflect`]), its own
+//!   resources bound by name and shared groups recognised by what they declare.
 //!
 //! Shader modules from inline WGSL with `#import`s come from
 //! [`ShaderLibrary::create_module_from_source`](crate::ShaderLibrary::create_module_from_source).
 
-pub mod compute;
 pub mod layouts;
 pub mod lazy;
 pub mod light_pass;
 pub mod reflect;
 pub mod slot;
+pub mod stage;
 pub mod uniforms;
 
-pub use compute::{ComputeStage, StageGroups};
 pub use layouts::{
-    SlotPipeline, bind_group, bind_group_layout, diagnostics_pipelines, pipeline_layout, sampler,
-    slot_fullscreen_pipeline, storage, texture, uniform,
+    bind_group, bind_group_layout, pipeline_layout, sampler, storage, texture, uniform,
 };
 pub use lazy::LazyGpu;
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use slot::{LightSlot, slot_target};
-pub use uniforms::{UniformSlots, UniformValue};
+pub use stage::{NamedGroup, SharedGroup, Stage, StageBindGroup, StageBuilder};
+pub use uniforms::{UniformSlot, UniformSlots, UniformValue};

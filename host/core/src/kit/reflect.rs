@@ -1,5 +1,5 @@
-//! A compute entry point's bindings and workgroup size, read from its WGSL (naga's IR), so a
-//! stage's resources are declared once, in the shader, and bound by their variable names.
+//! The bindings and workgroup size of a stage's entry points, read from its WGSL (naga's IR),
+//! so a stage's resources are declared once, in the shader, and bound by their variable names.
 
 use naga::valid::ModuleInfo;
 use naga::{AddressSpace, ImageClass, ImageDimension, ScalarKind, StorageAccess, TypeInner};
@@ -9,47 +9,72 @@ use naga::{AddressSpace, ImageClass, ImageDimension, ScalarKind, StorageAccess, 
 pub struct ReflectedBinding {
     /// The WGSL variable name.
     pub name: String,
-    /// The layout entry the declaration implies (compute visibility).
+    /// The name of the variable's type where it is a named type (a struct).
+    pub type_name: Option<String>,
+    /// The layout entry the declaration implies, visible to the stages that use it.
     pub entry: wgpu::BindGroupLayoutEntry,
 }
 
-/// What a compute entry point uses of one bind group, and its workgroup size.
-#[derive(Debug, Clone)]
-pub struct ReflectedStage {
-    /// The group's resources that the entry point uses, by binding number.
-    pub bindings: Vec<ReflectedBinding>,
-    /// `@workgroup_size` of the entry point.
-    pub workgroup_size: [u32; 3],
+/// What a set of entry points of one module uses of its bind groups.
+#[derive(Debug, Clone, Default)]
+pub struct ReflectedShader {
+    /// The used resources of each group, by group index and then binding number.
+    pub groups: std::collections::BTreeMap<u32, Vec<ReflectedBinding>>,
+    /// `@workgroup_size` of the compute entry point, if one of them is.
+    pub workgroup_size: Option<[u32; 3]>,
 }
 
-/// Reads the bindings of `group` used by compute entry point `entry` of `module`. Float
-/// textures are filterable where the entry samples them with a filtering sampler (so
-/// unfilterable formats can be bound to the ones it only loads).
-pub fn reflect_compute(
+impl ReflectedShader {
+    /// The bindings of `group` (none where the entry points use none of it).
+    pub fn group(&self, group: u32) -> &[ReflectedBinding] {
+        self.groups.get(&group).map_or(&[], Vec::as_slice)
+    }
+}
+
+/// Reads the bindings used by entry points `entries` of `module` (their visibility the union
+/// of the stages that use them). Float textures are filterable where an entry samples them
+/// with a filtering sampler (so unfilterable formats can be bound to the ones only loaded).
+pub fn reflect_entries(
     module: &naga::Module,
     info: &ModuleInfo,
-    entry: &str,
-    group: u32,
-) -> Result<ReflectedStage, String> {
-    let (index, point) = module
-        .entry_points
-        .iter()
-        .enumerate()
-        .find(|(_, e)| e.name == entry && e.stage == naga::ShaderStage::Compute)
-        .ok_or_else(|| format!("no compute entry point `{entry}`"))?;
-    if point.workgroup_size_overrides.is_some() {
-        return Err(format!(
-            "`{entry}`: a workgroup size set by overrides cannot be read from the shader"
-        ));
+    entries: &[&str],
+) -> Result<ReflectedShader, String> {
+    let mut out = ReflectedShader::default();
+    for &entry in entries {
+        let (index, point) = module
+            .entry_points
+            .iter()
+            .enumerate()
+            .find(|(_, e)| e.name == entry)
+            .ok_or_else(|| format!("no entry point `{entry}`"))?;
+        if point.stage == naga::ShaderStage::Compute {
+            if point.workgroup_size_overrides.is_some() {
+                return Err(format!(
+                    "`{entry}`: a workgroup size set by overrides cannot be read from the shader"
+                ));
+            }
+            out.workgroup_size = Some(point.workgroup_size);
+        }
+        let visibility = match point.stage {
+            naga::ShaderStage::Vertex => wgpu::ShaderStages::VERTEX,
+            naga::ShaderStage::Fragment => wgpu::ShaderStages::FRAGMENT,
+            _ => wgpu::ShaderStages::COMPUTE,
+        };
+        add_entry_uses(module, info.get_entry_point(index), visibility, &mut out)?;
     }
-    let uses = info.get_entry_point(index);
-    let used: Vec<_> = module
-        .global_variables
-        .iter()
-        .filter(|(handle, var)| {
-            !uses[*handle].is_empty() && var.binding.as_ref().is_some_and(|b| b.group == group)
-        })
-        .collect();
+    for bindings in out.groups.values_mut() {
+        bindings.sort_by_key(|b| b.entry.binding);
+    }
+    Ok(out)
+}
+
+/// Adds the bindings one entry point uses to `out`, or its stage to their visibility.
+fn add_entry_uses(
+    module: &naga::Module,
+    uses: &naga::valid::FunctionInfo,
+    visibility: wgpu::ShaderStages,
+    out: &mut ReflectedShader,
+) -> Result<(), String> {
     // A texture is filterable where the entry samples it with a filtering sampler.
     let filtered = |image| {
         uses.sampling_set.iter().any(|key| {
@@ -60,30 +85,47 @@ pub fn reflect_compute(
                 )
         })
     };
-    let mut bindings = used
-        .iter()
-        .map(|&(handle, var)| {
-            let binding = var.binding.as_ref().expect("filtered on bindings").binding;
-            let name = var
-                .name
-                .clone()
-                .unwrap_or_else(|| format!("@binding({binding})"));
-            let ty = binding_type(module, var, filtered(handle))
-                .map_err(|e| format!("`{name}`: {e}"))?;
-            let entry = wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty,
-                count: None,
-            };
-            Ok(ReflectedBinding { name, entry })
-        })
-        .collect::<Result<Vec<_>, String>>()?;
-    bindings.sort_by_key(|b| b.entry.binding);
-    Ok(ReflectedStage {
-        bindings,
-        workgroup_size: point.workgroup_size,
-    })
+    for (handle, var) in module.global_variables.iter() {
+        let Some(binding) = var.binding.as_ref().filter(|_| !uses[handle].is_empty()) else {
+            continue;
+        };
+        let name = (var.name.clone()).unwrap_or_else(|| format!("@binding({})", binding.binding));
+        let ty =
+            binding_type(module, var, filtered(handle)).map_err(|e| format!("`{name}`: {e}"))?;
+        let group = out.groups.entry(binding.group).or_default();
+        match group
+            .iter_mut()
+            .find(|b| b.entry.binding == binding.binding)
+        {
+            Some(known) => {
+                known.entry.visibility |= visibility;
+                if let (
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: known },
+                        ..
+                    },
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable },
+                        ..
+                    },
+                ) = (&mut known.entry.ty, ty)
+                {
+                    *known |= filterable;
+                }
+            }
+            None => group.push(ReflectedBinding {
+                name,
+                type_name: module.types[var.ty].name.clone(),
+                entry: wgpu::BindGroupLayoutEntry {
+                    binding: binding.binding,
+                    visibility,
+                    ty,
+                    count: None,
+                },
+            }),
+        }
+    }
+    Ok(())
 }
 
 /// The layout binding type of one global variable.
@@ -218,30 +260,29 @@ fn storage_format(format: naga::StorageFormat) -> wgpu::TextureFormat {
     }
 }
 
-/// Checks `given` (name, resource) pairs against `stage`'s bindings and orders them as
+/// Checks `given` (name, resource) pairs against a group's `bindings` and orders them as
 /// bind-group entries: every binding given exactly once, no unknown names, and buffers,
 /// textures and samplers where the shader declares them.
 pub fn match_resources<'a>(
-    stage: &ReflectedStage,
+    bindings: &[ReflectedBinding],
     given: &[(&str, wgpu::BindingResource<'a>)],
 ) -> Result<Vec<wgpu::BindGroupEntry<'a>>, String> {
     let names = || {
-        let all: Vec<&str> = stage.bindings.iter().map(|b| b.name.as_str()).collect();
+        let all: Vec<&str> = bindings.iter().map(|b| b.name.as_str()).collect();
         all.join(", ")
     };
     for (k, (name, _)) in given.iter().enumerate() {
         if given[..k].iter().any(|(n, _)| n == name) {
             return Err(format!("`{name}` is given twice"));
         }
-        if !stage.bindings.iter().any(|b| b.name == *name) {
+        if !bindings.iter().any(|b| b.name == *name) {
             return Err(format!(
                 "`{name}` is not a binding the shader uses (it uses: {})",
                 names()
             ));
         }
     }
-    stage
-        .bindings
+    bindings
         .iter()
         .map(|b| {
             let resource = given
@@ -285,6 +326,19 @@ fn kind_name(ty: &wgpu::BindingType) -> &'static str {
     }
 }
 
+/// The names of the variables `module` declares in `group`, by binding number: what a
+/// [`super::SharedGroup`]'s list of names is checked against.
+pub fn declared_variables(module: &naga::Module, group: u32) -> Vec<String> {
+    let mut declared: Vec<(u32, String)> = (module.global_variables.iter())
+        .filter_map(|(_, var)| {
+            let binding = var.binding.as_ref().filter(|b| b.group == group)?;
+            Some((binding.binding, var.name.clone().unwrap_or_default()))
+        })
+        .collect();
+    declared.sort();
+    declared.into_iter().map(|(_, name)| name).collect()
+}
+
 /// Workgroups that cover `extent` invocations with `size`-invocation groups.
 pub fn workgroups_over(extent: [u32; 3], size: [u32; 3]) -> [u32; 3] {
     std::array::from_fn(|k| extent[k].div_ceil(size[k].max(1)))
@@ -302,6 +356,18 @@ struct Data { n: u32 }
 @group(0) @binding(3) var image: texture_storage_3d<rgba16float, write>;
 @group(0) @binding(4) var unused: texture_2d<f32>;
 @group(1) @binding(0) var<uniform> other: Data;
+@group(1) @binding(1) var picture: texture_2d<f32>;
+@group(1) @binding(2) var linear_sampler: sampler;
+
+@vertex
+fn vs_main() -> @builtin(position) vec4<f32> {
+    return vec4<f32>(f32(other.n));
+}
+
+@fragment
+fn fs_main() -> @location(0) vec4<f32> {
+    return textureSample(picture, linear_sampler, vec2<f32>(0.5)) + vec4<f32>(f32(other.n));
+}
 
 @compute @workgroup_size(4, 2, 1)
 fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -310,8 +376,8 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
-    /// Entry `entry` of [`SOURCE`], group 0, reflected.
-    fn reflect(entry: &str) -> Result<ReflectedStage, String> {
+    /// Entry points `entries` of [`SOURCE`], reflected.
+    fn reflect(entries: &[&str]) -> Result<ReflectedShader, String> {
         let module = naga::front::wgsl::parse_str(SOURCE).unwrap();
         let info = naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
@@ -319,24 +385,24 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
         )
         .validate(&module)
         .unwrap();
-        reflect_compute(&module, &info, entry, 0)
+        reflect_entries(&module, &info, entries)
     }
 
-    fn stage() -> ReflectedStage {
-        reflect("cs_main").unwrap()
+    /// `cs_main`'s group 0.
+    fn stage() -> Vec<ReflectedBinding> {
+        reflect(&["cs_main"]).unwrap().group(0).to_vec()
     }
 
     #[test]
     fn bindings_and_workgroup_size_come_from_the_shader() {
+        let reflected = reflect(&["cs_main"]).unwrap();
+        assert_eq!(reflected.workgroup_size, Some([4, 2, 1]));
+        assert_eq!(reflected.groups.len(), 1, "group 1 is not used");
         let stage = stage();
-        assert_eq!(stage.workgroup_size, [4, 2, 1]);
-        let names: Vec<_> = stage.bindings.iter().map(|b| b.name.as_str()).collect();
-        assert_eq!(
-            names,
-            ["data", "out", "layers", "image"],
-            "unused and group 1 left out"
-        );
-        let ty = |k: usize| stage.bindings[k].entry.ty;
+        let names: Vec<_> = stage.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(names, ["data", "out", "layers", "image"], "unused left out");
+        assert_eq!(stage[0].type_name.as_deref(), Some("Data"));
+        let ty = |k: usize| stage[k].entry.ty;
         assert_eq!(
             ty(0),
             wgpu::BindingType::Buffer {
@@ -369,10 +435,32 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         );
         assert!(
-            reflect("cs_missing")
+            reflect(&["cs_missing"])
                 .unwrap_err()
-                .contains("no compute entry point")
+                .contains("no entry point `cs_missing`")
         );
+    }
+
+    #[test]
+    fn render_entries_join_their_visibility_and_sampled_textures_filter() {
+        let reflected = reflect(&["vs_main", "fs_main"]).unwrap();
+        assert_eq!(reflected.workgroup_size, None);
+        let group = reflected.group(1);
+        let names: Vec<_> = group.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(names, ["other", "picture", "linear_sampler"]);
+        assert_eq!(
+            group[0].entry.visibility,
+            wgpu::ShaderStages::VERTEX_FRAGMENT
+        );
+        assert_eq!(group[1].entry.visibility, wgpu::ShaderStages::FRAGMENT);
+        assert!(matches!(
+            group[1].entry.ty,
+            wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                ..
+            }
+        ));
+        assert!(reflected.group(0).is_empty());
     }
 
     #[test]

@@ -2,24 +2,19 @@
 
 use std::marker::PhantomData;
 
-use bytemuck::Pod;
-
 use crate::GpuContext;
+use crate::kit::reflect::ReflectedBinding;
+use crate::kit::stage::SharedGroup;
 
-/// A value [`UniformSlots`] holds: a [`gpu_struct!`](crate::gpu_struct) type (laid out by
-/// WGSL's rules) or a hand-laid-out [`Pod`] type (its bytes as they are).
+/// A value [`UniformSlots`] holds: a [`gpu_struct!`](crate::gpu_struct) type, laid out by
+/// WGSL's rules.
 pub trait UniformValue {
     /// Its size in bytes as the shader reads it.
     const SIZE: usize;
+    /// The WGSL struct's name, by which stages recognise the variables it fills.
+    const WGSL_TYPE: &'static str;
     /// Writes it at the start of `out` (at least [`Self::SIZE`] bytes).
     fn write_bytes(&self, out: &mut [u8]);
-}
-
-impl<T: Pod> UniformValue for T {
-    const SIZE: usize = size_of::<T>();
-    fn write_bytes(&self, out: &mut [u8]) {
-        out[..size_of::<T>()].copy_from_slice(bytemuck::bytes_of(self));
-    }
 }
 
 /// `count` values of `T`, each at a multiple of the device's
@@ -148,5 +143,42 @@ impl<T: UniformValue> UniformSlots<T> {
     /// The buffer, for the memory table.
     pub fn buffer(&self) -> &wgpu::Buffer {
         &self.buffer
+    }
+}
+
+impl<T: UniformValue> UniformSlots<T> {
+    /// Slot `index`, as the group of stages whose shader reads one `T` as a uniform.
+    pub fn at(&self, index: usize) -> UniformSlot<'_, T> {
+        UniformSlot {
+            slots: self,
+            offset: [self.offset(index)],
+        }
+    }
+}
+
+/// One slot of [`UniformSlots`] (from [`UniformSlots::at`]): a [`SharedGroup`] that declares
+/// a uniform of `T`'s WGSL type at binding 0.
+pub struct UniformSlot<'a, T: UniformValue> {
+    slots: &'a UniformSlots<T>,
+    offset: [u32; 1],
+}
+
+impl<T: UniformValue> SharedGroup for UniformSlot<'_, T> {
+    fn declares(&self, binding: &ReflectedBinding) -> bool {
+        binding.entry.binding == 0
+            && binding.type_name.as_deref() == Some(T::WGSL_TYPE)
+            && matches!(
+                binding.entry.ty,
+                wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    ..
+                }
+            )
+    }
+    fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.slots.layout
+    }
+    fn bound(&self) -> Option<(&wgpu::BindGroup, &[u32])> {
+        Some((&self.slots.bind_group, &self.offset))
     }
 }

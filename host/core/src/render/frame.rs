@@ -138,6 +138,9 @@ pub struct FrameBindings {
     pub frames: u32,
 }
 
+/// The variables of the frame group as `common/frame.wgsl` declares them (a kit test checks).
+pub const FRAME_VARIABLES: &[&str] = &["camera", "lights", "objects"];
+
 /// Layout of bind group 0 (`common/frame.wgsl`).
 pub fn frame_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let storage = |binding| wgpu::BindGroupLayoutEntry {

@@ -47,6 +47,10 @@ pub struct GBuffer {
     pub bind_group: wgpu::BindGroup,
 }
 
+/// The variables of the G-buffer group as `common/gbuffer.wgsl` declares them (a kit test
+/// checks).
+pub const GBUFFER_VARIABLES: &[&str] = &["gbuffer_view_depth", "gbuffer_normal", "gbuffer_albedo"];
+
 /// Layout of bind group 1.
 pub fn gbuffer_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {

@@ -20,6 +20,11 @@ crate::gpu_struct! {
     }
 }
 
+/// The variables of the materials group as `common/materials.wgsl` declares them (a kit test
+/// checks).
+pub const MATERIAL_VARIABLES: &[&str] =
+    &["object_materials", "material_textures", "material_sampler"];
+
 /// The materials' bind group and its layout, built once per scene.
 pub struct MaterialBindings {
     pub layout: wgpu::BindGroupLayout,
