@@ -12,7 +12,7 @@
 pub mod matrix;
 
 use zoo_host::glam::{Mat4, Vec4};
-use zoo_host::gpu::{GpuType, gpu_bytes};
+use zoo_host::kit::{SharedGroup, Stage, UniformSlots, slot_target};
 use zoo_host::params::TechniqueParams;
 use zoo_host::render::SceneBuffers;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
@@ -54,16 +54,14 @@ zoo_host::gpu_struct! {
     }
 }
 
-/// Uniform slots are this far apart (the dynamic-offset alignment).
-const SLOT: u64 = 256;
 const PLANE_IDS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
 
 /// One receiver plane to draw for one light.
 struct PlaneDraw {
     /// Index into the scene's receivers (stencil id = index + 1).
     receiver: usize,
-    /// Byte offset of its [`Projection`] in the uniform buffer.
-    offset: u32,
+    /// Its [`Projection`]'s slot.
+    slot: usize,
 }
 
 /// The passes of one light.
@@ -73,152 +71,108 @@ struct LightPass {
 }
 
 struct Gpu {
-    mark: wgpu::RenderPipeline,
+    /// Marks the receiver's pixels in the stencil and the plane ids.
+    mark: Stage,
     /// Writes shadows into the light's slot (`kit::slot_target`).
-    shadow: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    shadow: Stage,
+    projections: UniformSlots<Projection>,
 }
 
 /// The planar technique.
 pub struct Planar {
     params: PlanarParams,
     gpu: Option<Gpu>,
-    uniforms: Option<(wgpu::Buffer, wgpu::BindGroup)>,
     plane_ids: Option<(wgpu::Texture, wgpu::TextureView)>,
     lights: Vec<LightPass>,
 }
 
+/// Both faces of every triangle: a caster's projection may face either way.
+const BOTH_FACES: wgpu::PrimitiveState = wgpu::PrimitiveState {
+    topology: wgpu::PrimitiveTopology::TriangleList,
+    strip_index_format: None,
+    front_face: wgpu::FrontFace::Ccw,
+    cull_mode: None,
+    unclipped_depth: false,
+    polygon_mode: wgpu::PolygonMode::Fill,
+    conservative: false,
+};
+
+/// The G-buffer's depth-stencil, not written, tested with `depth_compare` and `stencil`.
+fn depth_stencil(
+    depth_compare: wgpu::CompareFunction,
+    (compare, pass_op): (wgpu::CompareFunction, wgpu::StencilOperation),
+    bias: wgpu::DepthBiasState,
+) -> wgpu::DepthStencilState {
+    let face = wgpu::StencilFaceState {
+        compare,
+        fail_op: wgpu::StencilOperation::Keep,
+        depth_fail_op: wgpu::StencilOperation::Keep,
+        pass_op,
+    };
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(depth_compare),
+        stencil: wgpu::StencilState {
+            front: face,
+            back: face,
+            read_mask: 0xff,
+            write_mask: 0xff,
+        },
+        bias,
+    }
+}
+
+/// The plane-ids target, written (`RED`) or not.
+fn plane_ids_target(write_mask: wgpu::ColorWrites) -> Option<wgpu::ColorTargetState> {
+    Some(wgpu::ColorTargetState {
+        format: PLANE_IDS_FORMAT,
+        blend: None,
+        write_mask,
+    })
+}
+
 impl Planar {
-    fn create_pipelines(&self, ctx: &RenderContext<'_>) -> Result<Gpu, TechniqueError> {
-        let device = &ctx.gpu.device;
-        let mark_module = ctx.shaders.create_module(device, "planar/mark.wgsl")?;
-        let shadow_module = ctx.shaders.create_module(device, "planar/shadow.wgsl")?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("planar projection layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(Projection::SIZE as u64),
-                },
-                count: None,
-            }],
+    fn create_stages(&self, ctx: &RenderContext<'_>) -> Result<Gpu, TechniqueError> {
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let projections = UniformSlots::new(ctx.gpu, "planar projections", 1, stages);
+        let slot = projections.at(0);
+        let offset = self.params.depth_offset;
+        // Toward the camera, so the plane wins the depth test against its own depth.
+        let bias = wgpu::DepthBiasState {
+            constant: -(offset as i32),
+            slope_scale: if offset > 0 { -2.0 } else { 0.0 },
+            clamp: 0.0,
+        };
+        let replace = (wgpu::CompareFunction::Always, wgpu::StencilOperation::Replace);
+        let no_visibility = Some(wgpu::ColorTargetState {
+            format: VISIBILITY_FORMAT,
+            blend: None,
+            write_mask: wgpu::ColorWrites::empty(),
         });
-        // Marking reads the G-buffer; the shadow pass reads the casters' materials instead.
-        let pipeline_layout = |label, group_1| {
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: &[Some(&ctx.frame.layout), Some(group_1), Some(&layout)],
-                immediate_size: 0,
-            })
-        };
-        let mark_layout = pipeline_layout("planar mark pipeline layout", &ctx.gbuffer.layout);
-        let shadow_layout = pipeline_layout(
-            "planar shadow pipeline layout",
-            &ctx.scene_buffers.materials.layout,
-        );
-        let stencil_face = |compare, pass_op| wgpu::StencilFaceState {
-            compare,
-            fail_op: wgpu::StencilOperation::Keep,
-            depth_fail_op: wgpu::StencilOperation::Keep,
-            pass_op,
-        };
-        let pipeline = |label: &str,
-                        (module, pipeline_layout): (&wgpu::ShaderModule, &wgpu::PipelineLayout),
-                        vertex: &str,
-                        fragment: &str,
-                        visibility: wgpu::ColorTargetState,
-                        plane_ids: wgpu::ColorWrites,
-                        depth_compare,
-                        stencil: wgpu::StencilFaceState,
-                        bias: wgpu::DepthBiasState| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some(vertex),
-                    compilation_options: Default::default(),
-                    buffers: &SceneBuffers::VERTEX_LAYOUTS,
-                },
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(false),
-                    depth_compare: Some(depth_compare),
-                    stencil: wgpu::StencilState {
-                        front: stencil,
-                        back: stencil,
-                        read_mask: 0xff,
-                        write_mask: 0xff,
-                    },
-                    bias,
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some(fragment),
-                    compilation_options: Default::default(),
-                    targets: &[
-                        Some(visibility),
-                        Some(wgpu::ColorTargetState {
-                            format: PLANE_IDS_FORMAT,
-                            blend: None,
-                            write_mask: plane_ids,
-                        }),
-                    ],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let mark = pipeline(
-            "planar mark plane pipeline",
-            (&mark_module, &mark_layout),
-            "vs_mark",
-            "fs_mark",
-            wgpu::ColorTargetState {
-                format: VISIBILITY_FORMAT,
-                blend: None,
-                write_mask: wgpu::ColorWrites::empty(),
-            },
-            wgpu::ColorWrites::RED,
-            wgpu::CompareFunction::LessEqual,
-            stencil_face(
-                wgpu::CompareFunction::Always,
-                wgpu::StencilOperation::Replace,
-            ),
-            wgpu::DepthBiasState {
-                constant: -(self.params.depth_offset as i32),
-                slope_scale: if self.params.depth_offset > 0 {
-                    -2.0
-                } else {
-                    0.0
-                },
-                clamp: 0.0,
-            },
-        );
-        let shadow = pipeline(
-            "planar shadow pipeline",
-            (&shadow_module, &shadow_layout),
-            "vs_shadow",
-            "fs_shadow",
-            zoo_host::kit::slot_target(),
-            wgpu::ColorWrites::empty(),
-            wgpu::CompareFunction::Always,
-            // Zero after the first write: each pixel is shadowed once per plane.
-            stencil_face(wgpu::CompareFunction::Equal, wgpu::StencilOperation::Zero),
-            Default::default(),
-        );
+        let mark = Stage::render("planar/mark.wgsl", "vs_mark")
+            .fragment("fs_mark")
+            .vertex_buffers(&SceneBuffers::VERTEX_LAYOUTS)
+            .primitive(BOTH_FACES)
+            .depth_stencil(depth_stencil(wgpu::CompareFunction::LessEqual, replace, bias))
+            .targets(&[no_visibility, plane_ids_target(wgpu::ColorWrites::RED)])
+            .shared(&[&slot])
+            .build(ctx)?;
+        // Zero after the first write: each pixel is shadowed once per plane.
+        let once = (wgpu::CompareFunction::Equal, wgpu::StencilOperation::Zero);
+        let always = wgpu::CompareFunction::Always;
+        let shadow = Stage::render("planar/shadow.wgsl", "vs_shadow")
+            .fragment("fs_shadow")
+            .vertex_buffers(&SceneBuffers::VERTEX_LAYOUTS)
+            .primitive(BOTH_FACES)
+            .depth_stencil(depth_stencil(always, once, Default::default()))
+            .targets(&[Some(slot_target()), plane_ids_target(wgpu::ColorWrites::empty())])
+            .shared(&[&slot])
+            .build(ctx)?;
         Ok(Gpu {
             mark,
             shadow,
-            layout,
+            projections,
         })
     }
 
@@ -240,7 +194,7 @@ impl Planar {
                 }
                 planes.push(PlaneDraw {
                     receiver: r,
-                    offset: (data.len() as u64 * SLOT) as u32,
+                    slot: data.len(),
                 });
                 data.push(Projection {
                     shadow_matrix: shadow_matrix(receiver.plane, l),
@@ -262,32 +216,8 @@ impl Planar {
                 scene.receivers.len()
             )));
         }
-        let device = &ctx.gpu.device;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("planar projections"),
-            size: (data.len().max(1) as u64) * SLOT,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        for (i, projection) in data.iter().enumerate() {
-            ctx.gpu
-                .queue
-                .write_buffer(&buffer, i as u64 * SLOT, &gpu_bytes(&[*projection]));
-        }
-        let layout = &self.gpu.as_ref().expect("pipelines exist").layout;
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("planar projections bind group"),
-            layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(Projection::SIZE as u64),
-                }),
-            }],
-        });
-        self.uniforms = Some((buffer, bind_group));
+        let gpu = self.gpu.as_mut().ok_or_else(TechniqueError::not_prepared)?;
+        gpu.projections.write(ctx.gpu, &data);
         Ok(())
     }
 }
@@ -302,21 +232,23 @@ impl ShadowTechnique for Planar {
         if let Some((texture, _)) = &self.plane_ids {
             out.push(ResourceInfo::texture("plane ids", texture, true));
         }
-        if let Some((buffer, _)) = &self.uniforms {
+        if let Some(gpu) = &self.gpu {
+            let slots = format!("Projection ({}-byte slots)", gpu.projections.stride());
             out.push(ResourceInfo::buffer(
                 "projections",
-                buffer,
-                "Projection (256-byte slots)",
+                gpu.projections.buffer(),
+                &slots,
             ));
         }
         out
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError> {
-        if self.gpu.is_none() {
-            self.gpu = Some(self.create_pipelines(ctx)?);
+        let rebuilt = self.gpu.is_none();
+        if rebuilt {
+            self.gpu = Some(self.create_stages(ctx)?);
         }
-        if changes.scene || changes.lights || changes.params || self.uniforms.is_none() {
+        if changes.scene || changes.lights || changes.params || rebuilt {
             self.plan(ctx)?;
         }
         if changes.resolution || self.plane_ids.is_none() {
@@ -336,12 +268,8 @@ impl ShadowTechnique for Planar {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> Result<(), TechniqueError> {
-        let (Some(gpu), Some((_, uniforms)), Some((_, plane_ids))) =
-            (&self.gpu, &self.uniforms, &self.plane_ids)
-        else {
-            return Err(TechniqueError::Other(
-                "planar: record before prepare".into(),
-            ));
+        let (Some(gpu), Some((_, plane_ids))) = (&self.gpu, &self.plane_ids) else {
+            return Err(TechniqueError::not_prepared());
         };
         let scene = ctx.scene;
         for (k, light_pass) in self.lights.iter().enumerate() {
@@ -357,13 +285,11 @@ impl ShadowTechnique for Planar {
             let buffers = ctx.scene_buffers;
             for plane in &light_pass.planes {
                 let receiver = &scene.receivers[plane.receiver];
-                pass.set_bind_group(2, uniforms, &[plane.offset]);
+                let projection = [&gpu.projections.at(plane.slot) as &dyn SharedGroup];
                 pass.set_stencil_reference(plane.receiver as u32 + 1);
-                pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
-                pass.set_pipeline(&gpu.mark);
+                gpu.mark.set_on(ctx, &mut pass, &[], &projection)?;
                 buffers.draw_objects_where(&mut pass, scene, |i, _| i == receiver.object);
-                pass.set_bind_group(1, &buffers.materials.bind_group, &[]);
-                pass.set_pipeline(&gpu.shadow);
+                gpu.shadow.set_on(ctx, &mut pass, &[], &projection)?;
                 buffers.draw_objects_where(&mut pass, scene, |i, o| {
                     o.casts_shadows && i != receiver.object
                 });
@@ -401,7 +327,6 @@ fn create(
     Ok(Box::new(Planar {
         params: PlanarParams::from_values(values)?,
         gpu: None,
-        uniforms: None,
         plane_ids: None,
         lights: Vec::new(),
     }))
