@@ -3,7 +3,7 @@
 
 use zoo_host::glam::{Mat4, UVec2, Vec3, Vec4};
 use zoo_host::gpu::GpuType;
-use zoo_host::kit::{self, UniformSlots};
+use zoo_host::kit::{self, SharedGroup, Stage, UniformSlots};
 use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
 use zoo_host::render::SceneBuffers;
@@ -146,7 +146,7 @@ impl RsmCamera {
 /// The reflective shadow maps (flux, normal and area, position; a layer per light) and the
 /// pass that renders them.
 pub struct Rsm {
-    pipeline: wgpu::RenderPipeline,
+    stage: Stage,
     cameras: UniformSlots<RsmCamera>,
     /// (flux, normal, position, depth) arrays, once sized.
     pub targets: Option<RsmTargets>,
@@ -284,19 +284,8 @@ pub const DEBUG_BOUNDS_PASS: &str = "LPV debug bounds";
 impl Rsm {
     /// Builds the pipeline (MRT: flux, normal and area, position; depth).
     pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Rsm> {
-        let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, "lpv/rsm.wgsl")?;
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let cameras = UniformSlots::new(ctx.gpu, "lpv rsm cameras", 1, stages);
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("lpv rsm pipeline layout"),
-            bind_group_layouts: &[
-                Some(&ctx.frame.layout),
-                Some(&ctx.scene_buffers.materials.layout),
-                Some(cameras.layout()),
-            ],
-            immediate_size: 0,
-        });
         let targets: Vec<Option<wgpu::ColorTargetState>> = RSM_FORMATS
             .iter()
             .map(|format| {
@@ -307,35 +296,21 @@ impl Rsm {
                 })
             })
             .collect();
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("lpv rsm pipeline"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_rsm"),
-                compilation_options: Default::default(),
-                buffers: &SceneBuffers::VERTEX_LAYOUTS,
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
+        let stage = Stage::render("lpv/rsm.wgsl", "vs_rsm")
+            .fragment("fs_rsm")
+            .vertex_buffers(&SceneBuffers::VERTEX_LAYOUTS)
+            .targets(&targets)
+            .depth_stencil(wgpu::DepthStencilState {
                 format: wgpu::TextureFormat::Depth32Float,
                 depth_write_enabled: Some(true),
                 depth_compare: Some(wgpu::CompareFunction::LessEqual),
                 stencil: Default::default(),
                 bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_rsm"),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+            })
+            .shared(&[&cameras.at(0)])
+            .build(ctx)?;
         Ok(Rsm {
-            pipeline,
+            stage,
             cameras,
             targets: None,
         })
@@ -388,10 +363,8 @@ impl Rsm {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            pass.set_bind_group(1, &ctx.scene_buffers.materials.bind_group, &[]);
-            pass.set_bind_group(2, self.cameras.bind_group(), &[self.cameras.offset(layer)]);
+            let camera = [&self.cameras.at(layer) as &dyn SharedGroup];
+            self.stage.set_on(ctx, &mut pass, &[], &camera)?;
             ctx.scene_buffers.draw_objects(&mut pass, ctx.scene, false);
         }
         Ok(())
