@@ -3,8 +3,8 @@
 //! (`shaders/shadow-maps/blur.wgsl`).
 
 use zoo_host::gpu::PassRecorder;
-use zoo_host::kit::{UniformSlots, bind_group, bind_group_layout, texture};
-use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
+use zoo_host::kit::{SharedGroup, Stage, StageBindGroup, UniformSlots};
+use zoo_host::{RenderContext, TechniqueError, wgpu};
 
 use crate::atlas_pages::MapTile;
 use crate::maps::MapArray;
@@ -30,18 +30,17 @@ zoo_host::gpu_struct! {
 struct Bound {
     maps: wgpu::Texture,
     scratch: MapArray,
-    maps_group: wgpu::BindGroup,
-    scratch_group: wgpu::BindGroup,
+    maps_group: StageBindGroup,
+    scratch_group: StageBindGroup,
 }
 
-/// The blur's pipeline, its per-pass parameters and its bindings to one map array. Blurring
+/// The blur's stage, its per-pass parameters and its bindings to one map array. Blurring
 /// is per layer: on cube maps, kernels wider than the guard band ([`crate::CUBE_GUARD`]) do
 /// not reach across face edges.
 pub struct LayerBlur {
     label: String,
     format: wgpu::TextureFormat,
-    pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    stage: Stage,
     params: UniformSlots<BlurParams>,
     bound: Option<Bound>,
 }
@@ -53,39 +52,17 @@ impl LayerBlur {
         label: &str,
         format: wgpu::TextureFormat,
     ) -> Result<LayerBlur, TechniqueError> {
-        let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, "shadow-maps/blur.wgsl")?;
         let fragment = wgpu::ShaderStages::FRAGMENT;
-        let unfiltered = wgpu::TextureSampleType::Uint;
-        let layout = bind_group_layout(
-            device,
-            &format!("{label} source layout"),
-            &[texture(
-                0,
-                fragment,
-                unfiltered,
-                wgpu::TextureViewDimension::D2Array,
-            )],
-        );
         let params = UniformSlots::new(ctx.gpu, &format!("{label} parameters"), 2, fragment);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&format!("{label} pipeline layout")),
-            bind_group_layouts: &[Some(&layout), Some(params.layout())],
-            immediate_size: 0,
-        });
-        let pipeline = zoo_host::gpu::fullscreen_pipeline(
-            device,
-            &format!("{label} pipeline"),
-            Some(&pipeline_layout),
-            &module,
-            "fs_blur",
-            wgpu::ColorTargetState::from(format),
-        );
+        let stage = Stage::render("shadow-maps/blur.wgsl", "fullscreen_vs")
+            .fragment("fs_blur")
+            .targets(&[Some(wgpu::ColorTargetState::from(format))])
+            .shared(&[&params.at(0)])
+            .build(ctx)?;
         Ok(LayerBlur {
             label: label.to_string(),
             format,
-            pipeline,
-            layout,
+            stage,
             params,
             bound: None,
         })
@@ -102,14 +79,14 @@ impl LayerBlur {
         passes: &[TilePass<'_>],
         radius: u32,
         base: &str,
-    ) {
+    ) -> Result<(), TechniqueError> {
         if radius == 0 {
             // Nothing to blur: let go of the scratch (and any replaced maps it still holds).
             self.bound = None;
-            return;
+            return Ok(());
         }
         if self.bound.as_ref().is_none_or(|b| b.maps != maps.texture) {
-            self.bound = Some(self.bind(ctx.gpu, maps));
+            self.bound = Some(self.bind(ctx, maps)?);
         }
         let bound = self.bound.as_ref().expect("bound above");
         // A tile's horizontal step reads it from its page into the same texels of the scratch
@@ -161,40 +138,35 @@ impl LayerBlur {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, source, &[]);
                 for (i, tile_pass) in on_page() {
                     tile_pass.tile.restrict(&mut pass);
-                    let offset = self.params.offset(2 * i + k);
-                    pass.set_bind_group(1, self.params.bind_group(), &[offset]);
+                    let step = [&self.params.at(2 * i + k) as &dyn SharedGroup];
+                    self.stage.set_on(ctx, &mut pass, &[source], &step)?;
                     pass.draw(0..3, 0..1);
                 }
             }
         }
+        Ok(())
     }
 
-    fn bind(&self, gpu: &GpuContext, maps: &MapArray) -> Bound {
+    fn bind(&self, ctx: &RenderContext<'_>, maps: &MapArray) -> Result<Bound, TechniqueError> {
         let label = &self.label;
         let scratch = MapArray::with_format(
-            gpu,
+            ctx.gpu,
             &format!("{label} scratch"),
             maps.resolution,
             1,
             self.format,
         );
         let group = |name: String, view: &wgpu::TextureView| {
-            bind_group(
-                &gpu.device,
-                &name,
-                &self.layout,
-                &[wgpu::BindingResource::TextureView(view)],
-            )
+            let source = ("source", wgpu::BindingResource::TextureView(view));
+            self.stage.bind(ctx, &name, &[source])
         };
-        Bound {
+        Ok(Bound {
             maps: maps.texture.clone(),
-            maps_group: group(format!("{label} maps"), &maps.array_view),
-            scratch_group: group(format!("{label} scratch"), &scratch.array_view),
+            maps_group: group(format!("{label} maps"), &maps.array_view)?,
+            scratch_group: group(format!("{label} scratch"), &scratch.array_view)?,
             scratch,
-        }
+        })
     }
 }

@@ -3,7 +3,8 @@
 //! colour map as well (moments for variance shadow maps, fluxes for reflective ones).
 
 use zoo_host::glam::{Mat4, Vec4};
-use zoo_host::gpu::{GpuType, PassRecorder, gpu_bytes_padded};
+use zoo_host::gpu::{GpuType, PassRecorder};
+use zoo_host::kit::{SharedGroup, Stage, StageBuilder, UniformSlot, UniformSlots};
 use zoo_host::render::SceneBuffers;
 use zoo_host::{GpuContext, RenderContext, TechniqueError, wgpu};
 
@@ -87,16 +88,16 @@ pub struct DepthState {
     pub opaque_only: bool,
 }
 
-/// The depth pipeline and the layer cameras.
+/// The depth stages and the layer cameras.
 pub struct DepthPass {
-    label: String,
     opaque_only: bool,
-    pipeline: wgpu::RenderPipeline,
+    stage: Stage,
     /// For alpha-tested casters (`shadow-maps/depth_masked.wgsl`), where the scene has any.
-    masked_pipeline: Option<wgpu::RenderPipeline>,
-    layout: wgpu::BindGroupLayout,
+    masked_stage: Option<Stage>,
     clear: Option<wgpu::Color>,
-    cameras: Option<(wgpu::Buffer, wgpu::BindGroup)>,
+    cameras: UniformSlots<LayerCamera>,
+    /// Whether the cameras were written.
+    written: bool,
 }
 
 impl DepthPass {
@@ -108,28 +109,10 @@ impl DepthPass {
         state: DepthState,
         color: Option<ColorOutput<'_>>,
     ) -> Result<DepthPass, TechniqueError> {
-        let device = &ctx.gpu.device;
-        let create = |shader: &str, source: Option<&str>| match source {
-            None => ctx.shaders.create_module(device, shader),
-            Some(text) => ctx.shaders.create_module_from_source(device, shader, text),
-        };
-        let module = match color {
-            None => create("shadow-maps/depth.wgsl", None)?,
-            Some(c) => create(c.shader, c.source)?,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(&format!("{label} layer camera layout")),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
-                },
-                count: None,
-            }],
-        });
+        let visibility = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let cameras_label = format!("{label} layer cameras");
+        let cameras =
+            UniformSlots::readable_as_array(ctx.gpu, &cameras_label, 1, visibility, CAMERA_STRIDE);
         let targets: Vec<_> = color
             .map(|c| {
                 Some(wgpu::ColorTargetState {
@@ -140,107 +123,72 @@ impl DepthPass {
             })
             .into_iter()
             .collect();
-        let stages = |vertex, fragment| DepthStages {
-            vertex,
-            fragment,
-            targets: &targets,
+        let camera = cameras.at(0);
+        let stage = |shader, text, vertex, fragment: Option<&str>| {
+            let mut stage = depth_stage(Stage::render(shader, vertex), state)
+                .targets(&targets)
+                .shared(&[&camera]);
+            if let Some(entry) = fragment {
+                stage = stage.fragment(entry);
+            }
+            if let Some(text) = text {
+                stage = stage.text(text);
+            }
+            stage.build(ctx)
         };
-        let pipeline = depth_pipeline(
-            device,
-            label,
-            &[Some(&layout)],
-            &module,
-            match color {
-                None => stages("vs_depth", None),
-                Some(c) => stages("vs_depth_world", Some(c.entry)),
-            },
-            state,
-        );
-        // Alpha-tested casters get a pipeline of their own, only where the scene has them.
+        let main = match color {
+            None => stage("shadow-maps/depth.wgsl", None, "vs_depth", None),
+            Some(c) => stage(c.shader, c.source, "vs_depth_world", Some(c.entry)),
+        }?;
+        // Alpha-tested casters get a stage of their own, only where the scene has them.
         let casts_masked =
             (ctx.scene.objects.iter()).any(|o| o.casts_shadows && o.alpha_mask.is_some());
-        let masked_pipeline = match (casts_masked, color) {
+        let masked_stage = match (casts_masked, color) {
             (false, _) => None,
-            (true, None) => {
-                let module = create("shadow-maps/depth_masked.wgsl", None)?;
-                Some((module, stages("vs_depth_masked", Some("fs_depth_masked"))))
-            }
-            (true, Some(c)) => Some((
-                module.clone(),
-                stages("vs_depth_masked", Some(c.masked_entry)),
-            )),
-        }
-        .map(|(module, stages)| {
-            let materials = &ctx.scene_buffers.materials.layout;
-            let groups = [Some(&layout), Some(materials)];
-            depth_pipeline(
-                device,
-                &format!("{label} masked"),
-                &groups,
-                &module,
-                stages,
-                state,
-            )
-        });
+            (true, None) => Some(stage(
+                "shadow-maps/depth_masked.wgsl",
+                None,
+                "vs_depth_masked",
+                Some("fs_depth_masked"),
+            )?),
+            (true, Some(c)) => Some(stage(
+                c.shader,
+                c.source,
+                "vs_depth_masked",
+                Some(c.masked_entry),
+            )?),
+        };
         Ok(DepthPass {
-            label: label.to_string(),
             opaque_only: state.opaque_only,
-            pipeline,
-            masked_pipeline,
-            layout,
+            stage: main,
+            masked_stage,
             clear: color.map(|c| c.clear),
-            cameras: None,
+            cameras,
+            written: false,
         })
     }
 
     /// Uploads the layer cameras of `lights` (growing the buffer when needed). Returns whether
     /// the buffer was replaced, so bind groups that read [`Self::cameras`] must be rebuilt.
     pub fn write_cameras(&mut self, gpu: &GpuContext, lights: &[LightMaps]) -> bool {
-        let mut bytes = Vec::new();
         let layers = lights.iter().flat_map(|l| l.frustums.iter().zip(&l.tiles));
-        for (frustum, &tile) in layers {
-            let camera = LayerCamera::new(frustum, tile);
-            bytes.extend(gpu_bytes_padded(&camera, CAMERA_STRIDE as usize));
-        }
-        let needed = (bytes.len() as u64).max(CAMERA_STRIDE);
-        let replaced = self
-            .cameras
-            .as_ref()
-            .is_none_or(|(buffer, _)| buffer.size() < needed);
-        if replaced {
-            let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(&format!("{} layer cameras", self.label)),
-                size: needed.next_power_of_two().max(CAMERA_STRIDE),
-                usage: wgpu::BufferUsages::UNIFORM
-                    | wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(&format!("{} layer camera bind group", self.label)),
-                layout: &self.layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &buffer,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
-                    }),
-                }],
-            });
-            self.cameras = Some((buffer, bind_group));
-        }
-        if !bytes.is_empty() {
-            let (buffer, _) = self.cameras.as_ref().expect("created above");
-            gpu.queue.write_buffer(buffer, 0, &bytes);
-        }
+        let cameras: Vec<LayerCamera> = layers
+            .map(|(frustum, &tile)| LayerCamera::new(frustum, tile))
+            .collect();
+        let replaced = self.cameras.write(gpu, &cameras) || !self.written;
+        self.written = true;
         replaced
+    }
+
+    /// Layer `layer`'s camera, as the group of stages that read one `LayerCamera`.
+    pub fn camera(&self, layer: u32) -> UniformSlot<'_, LayerCamera> {
+        self.cameras.at(layer as usize)
     }
 
     /// The layer cameras (`array<LayerCamera>` with a 256-byte stride, for lookups), once
     /// written.
     pub fn cameras(&self) -> Option<&wgpu::Buffer> {
-        self.cameras.as_ref().map(|(buffer, _)| buffer)
+        self.written.then(|| self.cameras.buffer())
     }
 
     /// Records one pass per tile of `passes` (named by [`TilePass::name`] with `base`), into
@@ -258,10 +206,9 @@ impl DepthPass {
         base: &str,
         reaches: &dyn Fn(usize, usize) -> bool,
     ) -> Result<(), TechniqueError> {
-        let (_, bind_group) = self
-            .cameras
-            .as_ref()
-            .ok_or_else(TechniqueError::not_prepared)?;
+        if !self.written {
+            return Err(TechniqueError::not_prepared());
+        }
         if color.is_some() != self.clear.is_some() {
             return Err(TechniqueError::Other(
                 "depth pass: colour maps go with a ColorOutput".into(),
@@ -278,9 +225,8 @@ impl DepthPass {
             let depth_view = &depth.layer_views[depth_page];
             let mut pass =
                 tile_pass.begin(recorder, base, &colors, depth_view, tile_pass.load_op(1.0));
-            pass.set_pipeline(&self.pipeline);
-            let offset = tile_pass.layer as u64 * CAMERA_STRIDE;
-            pass.set_bind_group(0, bind_group, &[offset as u32]);
+            let camera = [&self.camera(tile_pass.layer) as &dyn SharedGroup];
+            self.stage.set_on(ctx, &mut pass, &[], &camera)?;
             let (opaque_only, light) = (self.opaque_only, tile_pass.maps.light);
             let casts = |i: usize, o: &zoo_host::scene::SceneObject| {
                 o.casts_shadows
@@ -289,9 +235,8 @@ impl DepthPass {
             };
             let buffers = ctx.scene_buffers;
             buffers.draw_objects_masked(&mut pass, ctx.scene, false, casts);
-            if let Some(masked) = &self.masked_pipeline {
-                pass.set_pipeline(masked);
-                pass.set_bind_group(1, &buffers.materials.bind_group, &[]);
+            if let Some(masked) = &self.masked_stage {
+                masked.set_on(ctx, &mut pass, &[], &camera)?;
                 buffers.draw_objects_masked(&mut pass, ctx.scene, true, casts);
             }
         }
@@ -299,40 +244,16 @@ impl DepthPass {
     }
 }
 
-/// The entry points and colour targets of a depth pipeline.
-struct DepthStages<'a> {
-    vertex: &'a str,
-    fragment: Option<&'a str>,
-    targets: &'a [Option<wgpu::ColorTargetState>],
-}
-
-fn depth_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    groups: &[Option<&wgpu::BindGroupLayout>],
-    module: &wgpu::ShaderModule,
-    stages: DepthStages<'_>,
-    state: DepthState,
-) -> wgpu::RenderPipeline {
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(&format!("{label} pipeline layout")),
-        bind_group_layouts: groups,
-        immediate_size: 0,
-    });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(&format!("{label} pipeline")),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some(stages.vertex),
-            compilation_options: Default::default(),
-            buffers: &SceneBuffers::VERTEX_LAYOUTS,
-        },
-        primitive: wgpu::PrimitiveState {
+/// `stage` with the scene's vertices, faces culled and depth written and biased as `state`
+/// says.
+fn depth_stage(stage: StageBuilder<'_>, state: DepthState) -> StageBuilder<'_> {
+    stage
+        .vertex_buffers(&SceneBuffers::VERTEX_LAYOUTS)
+        .primitive(wgpu::PrimitiveState {
             cull_mode: state.cull_front.then_some(wgpu::Face::Front),
             ..Default::default()
-        },
-        depth_stencil: Some(wgpu::DepthStencilState {
+        })
+        .depth_stencil(wgpu::DepthStencilState {
             format: MAP_FORMAT,
             depth_write_enabled: Some(true),
             depth_compare: Some(wgpu::CompareFunction::LessEqual),
@@ -342,15 +263,5 @@ fn depth_pipeline(
                 slope_scale: state.slope_bias,
                 clamp: 0.0,
             },
-        }),
-        multisample: Default::default(),
-        fragment: stages.fragment.map(|entry| wgpu::FragmentState {
-            module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            targets: stages.targets,
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+        })
 }

@@ -144,7 +144,7 @@ impl MomentMaps {
         let lights = self.maps.lights();
         let blur = format!("{label} blur");
         let passes = self.maps.tile_passes();
-        (self.blur).record(ctx, recorder, maps, &passes, s.blur_radius, &blur);
+        (self.blur).record(ctx, recorder, maps, &passes, s.blur_radius, &blur)?;
         let uniform = |light: usize| MomentLight {
             map: MapHeader::new(&lights[light], s.normal_offset),
             bias: s.bias,

@@ -209,6 +209,12 @@ impl ShadowMapSet {
         limits
     }
 
+    /// Layer `layer`'s camera, as the group of stages that read one `LayerCamera` (the depth
+    /// pass's, and passes of the technique's own that render into the layers).
+    pub fn layer_camera(&self, layer: u32) -> zoo_host::kit::UniformSlot<'_, crate::LayerCamera> {
+        self.depth_pass.camera(layer)
+    }
+
     /// The lookup group (see [`crate::lookup`]) as stages share it; bound once prepared.
     pub fn lookup(&self) -> zoo_host::kit::NamedGroup<'_> {
         self.lookup.shared()

@@ -8,11 +8,11 @@
 //! gets the darkest one's colour in each channel, not their product (exact for one object,
 //! however many of its surfaces the ray crosses).
 
-use zoo_host::gpu::{GpuType, PassRecorder};
+use zoo_host::gpu::PassRecorder;
+use zoo_host::kit::{SharedGroup, Stage};
 use zoo_host::render::SceneBuffers;
 use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 
-use crate::depth::{CAMERA_STRIDE, LayerCamera};
 use crate::maps::{MAP_FORMAT, MapArray};
 use crate::set::ShadowMapSet;
 
@@ -22,89 +22,52 @@ pub const TRANSLUCENT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16F
 /// The translucency maps of a shadow-map set and the pass that draws them.
 pub struct TranslucentPass {
     label: String,
-    pipeline: wgpu::RenderPipeline,
-    camera_layout: wgpu::BindGroupLayout,
-    camera_group: Option<wgpu::BindGroup>,
+    stage: Stage,
     maps: Option<MapArray>,
 }
 
 impl TranslucentPass {
-    /// Builds the pipeline (`label` names it and its maps).
-    pub fn new(ctx: &RenderContext<'_>, label: &str) -> TechniqueResult<TranslucentPass> {
-        let device = &ctx.gpu.device;
-        let module = ctx
-            .shaders
-            .create_module(device, "shadow-maps/translucent.wgsl")?;
-        let camera_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(&format!("{label} layer camera layout")),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
-                },
-                count: None,
-            }],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&format!("{label} pipeline layout")),
-            bind_group_layouts: &[Some(&ctx.frame.layout), Some(&camera_layout)],
-            immediate_size: 0,
-        });
+    /// Builds the stage (`label` names it and its maps), drawing into the layers of `set`.
+    pub fn new(
+        ctx: &RenderContext<'_>,
+        label: &str,
+        set: &ShadowMapSet,
+    ) -> TechniqueResult<TranslucentPass> {
         let min = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Min,
         };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(&format!("{label} pipeline")),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_translucent"),
-                compilation_options: Default::default(),
-                buffers: &SceneBuffers::VERTEX_LAYOUTS,
-            },
-            primitive: wgpu::PrimitiveState::default(),
+        let stage = Stage::render("shadow-maps/translucent.wgsl", "vs_translucent")
+            .fragment("fs_translucent")
+            .vertex_buffers(&SceneBuffers::VERTEX_LAYOUTS)
             // Behind the opaque depth nothing can be lit through them: test, never write.
-            depth_stencil: Some(wgpu::DepthStencilState {
+            .depth_stencil(wgpu::DepthStencilState {
                 format: MAP_FORMAT,
                 depth_write_enabled: Some(false),
                 depth_compare: Some(wgpu::CompareFunction::Less),
                 stencil: Default::default(),
                 bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_translucent"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: TRANSLUCENT_FORMAT,
-                    blend: Some(wgpu::BlendState {
-                        color: min,
-                        alpha: min,
-                    }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+            })
+            .targets(&[Some(wgpu::ColorTargetState {
+                format: TRANSLUCENT_FORMAT,
+                blend: Some(wgpu::BlendState {
+                    color: min,
+                    alpha: min,
+                }),
+                write_mask: wgpu::ColorWrites::ALL,
+            })])
+            .shared(&[&set.layer_camera(0)])
+            .build(ctx)?;
         Ok(TranslucentPass {
             label: label.to_string(),
-            pipeline,
-            camera_layout,
-            camera_group: None,
+            stage,
             maps: None,
         })
     }
 
-    /// Matches the maps to `set`'s depth maps and binds its layer cameras; call after the
-    /// set's `prepare`, with what it returned (`replaced`).
-    pub fn prepare(&mut self, ctx: &RenderContext<'_>, set: &ShadowMapSet, replaced: bool) {
+    /// Matches the maps to `set`'s depth maps; call after the set's `prepare`.
+    pub fn prepare(&mut self, ctx: &RenderContext<'_>, set: &ShadowMapSet) {
         let Some(depth) = set.depth_maps() else {
             return;
         };
@@ -117,26 +80,6 @@ impl TranslucentPass {
                 shape.1,
                 TRANSLUCENT_FORMAT,
             ));
-        }
-        if let Some(cameras) = set.cameras()
-            && (replaced || self.camera_group.is_none())
-        {
-            let group = ctx
-                .gpu
-                .device
-                .create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(&format!("{} layer camera bind group", self.label)),
-                    layout: &self.camera_layout,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: cameras,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
-                        }),
-                    }],
-                });
-            self.camera_group = Some(group);
         }
     }
 
@@ -155,9 +98,7 @@ impl TranslucentPass {
         set: &ShadowMapSet,
         base: &str,
     ) -> TechniqueResult {
-        let (Some(maps), Some(group), Some(depth)) =
-            (&self.maps, &self.camera_group, set.depth_maps())
-        else {
+        let (Some(maps), Some(depth)) = (&self.maps, set.depth_maps()) else {
             return Err(TechniqueError::not_prepared());
         };
         for tile_pass in set.tile_passes() {
@@ -168,10 +109,8 @@ impl TranslucentPass {
             )];
             let depth_view = &depth.layer_views[page];
             let mut pass = tile_pass.begin(recorder, base, &colors, depth_view, wgpu::LoadOp::Load);
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-            let offset = tile_pass.layer as u64 * CAMERA_STRIDE;
-            pass.set_bind_group(1, group, &[offset as u32]);
+            let camera = [&set.layer_camera(tile_pass.layer) as &dyn SharedGroup];
+            self.stage.set_on(ctx, &mut pass, &[], &camera)?;
             ctx.scene_buffers
                 .draw_objects_where(&mut pass, ctx.scene, |_, o| o.transmittance().is_some());
         }

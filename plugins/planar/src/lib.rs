@@ -144,7 +144,10 @@ impl Planar {
             slope_scale: if offset > 0 { -2.0 } else { 0.0 },
             clamp: 0.0,
         };
-        let replace = (wgpu::CompareFunction::Always, wgpu::StencilOperation::Replace);
+        let replace = (
+            wgpu::CompareFunction::Always,
+            wgpu::StencilOperation::Replace,
+        );
         let no_visibility = Some(wgpu::ColorTargetState {
             format: VISIBILITY_FORMAT,
             blend: None,
@@ -154,7 +157,11 @@ impl Planar {
             .fragment("fs_mark")
             .vertex_buffers(&SceneBuffers::VERTEX_LAYOUTS)
             .primitive(BOTH_FACES)
-            .depth_stencil(depth_stencil(wgpu::CompareFunction::LessEqual, replace, bias))
+            .depth_stencil(depth_stencil(
+                wgpu::CompareFunction::LessEqual,
+                replace,
+                bias,
+            ))
             .targets(&[no_visibility, plane_ids_target(wgpu::ColorWrites::RED)])
             .shared(&[&slot])
             .build(ctx)?;
@@ -166,7 +173,10 @@ impl Planar {
             .vertex_buffers(&SceneBuffers::VERTEX_LAYOUTS)
             .primitive(BOTH_FACES)
             .depth_stencil(depth_stencil(always, once, Default::default()))
-            .targets(&[Some(slot_target()), plane_ids_target(wgpu::ColorWrites::empty())])
+            .targets(&[
+                Some(slot_target()),
+                plane_ids_target(wgpu::ColorWrites::empty()),
+            ])
             .shared(&[&slot])
             .build(ctx)?;
         Ok(Gpu {

@@ -123,7 +123,7 @@ impl Gpu {
         let translucent = ctx
             .scene
             .has_translucent_casters()
-            .then(|| TranslucentPass::new(ctx, "ssss translucency"))
+            .then(|| TranslucentPass::new(ctx, "ssss translucency", &maps))
             .transpose()?;
         let passes = Passes::new(ctx, &maps)?;
         let source = ctx.shaders.compose("ssss/debug.wgsl")?.source;
@@ -361,7 +361,7 @@ impl ShadowTechnique for Ssss {
         let gpu = self.gpu.get_mut()?;
         let min_filter = self.params.estimate == Estimate::MinFilter;
         let p = &self.params;
-        let replaced = gpu.maps.prepare(ctx, changes, p.map_size, p.stable_fit);
+        gpu.maps.prepare(ctx, changes, p.map_size, p.stable_fit);
         let view_proj = ctx.frame.matrices.view_proj;
         if p.cull_maps {
             let layers = &self.layers;
@@ -372,7 +372,7 @@ impl ShadowTechnique for Ssss {
             gpu.maps.cull(|l, _| layers.of_light[l.light].is_some());
         }
         if let Some(translucent) = &mut gpu.translucent {
-            translucent.prepare(ctx, &gpu.maps, replaced);
+            translucent.prepare(ctx, &gpu.maps);
         }
         if min_filter {
             gpu.min_filter.prepare(ctx, &gpu.maps)?;

@@ -24,6 +24,7 @@ pub trait UniformValue {
 pub struct UniformSlots<T: UniformValue> {
     label: String,
     stride: u64,
+    usage: wgpu::BufferUsages,
     capacity: usize,
     buffer: wgpu::Buffer,
     layout: wgpu::BindGroupLayout,
@@ -39,11 +40,44 @@ impl<T: UniformValue> UniformSlots<T> {
         capacity: usize,
         visibility: wgpu::ShaderStages,
     ) -> UniformSlots<T> {
-        let device = &gpu.device;
-        let alignment = u64::from(device.limits().min_uniform_buffer_offset_alignment);
+        let alignment = u64::from(gpu.device.limits().min_uniform_buffer_offset_alignment);
         let stride = (T::SIZE as u64).max(1).div_ceil(alignment) * alignment;
+        let usage = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        Self::with_layout(gpu, label, capacity, visibility, (stride, usage))
+    }
+
+    /// As [`Self::new`], with the slots `stride` bytes apart (a multiple of 256, which divides
+    /// every device's offset alignment) in a buffer that shaders may also read whole, as a
+    /// storage array of `stride`-byte elements.
+    pub fn readable_as_array(
+        gpu: &GpuContext,
+        label: &str,
+        capacity: usize,
+        visibility: wgpu::ShaderStages,
+        stride: u64,
+    ) -> UniformSlots<T> {
+        assert!(
+            stride.is_multiple_of(256) && stride >= T::SIZE as u64,
+            "slots of {} bytes hold no {}-byte value at every alignment",
+            stride,
+            T::SIZE
+        );
+        let usage = wgpu::BufferUsages::UNIFORM
+            | wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST;
+        Self::with_layout(gpu, label, capacity, visibility, (stride, usage))
+    }
+
+    fn with_layout(
+        gpu: &GpuContext,
+        label: &str,
+        capacity: usize,
+        visibility: wgpu::ShaderStages,
+        (stride, usage): (u64, wgpu::BufferUsages),
+    ) -> UniformSlots<T> {
+        let device = &gpu.device;
         let capacity = capacity.max(1);
-        let buffer = Self::create_buffer(device, label, stride, capacity);
+        let buffer = Self::create_buffer(device, label, (stride, usage), capacity);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some(&format!("{label} layout")),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -61,6 +95,7 @@ impl<T: UniformValue> UniformSlots<T> {
         UniformSlots {
             label: label.to_string(),
             stride,
+            usage,
             capacity,
             buffer,
             layout,
@@ -72,13 +107,13 @@ impl<T: UniformValue> UniformSlots<T> {
     fn create_buffer(
         device: &wgpu::Device,
         label: &str,
-        stride: u64,
+        (stride, usage): (u64, wgpu::BufferUsages),
         capacity: usize,
     ) -> wgpu::Buffer {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: stride * capacity as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage,
             mapped_at_creation: false,
         })
     }
@@ -106,11 +141,14 @@ impl<T: UniformValue> UniformSlots<T> {
     /// Writes `values` from slot 0 on, growing the buffer (and replacing the bind group, whose
     /// layout stays the same) when they do not fit. Once per frame: queued writes all land
     /// before the frame is submitted, so a second write in the same frame replaces the first
-    /// for every draw of that frame.
-    pub fn write(&mut self, gpu: &GpuContext, values: &[T]) {
-        if values.len() > self.capacity {
+    /// for every draw of that frame. Returns whether the buffer was replaced (bind groups
+    /// others made over [`Self::buffer`] must then be made again).
+    pub fn write(&mut self, gpu: &GpuContext, values: &[T]) -> bool {
+        let grow = values.len() > self.capacity;
+        if grow {
             self.capacity = values.len().next_power_of_two();
-            self.buffer = Self::create_buffer(&gpu.device, &self.label, self.stride, self.capacity);
+            let layout = (self.stride, self.usage);
+            self.buffer = Self::create_buffer(&gpu.device, &self.label, layout, self.capacity);
             self.bind_group = Self::bind(&gpu.device, &self.label, &self.layout, &self.buffer);
         }
         let mut bytes = vec![0u8; self.stride as usize * values.len()];
@@ -118,6 +156,7 @@ impl<T: UniformValue> UniformSlots<T> {
             value.write_bytes(chunk);
         }
         gpu.queue.write_buffer(&self.buffer, 0, &bytes);
+        grow
     }
 
     /// The dynamic offset of slot `index`.
