@@ -1,11 +1,16 @@
 //! The technique kit's helpers: uniforms at the device's alignment, inline shaders with
 //! imports, and slot writes that leave the other lights' channels untouched.
 
+use glam::UVec2;
 use zoo_host::ShaderLibrary;
 use zoo_host::gpu::ShaderError;
-use zoo_host::kit::{LightSlot, UniformSlots, UniformValue};
+use zoo_host::kit::{
+    LightSlot, NamedTextures, TextureSize, TextureSpec, UniformSlots, UniformValue,
+};
 use zoo_host::render::frame::GpuLight;
+use zoo_host::technique::ViewMapping;
 use zoo_host::test_support::gpu;
+use zoo_host::wgpu;
 
 #[test]
 fn uniform_slots_follow_the_device_alignment_and_grow() {
@@ -113,4 +118,57 @@ fn readback_ring_delivers_the_newest_results_without_waiting() {
     assert_eq!(words, [30, 31]);
     // The buffers are free again.
     assert!(frame(&mut ring, 40));
+}
+
+#[test]
+fn textures_are_made_again_only_when_their_shape_or_the_output_changes() {
+    let gpu = gpu();
+    let device = &gpu.device;
+    let format = wgpu::TextureFormat::R8Uint;
+    let layered = TextureSpec {
+        name: "layered",
+        size: TextureSize::Screen { divisor: 2 },
+        layers: 3,
+        ..TextureSpec::screen_target("layered", format, None)
+    };
+    let mut named = NamedTextures::new(
+        "test",
+        [
+            TextureSpec::screen_target("ids", format, Some(ViewMapping::Integer)),
+            layered,
+        ],
+    );
+    assert!(named.resources().is_empty() && named.view("ids").is_none());
+    let screen = UVec2::new(16, 8);
+    assert!(named.prepare_at(device, screen));
+    assert!(!named.prepare_at(device, screen), "nothing changed");
+    let texture = named.texture("ids").unwrap().clone();
+    // A new view is not a new texture.
+    named.respec("ids", |s| {
+        s.view = Some(ViewMapping::Color { min: 0.0, max: 1.0 })
+    });
+    assert!(!named.prepare_at(device, screen));
+    assert_eq!(named.texture("ids").unwrap(), &texture);
+    let shown = named.debug_view("ids").unwrap().mapping;
+    assert_eq!(shown, ViewMapping::Color { min: 0.0, max: 1.0 });
+    assert!(named.debug_view("layered").is_none(), "not viewable");
+    assert!(named.layer_view("layered", 2).is_some());
+    assert!(named.layer_view("layered", 3).is_none());
+    let listed: Vec<_> = (named.resources().into_iter())
+        .map(|r| (r.name, r.size, r.viewable))
+        .collect();
+    assert_eq!(
+        listed,
+        [
+            ("ids".to_string(), [16, 8, 1], true),
+            ("layered".to_string(), [8, 4, 3], false)
+        ]
+    );
+    // A new output size or shape makes them again.
+    assert!(named.prepare_at(device, UVec2::new(32, 8)));
+    assert_ne!(named.texture("ids").unwrap(), &texture);
+    named.respec("layered", |s| s.layers = 4);
+    assert!(named.prepare_at(device, UVec2::new(32, 8)));
+    assert_eq!(named.resources()[1].size, [16, 4, 4]);
+    assert!(gpu.take_uncaptured_errors().is_empty());
 }

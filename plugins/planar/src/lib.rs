@@ -12,7 +12,7 @@
 pub mod matrix;
 
 use zoo_host::glam::{Mat4, Vec4};
-use zoo_host::kit::{SharedGroup, Stage, UniformSlots, slot_target};
+use zoo_host::kit::{NamedTextures, SharedGroup, Stage, TextureSpec, UniformSlots, slot_target};
 use zoo_host::params::TechniqueParams;
 use zoo_host::render::SceneBuffers;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
@@ -82,9 +82,12 @@ struct Gpu {
 pub struct Planar {
     params: PlanarParams,
     gpu: Option<Gpu>,
-    plane_ids: Option<(wgpu::Texture, wgpu::TextureView)>,
+    targets: NamedTextures,
     lights: Vec<LightPass>,
 }
+
+/// The stencil's plane ids, as the debug view shows them.
+const PLANE_IDS: &str = "plane ids";
 
 /// Both faces of every triangle: a caster's projection may face either way.
 const BOTH_FACES: wgpu::PrimitiveState = wgpu::PrimitiveState {
@@ -238,10 +241,7 @@ fn pass_name(light: usize) -> String {
 
 impl ShadowTechnique for Planar {
     fn resources(&self) -> Vec<ResourceInfo> {
-        let mut out = Vec::new();
-        if let Some((texture, _)) = &self.plane_ids {
-            out.push(ResourceInfo::texture("plane ids", texture, true));
-        }
+        let mut out = self.targets.resources();
         if let Some(gpu) = &self.gpu {
             let slots = format!("Projection ({}-byte slots)", gpu.projections.stride());
             out.push(ResourceInfo::buffer(
@@ -261,15 +261,7 @@ impl ShadowTechnique for Planar {
         if changes.scene || changes.lights || changes.params || rebuilt {
             self.plan(ctx)?;
         }
-        if changes.resolution || self.plane_ids.is_none() {
-            self.plane_ids = Some(zoo_host::gpu::render_target(
-                &ctx.gpu.device,
-                "planar plane ids",
-                ctx.size,
-                PLANE_IDS_FORMAT,
-                wgpu::TextureUsages::empty(),
-            ));
-        }
+        self.targets.prepare(ctx);
         Ok(())
     }
 
@@ -278,7 +270,7 @@ impl ShadowTechnique for Planar {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> Result<(), TechniqueError> {
-        let (Some(gpu), Some((_, plane_ids))) = (&self.gpu, &self.plane_ids) else {
+        let (Some(gpu), Some(plane_ids)) = (&self.gpu, self.targets.view(PLANE_IDS)) else {
             return Err(TechniqueError::not_prepared());
         };
         let scene = ctx.scene;
@@ -315,13 +307,7 @@ impl ShadowTechnique for Planar {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        match (resource, &self.plane_ids) {
-            ("plane ids", Some((_, view))) => Some(DebugImage {
-                view,
-                mapping: ViewMapping::Integer,
-            }),
-            _ => None,
-        }
+        self.targets.debug_view(resource)
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
@@ -337,7 +323,14 @@ fn create(
     Ok(Box::new(Planar {
         params: PlanarParams::from_values(values)?,
         gpu: None,
-        plane_ids: None,
+        targets: NamedTextures::new(
+            "planar",
+            [TextureSpec::screen_target(
+                PLANE_IDS,
+                PLANE_IDS_FORMAT,
+                Some(ViewMapping::Integer),
+            )],
+        ),
         lights: Vec::new(),
     }))
 }

@@ -21,9 +21,8 @@ pub struct BlockerView {
     /// The tracing shader's text for the chosen tracer.
     text: String,
     pass: Option<TracePass>,
-    target: Option<(wgpu::Texture, wgpu::TextureView)>,
-    /// The farthest distance shown white (the scene's diagonal).
-    far: f32,
+    /// The distances, made (and viewable) when first traced.
+    targets: kit::NamedTextures,
 }
 
 impl BlockerView {
@@ -32,8 +31,13 @@ impl BlockerView {
         BlockerView {
             text: text.to_string(),
             pass: None,
-            target: None,
-            far: 1.0,
+            targets: kit::NamedTextures::new(
+                "rt-shadows",
+                [kit::TextureSpec {
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    ..kit::TextureSpec::screen_target(VIEW, FORMAT, None)
+                }],
+            ),
         }
     }
 
@@ -54,32 +58,18 @@ impl BlockerView {
             self.pass = Some(pass);
         }
         let pass = self.pass.as_mut().expect("made above");
-        let size = ctx.visibility.texture.size();
-        let fits = |(texture, _): &(wgpu::Texture, wgpu::TextureView)| {
-            texture.width() == size.width && texture.height() == size.height
-        };
-        if !self.target.as_ref().is_some_and(fits) {
-            let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("rt-shadows blocker distance"),
-                size: wgpu::Extent3d {
-                    depth_or_array_layers: 1,
-                    ..size
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&Default::default());
-            self.target = Some((texture, view));
-        }
+        // Black at the surface, white at the scene's diagonal.
         let (min, max) = ctx.scene.bounds();
-        self.far = (max - min).length().max(f32::MIN_POSITIVE);
-        let view = &self.target.as_ref().expect("made above").1;
+        let far = (max - min).length().max(f32::MIN_POSITIVE);
+        self.targets.respec(VIEW, |spec| {
+            spec.view = Some(ViewMapping::Channel {
+                channel: 0,
+                min: 0.0,
+                max: far,
+            })
+        });
+        self.targets.prepare(ctx);
+        let view = self.targets.view(VIEW).expect("made above");
         let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
         let target = |l: usize| (l == light).then_some((view, clear));
         let no_blend = |_| None;
@@ -88,21 +78,12 @@ impl BlockerView {
 
     /// The distances as a viewable resource, once traced.
     pub fn resource(&self) -> Option<ResourceInfo> {
-        let (texture, _) = self.target.as_ref()?;
-        Some(ResourceInfo::texture(VIEW, texture, true))
+        self.targets.resources().pop()
     }
 
     /// The distances for the debug view, black at the surface and white at the scene's
-    /// diagonal.
+    /// diagonal, once traced.
     pub fn debug_image(&self) -> Option<DebugImage<'_>> {
-        let (_, view) = self.target.as_ref()?;
-        Some(DebugImage {
-            view,
-            mapping: ViewMapping::Channel {
-                channel: 0,
-                min: 0.0,
-                max: self.far,
-            },
-        })
+        self.targets.debug_view(VIEW)
     }
 }

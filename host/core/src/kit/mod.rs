@@ -9,6 +9,8 @@
 //! - [`lazy`]: GPU state built at the first `prepare`, with the not-prepared error once.
 //! - [`light_pass`]: a full-screen fragment shader run once per light into its slot, with
 //!   per-light uniforms.
+//! - [`resources`]: textures declared once by name and spec, made and remade by the kit,
+//!   listed and viewed from their declarations.
 //! - [`stage`]: the one way to write a pass: a compute, full-screen or raster pipeline whose
 //!   groups, layouts and workgroup size are read from the WGSL ([`reflect`]), its own
 //!   resources bound by name and shared groups recognised by what they declare.
@@ -20,6 +22,7 @@ pub mod layouts;
 pub mod lazy;
 pub mod light_pass;
 pub mod reflect;
+pub mod resources;
 pub mod slot;
 pub mod stage;
 pub mod uniforms;
@@ -29,6 +32,7 @@ pub use layouts::{
 };
 pub use lazy::LazyGpu;
 pub use light_pass::{FullscreenLightPass, light_pass_name};
+pub use resources::{NamedTextures, TextureSize, TextureSpec};
 pub use slot::{LightSlot, slot_target};
 pub use stage::{NamedGroup, SharedGroup, Stage, StageBindGroup, StageBuilder};
 pub use uniforms::{UniformSlot, UniformSlots, UniformValue};
