@@ -11,6 +11,7 @@
 #import "common/lighting.wgsl"
 #import "common/fullscreen.wgsl"
 #import "ray-tracing/trace.wgsl"
+#import "ray-tracing/origin.wgsl"
 #import "rt-shadows/light.wgsl"
 
 // Two unit vectors perpendicular to unit `w` and to each other.
@@ -59,12 +60,30 @@ struct Traced {
     transmittance: vec3<f32>,
 }
 
-// Where rays from surface `s` toward `toward` start: off the surface, on the light's side, by
-// more than the reconstruction's error.
-fn ray_origin(s: Surface, toward: vec3<f32>) -> vec3<f32> {
-    let side = select(-s.normal, s.normal, dot(s.normal, toward) >= 0.0);
-    let magnitude = max(max(abs(s.position.x), abs(s.position.y)), abs(s.position.z));
-    return s.position + side * (distance(s.position, camera.position) * 1e-4 + magnitude * 1e-6);
+// Where rays from surface `s` start: off the surface on the camera's side (the G-buffer's
+// normal faces the camera) by the bound on the position's rounding, as the judge's rays
+// start (`ray-tracing/origin.wgsl`). A light behind the surface shadows its own points, which
+// it does not light either; a light grazing it is not taken for one behind by the rounding.
+fn ray_origin(s: Surface) -> vec3<f32> {
+    return rt_gbuffer_ray_origin(s.position, s.normal, camera.position);
+}
+
+// A shadow ray from surface `s`: from `origin` along unit `direction` up to `reach`.
+struct ShadowRay {
+    origin: vec3<f32>,
+    direction: vec3<f32>,
+    reach: f32,
+    // How far along the ray from `origin` it starts (past the rasteriser's error).
+    skipped: f32,
+}
+
+// The ray from `origin` (`ray_origin(s)`) along `direction` up to `reach`, started past the
+// stretch where it could meet its own surface again (`rt_gbuffer_raster_skip`).
+fn shadow_ray(s: Surface, origin: vec3<f32>, direction: vec3<f32>, reach: f32) -> ShadowRay {
+    // A pixel's side at unit distance: the view plane's height over the pixels.
+    let pixel = 2.0 / (camera.proj[1][1] * camera.size.y);
+    let skip = min(rt_gbuffer_raster_skip(s.position, s.normal, camera.position, direction, pixel), reach);
+    return ShadowRay(origin + direction * skip, direction, reach - skip, skip);
 }
 
 // The light's visibility, and its transmittance when `coloured` (white otherwise), from the
@@ -76,7 +95,7 @@ fn trace(pixel: vec2<i32>, coloured: bool) -> Traced {
     if !s.valid || light_falloff(light, s.position) <= 0.0 {
         return Traced(1.0, vec3<f32>(1.0));
     }
-    let origin = ray_origin(s, toward);
+    let origin = ray_origin(s);
 
     let rays = select(rt_light.rays, 1u, light.radius <= 0.0);
     let disk = basis(toward);
@@ -107,10 +126,11 @@ fn trace(pixel: vec2<i32>, coloured: bool) -> Traced {
         }
         let weight = max(dot(s.normal, direction), 0.0);
         total += weight;
-        if !rt_occluded(origin, direction, reach) {
+        let ray = shadow_ray(s, origin, direction, reach);
+        if !rt_occluded(ray.origin, direction, ray.reach) {
             var colour = vec3<f32>(1.0);
             if coloured {
-                colour = rt_transmittance(origin, direction, reach);
+                colour = rt_transmittance(ray.origin, direction, ray.reach);
             }
             lit += 1u;
             arrived += weight;
@@ -167,14 +187,15 @@ fn fs_blocker_distance(in: FullscreenOut) -> @location(0) vec4<f32> {
     if !s.valid || light_falloff(light, s.position) <= 0.0 {
         discard;
     }
-    let origin = ray_origin(s, toward);
+    let origin = ray_origin(s);
     var reach = 3.0e38;
     if light.kind != LIGHT_DIRECTIONAL {
         reach = distance(light.position, origin);
     }
-    let hit = rt_closest(origin, normalize(toward), reach);
+    let ray = shadow_ray(s, origin, normalize(toward), reach);
+    let hit = rt_closest(ray.origin, ray.direction, ray.reach);
     if !hit.found {
         discard;
     }
-    return vec4<f32>(hit.t, 0.0, 0.0, 1.0);
+    return vec4<f32>(ray.skipped + hit.t, 0.0, 0.0, 1.0);
 }

@@ -5,73 +5,163 @@
 
 use glam::UVec2;
 use shadow_zoo::gpu_judge::trace_reference;
-use zoo_host::judge::edge_band;
+use zoo_host::judge::{LightReference, edge_band};
 use zoo_host::judging::SceneReference;
 use zoo_host::test_support::{gpu, standard_scenes};
 use zoo_host::{Renderer, Scene};
 
-const SIZE: UVec2 = UVec2::new(96, 72);
-const SAMPLES: u32 = 16;
+/// Most of a light's pixels whose hard class may change off the reference's shadow edges.
+const CORE_BOUND: f64 = 0.0002;
 
+/// How the two judges' hard visibility of one light compares.
+#[derive(Debug, Default, Clone, Copy)]
+struct HardAgreement {
+    /// Pixels the light reaches.
+    pixels: usize,
+    /// Pixels whose class (shadowed or lit) differs.
+    changed: usize,
+    /// Of those, the ones off the CPU reference's shadow edges.
+    changed_core: usize,
+    /// Of the changed, the ones the GPU finds lit and the CPU shadowed.
+    gpu_lit: usize,
+}
+
+impl HardAgreement {
+    /// The comparison of `gpu` with `cpu` on an image `size` wide and high.
+    fn of(cpu: &LightReference, gpu: &LightReference, size: UVec2) -> HardAgreement {
+        let band = edge_band(cpu, size.x as usize, size.y as usize);
+        let mut agreement = HardAgreement::default();
+        for i in (0..cpu.contributing.len()).filter(|&i| cpu.contributing[i]) {
+            let differs = (cpu.hard[i] < 0.5) != (gpu.hard[i] < 0.5);
+            agreement.pixels += 1;
+            agreement.changed += usize::from(differs);
+            agreement.changed_core += usize::from(differs && !band[i]);
+            agreement.gpu_lit += usize::from(differs && gpu.hard[i] >= 0.5);
+        }
+        agreement
+    }
+
+    /// The share of the light's pixels that changed off the shadow edges, and in all.
+    fn shares(&self) -> (f64, f64) {
+        let pixels = self.pixels.max(1) as f64;
+        (
+            self.changed_core as f64 / pixels,
+            self.changed as f64 / pixels,
+        )
+    }
+}
+
+/// Both judges' references of the scene at `path` at `size`, with `samples` area rays.
+fn references(
+    path: &std::path::Path,
+    size: UVec2,
+    samples: u32,
+) -> (String, SceneReference, SceneReference) {
+    let scene = Scene::load(path).unwrap();
+    let name = scene.name.clone();
+    let mut renderer = Renderer::new(gpu(), scene, size).unwrap();
+    let cpu = SceneReference::compute(&mut renderer, samples, |_| {}).unwrap();
+    let traced = trace_reference(&mut renderer, samples).unwrap();
+    (name, cpu, traced)
+}
+
+/// Every light of every standard scene at `size`: its hard agreement, printed, and the lights
+/// whose class changes off shadow edges exceed [`CORE_BOUND`].
+fn hard_agreement_everywhere(size: UVec2) -> Vec<String> {
+    let mut over = Vec::new();
+    for path in standard_scenes() {
+        let (name, cpu, traced) = references(&path, size, 1);
+        for (light, (c, g)) in cpu.lights.iter().zip(&traced.lights).enumerate() {
+            let agreement = HardAgreement::of(c, g, size);
+            let (core, all) = agreement.shares();
+            eprintln!(
+                "{name} at {}x{}, light {light}: class changed off edges {core:.5}, in all \
+                 {all:.5} ({} of {} changed, {} lit on the GPU only)",
+                size.x, size.y, agreement.changed, agreement.pixels, agreement.gpu_lit
+            );
+            if core > CORE_BOUND {
+                over.push(format!("{name} light {light}: {agreement:?}"));
+            }
+        }
+    }
+    over
+}
+
+/// The mean difference of area visibility over the lights' pixels, and of the area colour
+/// (its largest channel) where both keep one (0 without translucent casters).
+fn area_differences(cpu: &SceneReference, traced: &SceneReference) -> (f64, f64) {
+    let (mut pixels, mut area) = (0usize, 0.0f64);
+    let (mut coloured, mut colour) = (0usize, 0.0f64);
+    for (c, g) in cpu.lights.iter().zip(&traced.lights) {
+        for i in (0..c.contributing.len()).filter(|&i| c.contributing[i]) {
+            pixels += 1;
+            area += f64::from((c.area[i] - g.area[i]).abs());
+            // Behind translucent casters both keep the colour that arrives.
+            if let (Some(cc), Some(gc)) = (&c.color, &g.color) {
+                colour += f64::from((cc[i] - gc[i]).abs().max_element());
+                coloured += 1;
+            }
+        }
+    }
+    (area / pixels.max(1) as f64, colour / coloured.max(1) as f64)
+}
+
+/// At 128x128 with 16 area rays: off the reference's shadow edges at most [`CORE_BOUND`] of a
+/// scene's lit pixels (all its lights') change class (both judges start their rays off the
+/// surface by the same rounding bound; a light's pixels alone are too few here, one pixel
+/// being more than the bound, which the long check holds each light to at 512x512), at most
+/// 0.005 in all (on an edge the two origins, the judge's exact surface and the G-buffer's, can
+/// fall either side of a silhouette), and area visibility and colour move by at most 0.01 on
+/// average.
 #[test]
 fn the_gpu_judge_agrees_with_the_cpu_judge_on_every_standard_scene() {
+    let size = UVec2::splat(128);
     let (mut cpu_seconds, mut gpu_seconds) = (0.0, 0.0);
     for path in standard_scenes() {
-        let scene = Scene::load(&path).unwrap();
-        let name = scene.name.clone();
-        let mut renderer = Renderer::new(gpu(), scene, SIZE).unwrap();
-        let cpu = SceneReference::compute(&mut renderer, SAMPLES, |_| {}).unwrap();
-        let traced = trace_reference(&mut renderer, SAMPLES).unwrap();
-        let (mut pixels, mut changed, mut changed_core) = (0usize, 0usize, 0usize);
-        let mut area_difference = 0.0f64;
-        let (mut colour_difference, mut coloured) = (0.0f64, 0usize);
+        let (name, cpu, traced) = references(&path, size, 16);
         assert_eq!(
             cpu.lights[0].color.is_some(),
             traced.lights[0].color.is_some(),
             "{name}: both keep colours, or neither"
         );
+        let mut scene = HardAgreement::default();
         for (c, g) in cpu.lights.iter().zip(&traced.lights) {
             assert_eq!(c.contributing, g.contributing, "{name}");
-            let band = edge_band(c, SIZE.x as usize, SIZE.y as usize);
-            for i in (0..c.contributing.len()).filter(|&i| c.contributing[i]) {
-                let differs = (c.hard[i] < 0.5) != (g.hard[i] < 0.5);
-                pixels += 1;
-                changed += usize::from(differs);
-                changed_core += usize::from(differs && !band[i]);
-                area_difference += f64::from((c.area[i] - g.area[i]).abs());
-                // Behind translucent casters both keep the colour that arrives.
-                if let (Some(cc), Some(gc)) = (&c.color, &g.color) {
-                    colour_difference += f64::from((cc[i] - gc[i]).abs().max_element());
-                    coloured += 1;
-                }
-            }
+            let light = HardAgreement::of(c, g, size);
+            scene.pixels += light.pixels;
+            scene.changed += light.changed;
+            scene.changed_core += light.changed_core;
+            scene.gpu_lit += light.gpu_lit;
         }
-        let share = |n: usize| n as f64 / pixels.max(1) as f64;
-        let (all, core) = (share(changed), share(changed_core));
-        let area = area_difference / pixels.max(1) as f64;
+        let (core, all) = scene.shares();
+        let (area, colour) = area_differences(&cpu, &traced);
         eprintln!(
-            "{name}: {pixels} lit pixels, class changed {all:.5} ({core:.5} off shadow edges), \
-             area mean difference {area:.4}; traced in {:.2} s (CPU) and {:.2} s (GPU)",
-            cpu.seconds, traced.seconds
+            "{name}: {} lit pixels, class changed {core:.5} off edges, {all:.5} in all, area \
+             mean difference {area:.4}, colour {colour:.4}; traced in {:.2} s (CPU) and \
+             {:.2} s (GPU)",
+            scene.pixels, cpu.seconds, traced.seconds
         );
         cpu_seconds += cpu.seconds;
         gpu_seconds += traced.seconds;
-        // On a shadow edge's pixels the two origins (the judge's exact surface, the G-buffer's
-        // reconstruction) can fall either side of a silhouette: off the edges they agree.
         assert!(
-            core <= 0.0002,
-            "{name}: {core} of the pixels off shadow edges change class"
+            core <= CORE_BOUND,
+            "{name}: {core} of the pixels off shadow edges change class ({scene:?})"
         );
         assert!(all <= 0.005, "{name}: {all} of the pixels change class");
         assert!(
             area <= 0.01,
             "{name}: area visibility differs by {area} on average"
         );
-        let colour = colour_difference / coloured.max(1) as f64;
-        if coloured > 0 {
-            eprintln!("{name}: area colour differs by {colour:.4} on average (largest channel)");
-        }
         assert!(colour <= 0.01, "{name}: area colour differs by {colour}");
     }
     eprintln!("all scenes: CPU {cpu_seconds:.1} s, GPU {gpu_seconds:.1} s");
+}
+
+/// One ray to each light's centre at 512x512: off the CPU reference's shadow edges at most
+/// [`CORE_BOUND`] of each light's pixels change class, on every standard scene.
+#[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
+fn hard_visibility_agrees_off_shadow_edges_at_512() {
+    let over = hard_agreement_everywhere(UVec2::splat(512));
+    assert!(over.is_empty(), "{over:#?}");
 }

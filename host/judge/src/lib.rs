@@ -28,4 +28,6 @@ pub use occluders::Occluders;
 pub use placed::placed_box;
 pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, reference_visibility};
 pub use sampling::{concentric_disk, stratified_disk};
-pub use surfaces::{SurfaceHit, SurfacePoint, Surfaces};
+pub use surfaces::{
+    GBUFFER_POSITION_ERROR, SurfaceHit, SurfacePoint, Surfaces, reconstruction_error,
+};

@@ -166,19 +166,26 @@ impl Surfaces {
             position,
             normal,
             geometric_normal: normal,
-            offset: reconstruction_error(eye, position, depth),
+            offset: reconstruction_error(eye, position),
         }
     }
 }
 
-/// How far a G-buffer position may lie off its surface: the position is rebuilt as
-/// eye + depth × ray from the rasterised view depth, each step rounding at the magnitude of
+/// The relative error of a G-buffer position off its surface (γ₁₆): the position is rebuilt
+/// as eye + depth × ray from the rasterised view depth, each step rounding at the magnitude of
 /// the eye, the position and the view distance (about 16 roundings in all, with the
 /// rasteriser's interpolation of the depth). A margin rather than a strict bound: GPU
-/// interpolation is not correctly rounded. Used only where the pixel's ray misses the
-/// G-buffer's surface (silhouettes).
-fn reconstruction_error(eye: Vec3, position: Vec3, depth: f32) -> f32 {
-    gamma(16) * (eye.abs().max_element() + position.abs().max_element() + depth)
+/// interpolation is not correctly rounded. The GPU's tracers start their rays off G-buffer
+/// positions by the same rule (`zoo_ray_tracing`'s `ray-tracing/origin.wgsl` reads this value).
+pub const GBUFFER_POSITION_ERROR: f32 = gamma(16);
+
+/// How far a G-buffer `position` seen from `eye` may lie off its surface:
+/// [`GBUFFER_POSITION_ERROR`] of the eye's and the position's largest coordinates and the
+/// view distance. The judge starts rays this far off G-buffer positions where the pixel's ray
+/// misses the G-buffer's surface (silhouettes); the GPU's tracers everywhere.
+pub fn reconstruction_error(eye: Vec3, position: Vec3) -> f32 {
+    let depth = (position - eye).length();
+    GBUFFER_POSITION_ERROR * (eye.abs().max_element() + position.abs().max_element() + depth)
 }
 
 /// The texture coordinates at `point` on the triangle `corners` whose corners have `uvs`

@@ -30,12 +30,14 @@ use zoo_host::scene::{AlphaMask, Scene};
 use zoo_host::{RenderContext, ShaderLibrary, TechniqueError, TechniqueResult, wgpu};
 
 mod compute;
+mod origin;
 mod query;
 
 pub use compute::{
     CasterGeometry, GpuInstance, GpuNode, GpuRoots, GpuTexcoords, GpuTriangle, NO_OBJECT,
     STACK_SIZE,
 };
+pub use origin::{ERROR_MODULE, RASTER_SUBPIXEL};
 pub use query::GpuMaskedTriangle;
 
 /// The bind group index both traversals declare their bindings in.

@@ -1,6 +1,8 @@
 //! Ray-traced shadows against the reference judge: exact hard shadows, and soft shadows that
 //! approach the area reference as rays are added.
 
+mod fine_masks;
+
 // Link the plugin so its technique registers.
 use zoo_plugin_rt_shadows as _;
 

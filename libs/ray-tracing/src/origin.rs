@@ -1,0 +1,51 @@
+//! Where rays from a G-buffer surface start (`ray-tracing/origin.wgsl`): off the surface by the
+//! judge's bound on the position's rounding ([`zoo_host::judge::reconstruction_error`]), then
+//! along the ray past the rasteriser's error ([`RASTER_SUBPIXEL`]). Both factors are declared
+//! once, here and in the judge; this module registers them as the generated shader module
+//! [`ERROR_MODULE`].
+
+use zoo_host::judge::GBUFFER_POSITION_ERROR;
+
+/// How far the rasteriser may move a drawn surface off its plane, as a fraction of a pixel's
+/// footprint at its distance: its snapping of vertices to a sub-pixel grid of 8 bits
+/// (lavapipe's and common GPUs'; measured: 1/290 of a pixel on a grazing floor 170 m away).
+pub const RASTER_SUBPIXEL: f32 = 1.0 / 256.0;
+
+/// The generated module holding `RT_GBUFFER_POSITION_ERROR`, the judge's
+/// [`GBUFFER_POSITION_ERROR`], and `RT_RASTER_SUBPIXEL`, [`RASTER_SUBPIXEL`].
+pub const ERROR_MODULE: &str = "ray-tracing/gbuffer_error.wgsl";
+
+/// The text of [`ERROR_MODULE`]: the factors as WGSL literals that parse back to the same
+/// `f32`s (Rust's shortest round-trip form).
+fn error_module() -> String {
+    format!(
+        "// Generated from `zoo_judge::GBUFFER_POSITION_ERROR` (libs/ray-tracing/src/origin.rs).\n\
+         const RT_GBUFFER_POSITION_ERROR: f32 = {GBUFFER_POSITION_ERROR:?};\n\
+         const RT_RASTER_SUBPIXEL: f32 = {RASTER_SUBPIXEL:?};\n"
+    )
+}
+
+zoo_host::inventory::submit! {
+    zoo_host::params::shader::GeneratedShader {
+        name: ERROR_MODULE,
+        source: error_module,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_generated_constant_is_the_judges_value() {
+        let text = zoo_host::ShaderLibrary::embedded()
+            .compose("ray-tracing/origin.wgsl")
+            .unwrap()
+            .source;
+        let line = (text.lines())
+            .find_map(|l| l.strip_prefix("const RT_GBUFFER_POSITION_ERROR: f32 = "))
+            .expect("the origin module imports the generated constant");
+        let value: f32 = line.trim_end_matches(';').parse().unwrap();
+        assert_eq!(value.to_bits(), GBUFFER_POSITION_ERROR.to_bits());
+    }
+}
