@@ -40,7 +40,9 @@ use zoo_shadow_maps::{DepthState, LightMaps, LookupPass, LookupShader, MapHeader
 use coverage::CoverageMaps;
 use ids::IdMaps;
 use tiles::Tiles;
-use zoo_shadow_volumes::{VolumeGenerator, Volumes, band_volume_pipeline, stencil_state};
+use zoo_shadow_volumes::{
+    VolumeGenerator, Volumes, band_volume_pipeline, piece_pass_name, stencil_state,
+};
 
 zoo_host::param_choice! {
     /// Where shadow volumes are counted.
@@ -72,6 +74,17 @@ zoo_host::technique_params! {
         volume_bias: u32 = 16, range(0, 65536), step(1), flags(rebuild);
         /// Light whose classification the debug view shows.
         debug_light: u32 = 0, range(0, 1023), step(1);
+        /// Largest volume vertex buffer in MiB (0: as large as the device binds). Volumes that
+        /// may need more are generated and drawn in pieces that fit it, their stencil counts
+        /// adding up, so the band stays exact; smaller pieces take less memory and more passes.
+        volume_buffer_mib: u32 = 0, range(0, 4096), step(1), flags(rebuild);
+    }
+}
+
+impl HybridParams {
+    /// The volume buffer's budget in bytes, if one is set.
+    fn volume_budget(&self) -> Option<u64> {
+        (self.volume_buffer_mib > 0).then(|| u64::from(self.volume_buffer_mib) << 20)
     }
 }
 
@@ -361,6 +374,74 @@ fn record_counts(
     Ok(())
 }
 
+/// Counts light `light`'s volumes in its band, piece by piece into the band's stencil (only
+/// into the listed edge tiles where `tiled`), and shadows the band pixels with a non-zero
+/// count; `debug`: the light the debug views show.
+fn record_volumes(
+    ctx: &RenderContext<'_>,
+    recorder: &mut PassRecorder<'_>,
+    gpu: &Gpu,
+    (light, debug): (usize, bool),
+    tiled: bool,
+) -> TechniqueResult {
+    let (Some(volume), Some(args)) = (gpu.generator.volume(), gpu.generator.args()) else {
+        return Err(TechniqueError::not_prepared());
+    };
+    let showing = |view| debug && ctx.debug_view == Some(view);
+    let tiles = gpu.tiles.as_ref().filter(|_| tiled);
+    if let Some(tiles) = tiles {
+        tiles.record_list(recorder, &light_pass_name(TILES_PASS, light))?;
+        if showing(TILES_VIEW) {
+            let name = light_pass_name(DEBUG_PASS, light);
+            tiles.record_overlay(ctx, recorder, &gpu.targets.tiles.1, &name)?;
+        }
+    }
+    let pieces = gpu.generator.pieces(light);
+    for piece in 0..pieces {
+        let generation = piece_pass_name(GENERATION_PASS, light, piece);
+        gpu.generator
+            .record(ctx, recorder, (light, piece), &generation)?;
+        let last = piece + 1 == pieces;
+        // The next piece counts on; the count view reads the stencil after the last.
+        let keep = match !last || showing(COUNTS_VIEW) {
+            true => wgpu::StoreOp::Store,
+            false => wgpu::StoreOp::Discard,
+        };
+        let depth = wgpu::RenderPassDepthStencilAttachment {
+            view: &gpu.targets.band.1,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: keep,
+            }),
+            stencil_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: keep,
+            }),
+        };
+        if let Some(tiles) = tiles {
+            tiles.take_vertex_count(recorder, args)?;
+        }
+        let name = piece_pass_name(VOLUME_PASS, light, piece);
+        let mut pass = ctx.light_pass(recorder, &name, light, Some(depth));
+        if let Some(tiles) = tiles {
+            tiles.draw(&mut pass, volume)?;
+        } else {
+            pass.set_pipeline(&gpu.volume);
+            pass.set_vertex_buffer(0, volume.slice(..));
+            pass.draw_indirect(args, 0);
+        }
+        if last {
+            pass.set_pipeline(&gpu.resolve);
+            pass.set_stencil_reference(0);
+            pass.draw(0..3, 0..1);
+        }
+    }
+    if showing(COUNTS_VIEW) {
+        record_counts(ctx, recorder, gpu, light)?;
+    }
+    Ok(())
+}
+
 /// The band pass's uniform for one light's maps.
 fn edge_light(p: &HybridParams, maps: &LightMaps, restriction: u32) -> EdgeLight {
     EdgeLight {
@@ -425,8 +506,12 @@ impl ShadowTechnique for Hybrid {
             gpu.targets = Targets::new(&ctx.gpu.device, ctx.size);
         }
         if changes.scene || ctx.lights.len() != gpu.lights || gpu.generator.volume().is_none() {
-            gpu.generator.prepare(ctx, Volumes::Silhouette);
+            let budget = self.params.volume_budget();
+            gpu.generator.prepare(ctx, Volumes::Silhouette, budget)?;
             gpu.lights = ctx.lights.len();
+        } else if changes.lights {
+            // The casters each light reaches, and so its pieces, follow the lights.
+            gpu.generator.plan(ctx);
         }
         gpu.maps.prepare(ctx, changes, self.params.map_size, true);
         if let (Some(depth), Some(cameras)) = (gpu.maps.maps(), gpu.maps.cameras()) {
@@ -513,58 +598,14 @@ impl ShadowTechnique for Hybrid {
             if exact {
                 continue;
             }
-            let (Some(volume), Some(args)) = (gpu.generator.volume(), gpu.generator.args()) else {
-                return Err(TechniqueError::not_prepared());
-            };
-            let generation = light_pass_name(GENERATION_PASS, light);
-            gpu.generator.record(ctx, recorder, light, &generation)?;
-            let showing = |view| lookup.debug && ctx.debug_view == Some(view);
-            // The count view reads the stencil after the volumes.
-            let keep = if showing(COUNTS_VIEW) {
-                wgpu::StoreOp::Store
-            } else {
-                wgpu::StoreOp::Discard
-            };
-            let depth = wgpu::RenderPassDepthStencilAttachment {
-                view: band,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: keep,
-                }),
-                stencil_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: keep,
-                }),
-            };
-            let tiles = gpu
-                .tiles
-                .as_ref()
-                .filter(|_| p.restriction == Restriction::Tiles);
-            if let Some(tiles) = tiles {
-                tiles.record_list(recorder, &light_pass_name(TILES_PASS, light), args)?;
-                if showing(TILES_VIEW) {
-                    let name = light_pass_name(DEBUG_PASS, light);
-                    tiles.record_overlay(ctx, recorder, &gpu.targets.tiles.1, &name)?;
-                }
-            }
-            let name = light_pass_name(VOLUME_PASS, light);
-            let mut pass = ctx.light_pass(recorder, &name, light, Some(depth));
-            if let Some(tiles) = tiles {
-                tiles.draw(&mut pass, volume)?;
-            } else {
-                pass.set_pipeline(&gpu.volume);
-                pass.set_vertex_buffer(0, volume.slice(..));
-                pass.draw_indirect(args, 0);
-            }
-            pass.set_pipeline(&gpu.resolve);
-            pass.set_stencil_reference(0);
-            pass.draw(0..3, 0..1);
-            drop(pass);
-            if showing(COUNTS_VIEW) {
-                record_counts(ctx, recorder, gpu, light)?;
-            }
+            let tiled = p.restriction == Restriction::Tiles;
+            record_volumes(ctx, recorder, gpu, (light, lookup.debug), tiled)?;
         }
         Ok(())
+    }
+
+    fn warnings(&self) -> Vec<String> {
+        (self.gpu.built()).map_or(Vec::new(), |gpu| gpu.generator.warnings())
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -574,9 +615,11 @@ impl ShadowTechnique for Hybrid {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        self.gpu
-            .built()
-            .map_or(Vec::new(), |gpu| gpu.maps.counters())
+        self.gpu.built().map_or(Vec::new(), |gpu| {
+            let mut out = gpu.maps.counters();
+            out.extend(gpu.generator.counters());
+            out
+        })
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {

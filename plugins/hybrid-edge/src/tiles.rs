@@ -247,25 +247,37 @@ impl Tiles {
         });
     }
 
-    /// Lists the edge tiles of the band depth image in compute pass `name`, with the volume's
-    /// vertex count taken from `volume_args` (the generator's draw arguments).
+    /// Lists the edge tiles of the band depth image in compute pass `name`, once per light
+    /// (its volume pieces are all drawn into the listed tiles).
     pub(crate) fn record_list(
         &self,
         recorder: &mut PassRecorder<'_>,
         name: &str,
+    ) -> TechniqueResult {
+        let bound = self
+            .bound
+            .as_ref()
+            .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
+        recorder.encoder().clear_buffer(&bound.args, 0, None);
+        let mut pass = recorder.compute_pass(name);
+        pass.set_pipeline(&self.compute);
+        pass.set_bind_group(0, &bound.compute_group, &[]);
+        pass.dispatch_workgroups(bound.params.tiles_x, bound.params.tiles_y, 1);
+        Ok(())
+    }
+
+    /// Takes the vertex count of the volume piece just generated from `volume_args` (the
+    /// generator's draw arguments) for the next [`Self::draw`].
+    pub(crate) fn take_vertex_count(
+        &self,
+        recorder: &mut PassRecorder<'_>,
         volume_args: &wgpu::Buffer,
     ) -> TechniqueResult {
         let bound = self
             .bound
             .as_ref()
             .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
-        let encoder = recorder.encoder();
-        encoder.clear_buffer(&bound.args, 0, None);
-        encoder.copy_buffer_to_buffer(volume_args, 0, &bound.args, 0, 4);
-        let mut pass = recorder.compute_pass(name);
-        pass.set_pipeline(&self.compute);
-        pass.set_bind_group(0, &bound.compute_group, &[]);
-        pass.dispatch_workgroups(bound.params.tiles_x, bound.params.tiles_y, 1);
+        (recorder.encoder()).copy_buffer_to_buffer(volume_args, 0, &bound.args, 0, 4);
         Ok(())
     }
 
@@ -302,7 +314,8 @@ impl Tiles {
         Ok(())
     }
 
-    /// Draws the volume into the listed tiles (in a pass with the band attached).
+    /// Draws the volume piece into the listed tiles (in a pass with the band attached), with
+    /// the vertex count [`Self::take_vertex_count`] took.
     pub(crate) fn draw(
         &self,
         pass: &mut wgpu::RenderPass<'_>,

@@ -5,10 +5,12 @@
 //! triangles facing the light (and, for open or non-manifold meshes, from every triangle
 //! oriented toward it), and side quads on edges whose face orientations do not cancel, counted
 //! with multiplicity. Vertices are extruded to infinity (w = 0) and drawn with unclipped depth
-//! (`DEPTH_CLIP_CONTROL`), so counting is robust with the camera anywhere. One two-sided draw
+//! (`DEPTH_CLIP_CONTROL`), so counting is robust with the camera anywhere. A two-sided draw
 //! updates the G-buffer's stencil (z-fail: back faces increment and front faces decrement where
 //! the depth test fails, with wrap); a full-screen pass then writes visibility 0 where the count
-//! is not zero.
+//! is not zero. Where the volumes may need more vertices than one buffer the device binds holds
+//! (a crowd of instances), each light's are generated and drawn in pieces that fit it, their
+//! counts adding up in the one stencil, so no triangle count makes the shadows inexact.
 
 use zoo_host::params::TechniqueParams;
 use zoo_host::scene::LightKind;
@@ -18,10 +20,12 @@ use zoo_host::{
     TechniqueError, wgpu,
 };
 
+mod passes;
 mod pipelines;
 
-use pipelines::{Buffers, COUNT_LEVELS, DebugTargets, Pipelines, SLOT};
-use zoo_shadow_volumes::ARGS_BYTES;
+use pipelines::{Buffers, DebugTargets, Pipelines};
+use zoo_host::kit::light_pass_name;
+use zoo_shadow_volumes::{ARGS_BYTES, piece_pass_name};
 pub use zoo_shadow_volumes::{Counting, Volumes, silhouette};
 
 zoo_host::technique_params! {
@@ -41,6 +45,18 @@ zoo_host::technique_params! {
         slope_bias: f32 = 0.0, range(0.0, 8.0), step(0.1), flags(rebuild);
         /// Light whose volumes and stencil counts the debug views show.
         debug_light: u32 = 0, range(0, 1023), step(1);
+        /// Largest volume vertex buffer in MiB (0: as large as the device binds). Volumes that
+        /// may need more are generated and drawn in pieces that fit it, their stencil counts
+        /// adding up, so the shadows stay exact; smaller pieces take less memory and more
+        /// passes.
+        volume_buffer_mib: u32 = 0, range(0, 4096), step(1), flags(rebuild);
+    }
+}
+
+impl SvParams {
+    /// The volume buffer's budget in bytes, if one is set.
+    fn volume_budget(&self) -> Option<u64> {
+        (self.volume_buffer_mib > 0).then(|| u64::from(self.volume_buffer_mib) << 20)
     }
 }
 
@@ -73,24 +89,17 @@ impl ShadowVolumes {
             .collect();
         (0..self.lights)
             .map(|light| {
+                // The light's counters after its last piece.
                 let base = light * (ARGS_BYTES as usize / 4);
-                (words[base + 4], words[base] / 3)
+                (words[base + 4], words[base + 5] / 3)
             })
             .collect()
     }
 }
 
-fn volume_pass_name(light: usize) -> String {
-    format!("Shadow volumes: light {light}")
-}
-
-fn generation_pass_name(light: usize) -> String {
-    format!("Volume generation: light {light}")
-}
-
-fn debug_pass_name(light: usize) -> String {
-    format!("Volume debug: light {light}")
-}
+const VOLUME_PASS: &str = "Shadow volumes";
+const GENERATION_PASS: &str = "Volume generation";
+const DEBUG_PASS: &str = "Volume debug";
 
 impl ShadowTechnique for ShadowVolumes {
     fn resources(&self) -> Vec<ResourceInfo> {
@@ -116,11 +125,15 @@ impl ShadowTechnique for ShadowVolumes {
         if changes.scene || count_changed || self.buffers.is_none() {
             self.lights = ctx.lights.len();
             let generator = &mut self.pipelines.as_mut().expect("created above").generator;
-            generator.prepare(ctx, self.params.volumes);
+            generator.prepare(ctx, self.params.volumes, self.params.volume_budget())?;
             self.buffers = Some(Buffers::new(
                 ctx,
                 self.pipelines.as_ref().expect("built above"),
             ));
+        } else if changes.lights {
+            // The casters each light reaches, and so its pieces, follow the lights.
+            let generator = &mut self.pipelines.as_mut().expect("created above").generator;
+            generator.plan(ctx);
         }
         if changes.resolution || self.debug.is_none() {
             self.debug = Some(DebugTargets::new(&ctx.gpu.device, ctx.size));
@@ -134,11 +147,9 @@ impl ShadowTechnique for ShadowVolumes {
         recorder: &mut PassRecorder<'_>,
     ) -> Result<(), TechniqueError> {
         let (Some(p), Some(b), Some(debug)) = (&self.pipelines, &self.buffers, &self.debug) else {
-            return Err(TechniqueError::Other(
-                "sv-zfail: record before prepare".into(),
-            ));
+            return Err(TechniqueError::not_prepared());
         };
-        let (Some(volume), Some(args)) = (p.generator.volume(), p.generator.args()) else {
+        let Some(args) = p.generator.args() else {
             return Err(TechniqueError::not_prepared());
         };
         let stats = b
@@ -146,22 +157,22 @@ impl ShadowTechnique for ShadowVolumes {
             .lock()
             .ok()
             .and_then(|mut ring| ring.target().cloned());
+        let showing_debug = matches!(ctx.debug_view, Some("stencil counts" | "volumes"));
         for light in 0..self.lights {
-            p.generator
-                .record(ctx, recorder, light, &generation_pass_name(light))?;
-            {
-                let name = volume_pass_name(light);
-                let stencil = zoo_host::gpu::stencil_attachment(
-                    &ctx.gbuffer.depth_view,
-                    wgpu::LoadOp::Clear(0),
-                );
-                let mut pass = ctx.light_pass(recorder, &name, light, stencil);
-                pass.set_pipeline(&p.volume);
-                pass.set_vertex_buffer(0, volume.slice(..));
-                pass.draw_indirect(args, 0);
-                pass.set_pipeline(&p.resolve);
-                pass.set_stencil_reference(0);
-                pass.draw(0..3, 0..1);
+            let debug_here = showing_debug && light as u32 == self.params.debug_light;
+            let pieces = p.generator.pieces(light);
+            // Each piece is generated into the one buffer and counted into the light's
+            // stencil before the next.
+            for piece in 0..pieces {
+                let name = piece_pass_name(GENERATION_PASS, light, piece);
+                p.generator.record(ctx, recorder, (light, piece), &name)?;
+                let last = piece + 1 == pieces;
+                let name = piece_pass_name(VOLUME_PASS, light, piece);
+                passes::record_volume(ctx, recorder, p, (light, piece, last), &name)?;
+                if debug_here {
+                    let name = piece_pass_name(DEBUG_PASS, light, piece);
+                    passes::record_overlay(ctx, recorder, p, debug, piece, &name)?;
+                }
             }
             if let Some(stats) = &stats {
                 recorder.encoder().copy_buffer_to_buffer(
@@ -172,41 +183,16 @@ impl ShadowTechnique for ShadowVolumes {
                     ARGS_BYTES,
                 );
             }
-            let showing_debug = matches!(ctx.debug_view, Some("stencil counts" | "volumes"));
-            if showing_debug && light as u32 == self.params.debug_light {
-                let name = debug_pass_name(light);
-                let clear = |view| {
-                    zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::BLACK))
-                };
-                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(&name),
-                    color_attachments: &[clear(&debug.counts.1), clear(&debug.overlay.1)],
-                    depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
-                        &ctx.gbuffer.depth_view,
-                        wgpu::LoadOp::Load,
-                    ),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-                // Any non-zero count first (level 9), then the exact levels.
-                pass.set_pipeline(&p.count_any);
-                pass.set_stencil_reference(0);
-                pass.set_bind_group(1, &b.levels_bind_group, &[0]);
-                pass.draw(0..3, 0..1);
-                pass.set_pipeline(&p.count_equal);
-                for (k, level) in COUNT_LEVELS.iter().enumerate() {
-                    pass.set_stencil_reference(*level);
-                    pass.set_bind_group(1, &b.levels_bind_group, &[((k as u64 + 1) * SLOT) as u32]);
-                    pass.draw(0..3, 0..1);
-                }
-                pass.set_pipeline(&p.overlay);
-                pass.set_vertex_buffer(0, volume.slice(..));
-                pass.draw_indirect(args, 0);
+            if debug_here {
+                let name = light_pass_name(DEBUG_PASS, light);
+                passes::record_counts(ctx, recorder, p, b, debug, &name);
             }
         }
         Ok(())
+    }
+
+    fn warnings(&self) -> Vec<String> {
+        (self.pipelines.as_ref()).map_or(Vec::new(), |p| p.generator.warnings())
     }
 
     fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
@@ -231,10 +217,8 @@ impl ShadowTechnique for ShadowVolumes {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        self.workload()
-            .into_iter()
-            .enumerate()
-            .flat_map(|(light, (silhouettes, triangles))| {
+        let workload = self.workload().into_iter().enumerate().flat_map(
+            |(light, (silhouettes, triangles))| {
                 [
                     (
                         format!("light {light} silhouette edges"),
@@ -242,8 +226,10 @@ impl ShadowTechnique for ShadowVolumes {
                     ),
                     (format!("light {light} volume triangles"), triangles as f64),
                 ]
-            })
-            .collect()
+            },
+        );
+        let pieces = (self.pipelines.iter()).flat_map(|p| p.generator.counters());
+        workload.chain(pieces).collect()
     }
 }
 
