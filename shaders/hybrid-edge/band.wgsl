@@ -306,28 +306,5 @@ fn fs_band_ids(in: FullscreenOut) -> BandOut {
     return out;
 }
 
-// Pass 4: edge pixels inside a volume (non-zero count) are shadowed.
-@fragment
-fn fs_shadowed() -> @location(0) vec4<f32> {
-    return vec4<f32>(0.0);
-}
-
-// Debug: the stencil counts left by the volumes, drawn once per count level with the stencil
-// test selecting the pixels; the level's id comes in as the instance index.
-struct CountVertex {
-    @builtin(position) position: vec4<f32>,
-    @location(0) @interpolate(flat) level: u32,
-}
-
-@vertex
-fn vs_count(@builtin(vertex_index) vertex: u32, @builtin(instance_index) level: u32) -> CountVertex {
-    var out: CountVertex;
-    out.position = fullscreen_position(vertex);
-    out.level = level;
-    return out;
-}
-
-@fragment
-fn fs_count(in: CountVertex) -> @location(0) u32 {
-    return in.level;
-}
+// Pass 4, edge pixels inside a volume (non-zero count) shadowed, and the count view are the
+// shadow-volume library's (`shadow-volumes/stencil_read.wgsl`).

@@ -9,8 +9,8 @@
 
 @group(1) @binding(0) var<uniform> layer_camera: LayerCamera;
 // The scene's vertices (`VERTEX_FLOATS` floats each) and triangle indices.
-@group(1) @binding(1) var<storage, read> scene_vertices: array<f32>;
-@group(1) @binding(2) var<storage, read> scene_indices: array<u32>;
+@group(2) @binding(0) var<storage, read> scene_vertices: array<f32>;
+@group(2) @binding(1) var<storage, read> scene_indices: array<u32>;
 
 // A clip position outside the clip volume, for triangles that draw nothing.
 const OUTSIDE_CLIP: vec4<f32> = vec4<f32>(2.0, 2.0, 2.0, 1.0);

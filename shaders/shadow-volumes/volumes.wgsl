@@ -8,7 +8,9 @@
 // so sides shared by two emitting triangles cancel and boundary or non-manifold edges close
 // the volume exactly as per-triangle volumes would.
 // Both run once per part of the scene (`Part`): the triangles stored in world space, then each
-// instance's shared triangles under its placement.
+// instance's shared triangles under its placement, or a stretch of one's triangles or edges.
+// A light's parts may come in pieces, each generated into the same buffer and drawn before
+// the next: `tally` adds each piece's vertices to the light's total.
 
 #import "common/vertices.wgsl"
 #import "common/frame.wgsl"
@@ -33,7 +35,9 @@ struct DrawArgs {
     instance_count: u32,
     first_vertex: u32,
     first_instance: u32,
+    // The light's counts over its pieces so far.
     silhouette_edges: atomic<u32>,
+    total_vertices: u32,
 }
 
 @group(1) @binding(0) var<storage, read> vertices: array<f32>;
@@ -44,8 +48,8 @@ struct DrawArgs {
 @group(1) @binding(5) var<storage, read_write> weights: array<i32>;
 @group(1) @binding(6) var<storage, read_write> volume: array<vec4<f32>>;
 @group(1) @binding(7) var<storage, read_write> draw: DrawArgs;
-@group(1) @binding(8) var<uniform> params: Params;
-@group(1) @binding(9) var<uniform> part: Part;
+@group(2) @binding(0) var<uniform> params: Params;
+@group(3) @binding(0) var<uniform> part: Part;
 
 fn position(index: u32) -> vec3<f32> {
     let base = index * VERTEX_FLOATS;
@@ -66,9 +70,12 @@ fn extrude(p: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(p - light.position, 0.0);
 }
 
+// The first of `count` vertices in the volume, or 0xffffffff where the piece is full (its
+// pieces are planned so that it never is): the count drawn then stays within the buffer.
 fn allocate(count: u32) -> u32 {
     let base = atomicAdd(&draw.vertex_count, count);
     if base + count > params.capacity {
+        atomicSub(&draw.vertex_count, count);
         return 0xffffffffu;
     }
     return base;
@@ -191,4 +198,10 @@ fn edges_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
             emit_side(p1, p0);
         }
     }
+}
+
+// Adds the piece just generated to the light's vertex total (one invocation).
+@compute @workgroup_size(1)
+fn tally() {
+    draw.total_vertices += atomicLoad(&draw.vertex_count);
 }

@@ -14,6 +14,67 @@ zoo_host::register_technique! {
     create: |_, _| Ok(Box::new(Inert)),
 }
 
+/// A test-only technique that shadows nothing and says it cannot meet something.
+struct Warns;
+
+impl zoo_host::ShadowTechnique for Warns {
+    fn prepare(
+        &mut self,
+        _: &zoo_host::RenderContext<'_>,
+        _: zoo_host::Changes,
+    ) -> zoo_host::TechniqueResult {
+        Ok(())
+    }
+    fn record(
+        &mut self,
+        _: &zoo_host::RenderContext<'_>,
+        _: &mut zoo_host::PassRecorder<'_>,
+    ) -> zoo_host::TechniqueResult {
+        Ok(())
+    }
+    fn warnings(&self) -> Vec<String> {
+        vec!["test-warns: half the shadows are dropped".to_string()]
+    }
+}
+
+zoo_host::register_technique! {
+    id: "test-warns",
+    name: "Test: warns",
+    description: "Shadows nothing and says so (test only)",
+    source: "test",
+    light_kinds: &[LightKind::Point, LightKind::Spot, LightKind::Directional],
+    create: |_, _| Ok(Box::new(Warns)),
+}
+
+#[test]
+fn warnings_reach_the_judged_results_and_the_compare_report() {
+    let run = judge("planar-room.ron", "test-warns", &[], UVec2::new(64, 64));
+    let warning = "test-warns: half the shadows are dropped";
+    assert_eq!(run.judged.warnings, [warning]);
+    let view = shadow_zoo::compare::JudgedView {
+        view: 0,
+        time: None,
+        reference: run.reference,
+        judged: vec![run.judged],
+        flip: vec![None],
+        indirect: Vec::new(),
+    };
+    let summary = shadow_zoo::compare::summary_table(&view);
+    assert!(
+        summary.contains(&format!("warning: {warning}")),
+        "{summary}"
+    );
+    let views = [view];
+    let report = shadow_zoo::compare::warnings_md(&views).unwrap();
+    assert!(
+        report.contains(&format!("`test-warns`: {warning}")),
+        "{report}"
+    );
+    // Techniques that meet everything add no line.
+    let quiet = judge("planar-room.ron", "unshadowed", &[], UVec2::new(64, 64));
+    assert!(quiet.judged.warnings.is_empty());
+}
+
 #[test]
 fn unsupported_light_kinds_are_reported_not_scored() {
     let run = judge(

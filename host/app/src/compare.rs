@@ -595,7 +595,9 @@ pub fn images_csv(scene: &str, views: &[JudgedView]) -> String {
     out
 }
 
-fn summary_table(view: &JudgedView) -> String {
+/// The summary `compare` prints for one view: per technique and light its metrics, its image
+/// score, and its notes and warnings.
+pub fn summary_table(view: &JudgedView) -> String {
     let mut out = String::new();
     for (j, flip) in view.judged.iter().zip(&view.flip) {
         for s in &j.scores {
@@ -633,8 +635,35 @@ fn summary_table(view: &JudgedView) -> String {
             )
             .expect("write to string");
         }
+        for warning in &j.warnings {
+            writeln!(out, "  {:16} warning: {warning}", j.technique).expect("write to string");
+        }
     }
     out
+}
+
+/// The report's list of what techniques could not meet (their
+/// [`zoo_host::ShadowTechnique::warnings`]), each once over the views; `None` where none
+/// warned.
+pub fn warnings_md(views: &[JudgedView]) -> Option<String> {
+    let mut seen: Vec<(&str, &str)> = Vec::new();
+    for j in views.iter().flat_map(|v| &v.judged) {
+        for warning in &j.warnings {
+            if !seen.contains(&(&j.technique, warning)) {
+                seen.push((&j.technique, warning));
+            }
+        }
+    }
+    if seen.is_empty() {
+        return None;
+    }
+    let mut out = String::from(
+        "- Warnings: what techniques could not meet here, so their results fall short of what they should be:\n",
+    );
+    for (technique, warning) in seen {
+        let _ = writeln!(out, "  - `{technique}`: {warning}");
+    }
+    Some(out)
 }
 
 /// Scores the indirect light of the techniques that add light in `view` against the
@@ -839,6 +868,9 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             "- Alpha-masked casters: the reference lets light through their holes; {} treat them as opaque (their registrations say so: shadow volumes cannot follow a texture)",
             masks_opaque.join(", ")
         );
+    }
+    if let Some(warnings) = warnings_md(r.views) {
+        w.push_str(&warnings);
     }
     let _ = writeln!(
         w,

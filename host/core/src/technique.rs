@@ -536,6 +536,14 @@ pub trait ShadowTechnique: Send {
         Ok(ParamUpdate::Rebuild)
     }
 
+    /// What it cannot meet for the current scene and lights (a limit of the device that
+    /// leaves part of its output out, for example), each a sentence naming the technique:
+    /// `compare`'s report and the viewer show them beside its results. Empty (the default)
+    /// where it renders what it should.
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
+
     /// Workload counters from the newest frame whose counters have arrived (silhouette
     /// edges, VPLs, ...); read back without stalling, so they may lag a frame or two.
     fn counters(&self) -> Vec<(String, f64)> {

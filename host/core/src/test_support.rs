@@ -432,3 +432,86 @@ impl JudgeRun {
             .collect()
     }
 }
+
+/// The real mesh of [`shared_models`] named `model` (`fandisk`, `teapot`, `cow`, `spot` or
+/// `stanford-bunny`) and the transform that stands it on the ground about a metre across.
+fn crowd_member(dir: &Path, model: &str) -> (PathBuf, &'static str) {
+    let transform = match model {
+        "fandisk" => "(translation: (-0.483, -2.52, 0.268), scale: (0.2, 0.2, 0.2))",
+        "teapot" => "(translation: (-0.035, 0, 0), scale: (0.16, 0.16, 0.16))",
+        "cow" => "(translation: (-0.078, 0.364, 0), scale: (0.1, 0.1, 0.1))",
+        "spot" => "(translation: (0, 0.74, 0), scale: (1, 1, 1))",
+        "stanford-bunny" => "(translation: (0.1, -0.2, 0), scale: (6, 6, 6))",
+        other => panic!("crowd_scene: no crowd of `{other}`"),
+    };
+    (dir.join(format!("{model}.obj")), transform)
+}
+
+/// A crowd: `count` instances of the real mesh `model` (see [`shared_models`]; `fandisk`,
+/// `teapot`, `cow`, `spot` or `stanford-bunny`), each turned its own way, on a square grid on
+/// a ground plane, seen from above at an angle and lit by one light of each of `lights` (a
+/// spot light and a point light above the crowd, a sun from the side). `None`, saying so,
+/// where the shared models are absent.
+pub fn crowd_scene(
+    model: &str,
+    count: usize,
+    lights: &[crate::LightKind],
+) -> Option<crate::scene::Scene> {
+    let dir = shared_models()?;
+    let (path, transform) = crowd_member(&dir, model);
+    let side = (count as f32).sqrt().ceil().max(1.0) as usize;
+    let spacing = 1.3;
+    let width = side as f32 * spacing;
+    let instances: Vec<String> = (0..count)
+        .map(|i| {
+            let x = ((i % side) as f32 + 0.5) * spacing - width / 2.0;
+            let z = ((i / side) as f32 + 0.5) * spacing - width / 2.0;
+            let yaw = (i * 137 % 360) as f32;
+            format!(
+                "(translation: ({x}, 0, {z}), rotation_degrees: (0, {yaw}, 0), scale: (1, 1, 1))"
+            )
+        })
+        .collect();
+    let (h, range) = (width + 3.0, 4.0 * width + 20.0);
+    let lights: Vec<String> = (lights.iter())
+        .map(|kind| match kind {
+            crate::LightKind::Spot => format!(
+                "Spot(position: ({}, {h}, {}), direction: ({}, {}, {}), intensity: {}, \
+                 range: {range}, angle_degrees: 45)",
+                0.3 * width,
+                0.2 * width,
+                -0.3 * width,
+                -h,
+                -0.2 * width,
+                h * h
+            ),
+            crate::LightKind::Point => format!(
+                "Point(position: ({}, {}, {}), intensity: {}, range: {range})",
+                -0.25 * width,
+                0.6 * h,
+                0.3 * width,
+                h * h
+            ),
+            crate::LightKind::Directional => {
+                "Directional(direction: (-0.6, -0.7, -0.4), intensity: 1)".to_string()
+            }
+        })
+        .collect();
+    let text = format!(
+        "(name: \"crowd-{count}-{model}\",
+          camera: (position: (0, {}, {}), target: (0, 0, 0), fov_y_degrees: 50),
+          lights: [{}],
+          objects: [(mesh: Plane(size: {}), receiver: true),
+                    (mesh: Obj(\"{}\"), transform: {transform}, instances: [{}])])",
+        0.9 * width + 2.0,
+        0.8 * width + 2.0,
+        lights.join(", "),
+        width + 4.0,
+        path.display(),
+        instances.join(", ")
+    );
+    Some(
+        crate::scene::Scene::from_ron(&text, Path::new("crowd.ron"), &dir)
+            .unwrap_or_else(|e| panic!("{e}")),
+    )
+}

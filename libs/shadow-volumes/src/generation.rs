@@ -7,48 +7,56 @@
 //! triangles cancel and boundary or non-manifold edges close the volume. The vertices (w = 0 at
 //! infinity) land in one buffer drawn with indirect arguments.
 //!
-//! Both passes run once per part: the triangles stored in world space, then each shadow-casting
-//! instance's shared triangles and edges under its placement, so instances share their
-//! geometry here as in every other pass.
+//! Both passes run once per unit of the work ([`crate::pieces`]): the triangles stored in world
+//! space, then each shadow-casting instance's shared triangles and edges under its placement,
+//! so instances share their geometry here as in every other pass. Where the volumes may need
+//! more vertices than one buffer the device binds (or the budget given) holds, each light's
+//! units are generated and drawn in pieces that fit it, one buffer reused by all.
 
 use zoo_host::glam::Mat4;
-use zoo_host::gpu::gpu_struct::round_up;
-use zoo_host::gpu::{GpuType, PassRecorder, gpu_bytes_padded};
+use zoo_host::gpu::PassRecorder;
+use zoo_host::kit::{SharedGroup, Stage, StageBindGroup, UniformSlots};
 use zoo_host::scene::{EdgeKind, Scene};
 use zoo_host::technique::ResourceInfo;
-use zoo_host::{RenderContext, TechniqueError, wgpu};
+use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
+
+use crate::culling::reaches_box;
+use crate::pieces::{Unit, pack, units};
 
 zoo_host::param_choice! {
     /// How volumes are built.
     pub enum Volumes { Silhouette, PerTriangle }
 }
 
-const FLAG_CASTS: u32 = 1;
+pub(crate) const FLAG_CASTS: u32 = 1;
 const FLAG_CLOSED: u32 = 2;
-const FLAG_PLACED: u32 = 4;
+pub(crate) const FLAG_PLACED: u32 = 4;
 /// Invocations per workgroup of both entry points (`@workgroup_size` in the shader).
 pub const WORKGROUP_SIZE: u32 = 64;
-/// Bytes between the per-light parameter slots and between the per-part slots (uniform
-/// dynamic-offset slots).
-const SLOT: u64 = 256;
-/// Draw arguments followed by the silhouette counter (`DrawArgs` in the shader).
-pub const ARGS_BYTES: u64 = 20;
+/// Draw arguments followed by the silhouette counter and the light's vertex total (`DrawArgs`
+/// in the shader).
+pub const ARGS_BYTES: u64 = 24;
+/// Bytes of one volume vertex (`vec4<f32>`).
+const VERTEX_BYTES: u64 = 16;
+/// Byte offset of the silhouette counter and the vertex total in the arguments.
+const COUNTERS_OFFSET: u64 = 16;
 
 zoo_host::gpu_struct! {
     "shadow-volumes/params.wgsl" =>
-    /// The per-light uniform of `shadow-volumes/volumes.wgsl`, in a [`SLOT`]-byte slot.
+    /// The per-light uniform of `shadow-volumes/volumes.wgsl`.
     #[derive(Debug, Clone, Copy)]
     pub struct Params {
         pub light: u32,
         pub mode: u32,
+        /// Vertices the volume buffer holds.
         pub capacity: u32,
     }
 }
 
 zoo_host::gpu_struct! {
     "shadow-volumes/part.wgsl" =>
-    /// The per-part uniform of `shadow-volumes/volumes.wgsl`, in a [`SLOT`]-byte slot: one
-    /// dispatch's triangles and edges, and the placement of their stored vertices.
+    /// The per-part uniform of `shadow-volumes/volumes.wgsl`: one dispatch's triangles and
+    /// edges, and the placement of their stored vertices.
     #[derive(Debug, Clone, Copy)]
     pub struct Part {
         pub to_world: Mat4,
@@ -59,48 +67,6 @@ zoo_host::gpu_struct! {
         /// 1 for an instance, 0 for the world-space part.
         pub instance: u32,
     }
-}
-
-// Each value fits its slot.
-const _: () = assert!(Params::SIZE <= SLOT as usize);
-const _: () = assert!(Part::SIZE <= SLOT as usize);
-
-/// The bytes of `values`, each in a [`SLOT`]-byte slot.
-fn in_slots<T: GpuType>(values: &[T]) -> Vec<u8> {
-    (values.iter())
-        .flat_map(|v| gpu_bytes_padded(v, SLOT as usize))
-        .collect()
-}
-
-/// The parts volumes are built from: every stored triangle and edge in world space (instances'
-/// triangles left out by their flag), then each shadow-casting instance's.
-pub fn parts(scene: &Scene) -> Vec<Part> {
-    let part = |to_world: Mat4,
-                triangles: std::ops::Range<usize>,
-                edges: &std::ops::Range<u32>,
-                instance| Part {
-        to_world,
-        first_triangle: triangles.start as u32,
-        triangle_count: triangles.len() as u32,
-        first_edge: edges.start,
-        edge_count: edges.len() as u32,
-        instance,
-    };
-    let everything = 0..scene.adjacency.edges.len() as u32;
-    let instances = (scene.objects.iter().enumerate())
-        .filter(|(_, o)| o.is_placed() && o.casts_shadows)
-        .map(|(i, o)| {
-            let triangles = o.indices.start / 3..o.indices.end / 3;
-            part(o.placement, triangles, &scene.adjacency.object_edges[i], 1)
-        });
-    std::iter::once(part(
-        zoo_host::glam::Mat4::IDENTITY,
-        0..scene.triangle_count(),
-        &everything,
-        0,
-    ))
-    .chain(instances)
-    .collect()
 }
 
 /// Per-triangle flags: casts shadows, belongs to a closed (all edges manifold) object, and is
@@ -119,23 +85,24 @@ pub fn triangle_flags(scene: &Scene) -> Vec<u32> {
     flags
 }
 
-/// Vertex capacity of the volume buffer for `scene` (caps, plus sides for the chosen mode),
-/// instances counted.
-pub fn volume_capacity(scene: &Scene, volumes: Volumes) -> u64 {
-    let adjacency = &scene.adjacency;
-    let (mut triangles, mut incidences) = (0u64, 0u64);
-    for (i, object) in scene.objects.iter().enumerate() {
-        triangles += object.indices.len() as u64 / 3;
-        let edges = &adjacency.object_edges[i];
-        incidences += (adjacency.edges[edges.start as usize..edges.end as usize].iter())
-            .map(|e| u64::from(e.face_count()))
-            .sum::<u64>();
+/// Volume vertices one piece may hold: as many as one storage binding and one buffer of the
+/// device take (`limits`), or as `budget` bytes take where given and smaller; at least a
+/// triangle's, and few enough for the shader's 32-bit counts.
+pub fn piece_vertices(limits: &wgpu::Limits, budget: Option<u64>) -> u64 {
+    let bytes = (limits.max_storage_buffer_binding_size)
+        .min(limits.max_buffer_size)
+        .min(budget.unwrap_or(u64::MAX));
+    (bytes / VERTEX_BYTES).clamp(24, u64::from(u32::MAX / 2))
+}
+
+/// The name of a pass of piece `piece` of light `light`'s volumes: `"{base}: light {light}"`,
+/// then `" piece {piece}"` after the first.
+pub fn piece_pass_name(base: &str, light: usize, piece: usize) -> String {
+    let name = zoo_host::kit::light_pass_name(base, light);
+    match piece {
+        0 => name,
+        _ => format!("{name} piece {piece}"),
     }
-    let sides = match volumes {
-        Volumes::Silhouette => 6 * incidences,
-        Volumes::PerTriangle => 18 * triangles,
-    };
-    (6 * triangles + sides).max(3)
 }
 
 /// Workgroups (x, y) of [`WORKGROUP_SIZE`] invocations covering `items` (more than 65535
@@ -151,94 +118,119 @@ struct Buffers {
     weights: wgpu::Buffer,
     volume: wgpu::Buffer,
     args: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
-    /// Each part's triangle and edge counts, in slot order.
-    parts: Vec<(u32, u32)>,
+    /// The generation group of each stage: caps, sides, tally.
+    groups: [StageBindGroup; 3],
+    volumes: Volumes,
+    /// Vertices the volume buffer holds.
+    capacity: u64,
+    /// The work, one uniform slot each.
+    units: Vec<Unit>,
+    /// Per light, its pieces: indices into `units`.
+    pieces: Vec<Vec<Vec<u32>>>,
+    /// What the pieces cannot hold.
+    unmet: Vec<String>,
 }
 
-/// The generation pipelines and, once prepared for a scene and its lights, the buffers.
+/// The generation stages and, once prepared for a scene and its lights, the buffers.
 pub struct VolumeGenerator {
     label: String,
-    triangles: wgpu::ComputePipeline,
-    edges: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    /// Caps (`triangles`), sides (`edges_main`) and the vertex tally (`tally`).
+    stages: [Stage; 3],
+    /// Per light, its parameters.
+    params: UniformSlots<Params>,
+    /// Per unit of work, its part.
+    parts: UniformSlots<Part>,
     buffers: Option<Buffers>,
 }
 
 impl VolumeGenerator {
-    /// Builds the compute pipelines (`label` names them and the buffers).
+    /// Builds the compute stages (`label` names them and the buffers).
     pub fn new(ctx: &RenderContext<'_>, label: &str) -> Result<VolumeGenerator, TechniqueError> {
-        let device = &ctx.gpu.device;
-        let module = ctx
-            .shaders
-            .create_module(device, "shadow-volumes/volumes.wgsl")?;
-        let stage = wgpu::ShaderStages::COMPUTE;
-        let storage = |binding, read_only| zoo_host::kit::storage(binding, stage, read_only);
-        let slot = |binding, size| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: stage,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: true,
-                min_binding_size: wgpu::BufferSize::new(size),
-            },
-            count: None,
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let params = UniformSlots::new(ctx.gpu, &format!("{label} light parameters"), 1, compute);
+        let parts = UniformSlots::new(ctx.gpu, &format!("{label} parts"), 1, compute);
+        let shared: [&dyn SharedGroup; 2] = [&params.at(0), &parts.at(0)];
+        let stage = |entry| {
+            Stage::compute("shadow-volumes/volumes.wgsl", entry)
+                .shared(&shared)
+                .build(ctx)
         };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(&format!("{label} generation layout")),
-            entries: &[
-                storage(0, true),
-                storage(1, true),
-                storage(2, true),
-                storage(3, true),
-                storage(4, true),
-                storage(5, false),
-                storage(6, false),
-                storage(7, false),
-                slot(8, round_up(Params::SIZE, 16) as u64),
-                slot(9, round_up(Part::SIZE, 16) as u64),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&format!("{label} generation pipeline layout")),
-            bind_group_layouts: &[Some(&ctx.frame.layout), Some(&layout)],
-            immediate_size: 0,
-        });
-        let compute = |what: &str, entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(&format!("{label} {what} pipeline")),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let stages = [stage("triangles")?, stage("edges_main")?, stage("tally")?];
         Ok(VolumeGenerator {
             label: label.to_string(),
-            triangles: compute("caps", "triangles"),
-            edges: compute("sides", "edges_main"),
-            layout,
+            stages,
+            params,
+            parts,
             buffers: None,
         })
     }
 
-    /// (Re)creates the buffers for the context's scene and lights, with `volumes` built from
-    /// silhouette edges or per triangle.
-    pub fn prepare(&mut self, ctx: &RenderContext<'_>, volumes: Volumes) {
+    /// (Re)creates the buffers and the units of work for the context's scene and number of
+    /// lights, with `volumes` built from silhouette edges or per triangle, in pieces of at most
+    /// `budget` bytes where given (and never more than the device binds), and plans each
+    /// light's pieces. Fails, saying why, where the scene's per-triangle data exceeds what the
+    /// device binds.
+    pub fn prepare(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        volumes: Volumes,
+        budget: Option<u64>,
+    ) -> TechniqueResult {
         let device = &ctx.gpu.device;
         let label = &self.label;
         let scene = ctx.scene;
+        let limits = device.limits();
+        let per_triangle = 4 * scene.triangle_count() as u64;
+        let binds = limits.max_storage_buffer_binding_size;
+        if per_triangle > binds.min(limits.max_buffer_size) {
+            return Err(TechniqueError::Unavailable {
+                id: label.clone(),
+                reason: format!(
+                    "the scene stores {} triangles, whose weights ({per_triangle} bytes) exceed \
+                     the {binds} bytes the device binds",
+                    scene.triangle_count()
+                ),
+            });
+        }
         let flags = triangle_flags(scene);
-        let needed = volume_capacity(scene, volumes);
-        let limit = device.limits().max_storage_buffer_binding_size / 16;
+        let limit = piece_vertices(&limits, budget);
+        let work = units(scene, &flags, volumes, limit);
+        let needed: u64 = (work.units.iter())
+            .map(|u| u.emitters.most_vertices(volumes))
+            .sum();
+        let capacity = needed.clamp(24, limit);
         if needed > limit {
-            zoo_host::log::warn!(
-                "{label}: volumes may need {needed} vertices, the device binds at most {limit}; \
-                 extra volume geometry is dropped"
+            zoo_host::log::info!(
+                "{label}: volumes may need {needed} vertices, a piece holds {capacity}: \
+                 each light's are generated and drawn in pieces"
             );
         }
-        let capacity = needed.min(limit) as u32;
+        let params: Vec<Params> = (0..ctx.lights.len().max(1))
+            .map(|light| Params {
+                light: light as u32,
+                mode: u32::from(volumes == Volumes::PerTriangle),
+                capacity: capacity as u32,
+            })
+            .collect();
+        let parts: Vec<Part> = work.units.iter().map(|u| u.part).collect();
+        self.params.write(ctx.gpu, &params);
+        self.parts.write(ctx.gpu, &parts);
+        self.buffers = Some(self.buffers(ctx, &flags, (volumes, capacity), work)?);
+        self.plan(ctx);
+        Ok(())
+    }
+
+    /// The buffers for `work` on the context's scene and lights, with `volumes` built into
+    /// a buffer of `capacity` vertices.
+    fn buffers(
+        &self,
+        ctx: &RenderContext<'_>,
+        flags: &[u32],
+        (volumes, capacity): (Volumes, u64),
+        work: crate::pieces::Units,
+    ) -> TechniqueResult<Buffers> {
+        let device = &ctx.gpu.device;
+        let label = &self.label;
         let init = |what: &str, contents: &[u8], usage| {
             wgpu::util::DeviceExt::create_buffer_init(
                 device,
@@ -249,22 +241,20 @@ impl VolumeGenerator {
                 },
             )
         };
-        let empty = |what: &str, size: u64, usage| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(&format!("{label} {what}")),
-                size: size.max(16),
-                usage,
-                mapped_at_creation: false,
-            })
-        };
         let storage = wgpu::BufferUsages::STORAGE;
-        let triangle_flags = init("triangle flags", bytemuck::cast_slice(&flags), storage);
-        let weights = empty("triangle weights", 4 * flags.len() as u64, storage);
-        let volume = empty(
-            "volume vertices",
-            16 * capacity as u64,
-            storage | wgpu::BufferUsages::VERTEX,
-        );
+        let triangle_flags = init("triangle flags", bytemuck::cast_slice(flags), storage);
+        let weights = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(&format!("{label} triangle weights")),
+            size: (4 * flags.len() as u64).max(16),
+            usage: storage,
+            mapped_at_creation: false,
+        });
+        let volume = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(&format!("{label} volume vertices")),
+            size: VERTEX_BYTES * capacity,
+            usage: storage | wgpu::BufferUsages::VERTEX,
+            mapped_at_creation: false,
+        });
         let args = init(
             "draw arguments",
             bytemuck::cast_slice(&[0u32, 1, 0, 0, 0, 0, 0, 0]),
@@ -273,98 +263,120 @@ impl VolumeGenerator {
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::COPY_SRC,
         );
-        let params: Vec<Params> = (0..ctx.lights.len().max(1))
-            .map(|light| Params {
-                light: light as u32,
-                mode: u32::from(volumes == Volumes::PerTriangle),
-                capacity,
-            })
-            .collect();
-        let params = init(
-            "light parameters",
-            &in_slots(&params),
-            wgpu::BufferUsages::UNIFORM,
-        );
-        let parts = parts(scene);
-        let part_slots = init("parts", &in_slots(&parts), wgpu::BufferUsages::UNIFORM);
         let b = ctx.scene_buffers;
-        fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }
-        }
-        // One whole slot, at dynamic offsets.
-        fn slot_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(SLOT),
-                }),
-            }
-        }
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(&format!("{label} generation bind group")),
-            layout: &self.layout,
-            entries: &[
-                entry(0, &b.vertices),
-                entry(1, &b.indices),
-                entry(2, &b.edges),
-                entry(3, &b.edge_faces),
-                entry(4, &triangle_flags),
-                entry(5, &weights),
-                entry(6, &volume),
-                entry(7, &args),
-                slot_entry(8, &params),
-                slot_entry(9, &part_slots),
-            ],
-        });
-        self.buffers = Some(Buffers {
+        let resources = [
+            ("vertices", b.vertices.as_entire_binding()),
+            ("indices", b.indices.as_entire_binding()),
+            ("edges", b.edges.as_entire_binding()),
+            ("edge_faces", b.edge_faces.as_entire_binding()),
+            ("triangle_flags", triangle_flags.as_entire_binding()),
+            ("weights", weights.as_entire_binding()),
+            ("volume", volume.as_entire_binding()),
+            ("draw", args.as_entire_binding()),
+        ];
+        let group_label = format!("{label} generation group");
+        let [caps, sides, tally] = &self.stages;
+        let groups = [
+            caps.bind(ctx, &group_label, &resources)?,
+            sides.bind(ctx, &group_label, &resources)?,
+            tally.bind(ctx, &group_label, &resources)?,
+        ];
+        Ok(Buffers {
             triangle_flags,
             weights,
             volume,
             args,
-            bind_group,
-            parts: (parts.iter())
-                .map(|p| (p.triangle_count, p.edge_count))
-                .collect(),
-        });
+            groups,
+            volumes,
+            capacity,
+            units: work.units,
+            pieces: Vec::new(),
+            unmet: work.unmet,
+        })
     }
 
-    /// Records compute pass `name` that builds light `light`'s volume into [`Self::volume`]
-    /// and its vertex count (and silhouette-edge counter) into [`Self::args`].
+    /// Packs each of the context's lights' units into pieces: those of the instances the
+    /// light reaches (all for a directional light), each piece at most the buffer's capacity
+    /// for the light's kind. Called by [`Self::prepare`]; call it again after lights move.
+    pub fn plan(&mut self, ctx: &RenderContext<'_>) {
+        let Some(b) = &mut self.buffers else { return };
+        let scene = ctx.scene;
+        b.pieces = (ctx.lights.iter())
+            .map(|light| {
+                let directional = light.kind == zoo_host::LightKind::Directional;
+                let needed = |unit: &Unit| {
+                    let reached = unit.object.is_none_or(|i| {
+                        (scene.objects[i].bounds).is_none_or(|bounds| reaches_box(light, bounds))
+                    });
+                    reached.then(|| unit.emitters.vertices(b.volumes, directional))
+                };
+                pack(&b.units, b.capacity, needed)
+            })
+            .collect();
+    }
+
+    /// The number of pieces light `light`'s volumes are generated and drawn in (0 before
+    /// [`Self::prepare`]).
+    pub fn pieces(&self, light: usize) -> usize {
+        (self.buffers.as_ref())
+            .and_then(|b| b.pieces.get(light))
+            .map_or(0, Vec::len)
+    }
+
+    /// Records compute pass `name` that builds piece `piece` of light `light`'s volume into
+    /// [`Self::volume`] and its vertex count into [`Self::args`], adding its silhouette edges
+    /// and vertices to the light's counters there (reset by piece 0). Draw each piece before
+    /// recording the next.
     pub fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-        light: usize,
+        (light, piece): (usize, usize),
         name: &str,
-    ) -> Result<(), TechniqueError> {
+    ) -> TechniqueResult {
         let b = self
             .buffers
             .as_ref()
             .ok_or_else(TechniqueError::not_prepared)?;
-        // Reset the vertex count (keeping instance_count = 1) and the silhouette counter.
+        let units = (b.pieces.get(light))
+            .and_then(|pieces| pieces.get(piece))
+            .ok_or_else(TechniqueError::not_prepared)?;
+        // Reset the vertex count (keeping instance_count = 1), and the light's counters first.
         let encoder = recorder.encoder();
         encoder.clear_buffer(&b.args, 0, Some(4));
-        encoder.clear_buffer(&b.args, 16, Some(4));
-        let mut pass = recorder.compute_pass(name);
-        pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-        // Each part's triangles weigh in before its edges read the weights (wgpu orders the
-        // dispatches' storage accesses).
-        for (k, &(triangles, edges)) in b.parts.iter().enumerate() {
-            let offsets = [light as u64 * SLOT, k as u64 * SLOT].map(|o| o as u32);
-            pass.set_bind_group(1, &b.bind_group, &offsets);
-            let (x, y) = dispatch_size(triangles);
-            pass.set_pipeline(&self.triangles);
-            pass.dispatch_workgroups(x, y, 1);
-            let (x, y) = dispatch_size(edges);
-            pass.set_pipeline(&self.edges);
-            pass.dispatch_workgroups(x, y, 1);
+        if piece == 0 {
+            encoder.clear_buffer(&b.args, COUNTERS_OFFSET, Some(ARGS_BYTES - COUNTERS_OFFSET));
         }
+        let mut pass = recorder.compute_pass(name);
+        let light_params = self.params.at(light);
+        // Each unit's triangles weigh in before its edges read the weights (wgpu orders the
+        // dispatches' storage accesses).
+        let [caps, sides, tally] = &self.stages;
+        for &k in units {
+            let part = &b.units[k as usize].part;
+            let shared: [&dyn SharedGroup; 2] = [&light_params, &self.parts.at(k as usize)];
+            for (items, stage, group) in [
+                (part.triangle_count, caps, &b.groups[0]),
+                (part.edge_count, sides, &b.groups[1]),
+            ] {
+                if items > 0 {
+                    let (x, y) = dispatch_size(items);
+                    let extent = [x * WORKGROUP_SIZE, y, 1];
+                    stage.dispatch_in(ctx, &mut pass, (&[group], &shared), extent)?;
+                }
+            }
+        }
+        let shared: [&dyn SharedGroup; 2] = [&light_params, &self.parts.at(0)];
+        tally.dispatch_in(ctx, &mut pass, (&[&b.groups[2]], &shared), [1, 1, 1])?;
         Ok(())
+    }
+
+    /// Counters: `light N volume pieces` for each light, once prepared.
+    pub fn counters(&self) -> Vec<(String, f64)> {
+        (self.buffers.iter())
+            .flat_map(|b| b.pieces.iter().enumerate())
+            .map(|(light, pieces)| (format!("light {light} volume pieces"), pieces.len() as f64))
+            .collect()
     }
 
     /// The volume vertices (`vec4<f32>`, [`super::VOLUME_VERTEX_LAYOUT`]), once prepared.
@@ -372,10 +384,21 @@ impl VolumeGenerator {
         self.buffers.as_ref().map(|b| &b.volume)
     }
 
-    /// Indirect draw arguments (offset 0) and the silhouette-edge counter (offset 16), once
-    /// prepared: [`ARGS_BYTES`] bytes.
+    /// Indirect draw arguments of the last piece (offset 0), then the light's silhouette-edge
+    /// count (offset 16) and volume vertex total (offset 20) so far, once prepared:
+    /// [`ARGS_BYTES`] bytes.
     pub fn args(&self) -> Option<&wgpu::Buffer> {
         self.buffers.as_ref().map(|b| &b.args)
+    }
+
+    /// What the volumes cannot meet for the prepared scene, each a sentence naming the
+    /// generator: geometry that no piece can hold and is dropped. Empty where every volume is
+    /// exact.
+    pub fn warnings(&self) -> Vec<String> {
+        (self.buffers.iter())
+            .flat_map(|b| &b.unmet)
+            .map(|line| format!("{}: {line}", self.label))
+            .collect()
     }
 
     /// The buffers, for the memory table.
@@ -387,7 +410,7 @@ impl VolumeGenerator {
             ResourceInfo::buffer("volume vertices", &b.volume, "vec4<f32>"),
             ResourceInfo::buffer("triangle flags", &b.triangle_flags, "u32"),
             ResourceInfo::buffer("triangle weights", &b.weights, "i32"),
-            ResourceInfo::buffer("draw arguments", &b.args, "DrawIndirectArgs + counter"),
+            ResourceInfo::buffer("draw arguments", &b.args, "DrawIndirectArgs + counters"),
         ]
     }
 }

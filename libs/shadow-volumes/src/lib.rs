@@ -1,16 +1,23 @@
-//! Shadow-volume building blocks shared by techniques (sv-zfail today; the hybrid SM/SV
-//! technique next): volume generation on the GPU from the scene's edge adjacency
-//! ([`generation`], `shaders/shadow-volumes/volumes.wgsl`), its CPU mirror ([`silhouette`]),
-//! and the stencil states that count volumes with z-fail or z-pass ([`stencil`]).
+//! Shadow-volume building blocks shared by techniques (sv-zfail and the hybrid SM/SV
+//! technique): volume generation on the GPU from the scene's edge adjacency
+//! ([`generation`], `shaders/shadow-volumes/volumes.wgsl`) in pieces that fit the device's
+//! buffers ([`pieces`]), for the casters each light reaches ([`culling`]), its CPU mirror
+//! ([`silhouette`]), the stages that count volumes in the stencil with z-fail or z-pass and
+//! resolve the counts into visibility ([`stencil`]), and the count view ([`counts`]).
 
+pub mod counts;
+pub mod culling;
 pub mod generation;
+pub mod pieces;
 pub mod silhouette;
 pub mod stencil;
 
+pub use counts::{COUNT_LEVELS, COUNTS_FORMAT, StencilCounts};
 pub use generation::{
-    ARGS_BYTES, VolumeGenerator, Volumes, dispatch_size, triangle_flags, volume_capacity,
+    ARGS_BYTES, VolumeGenerator, Volumes, dispatch_size, piece_pass_name, piece_vertices,
+    triangle_flags,
 };
 pub use stencil::{
-    Counting, VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil, band_volume_pipeline, stencil_state,
-    volume_depth_stencil, volume_primitive,
+    Counting, VOLUME_BUFFERS, VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil, resolve_stage,
+    stencil_state, stencil_test, volume_depth_stencil, volume_primitive, volume_stage,
 };

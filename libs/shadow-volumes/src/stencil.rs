@@ -1,9 +1,11 @@
 //! Counting volume crossings in the stencil buffer.
 
-use zoo_host::RenderContext;
-use zoo_host::kit::{pipeline_layout, slot_target};
+use zoo_host::kit::{Stage, StageBuilder, slot_target};
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
-use zoo_host::wgpu;
+use zoo_host::{RenderContext, TechniqueResult, wgpu};
+
+/// The shader of the passes that read the counts.
+pub(crate) const STENCIL_READ: &str = "shadow-volumes/stencil_read.wgsl";
 
 zoo_host::param_choice! {
     /// How volume crossings are counted.
@@ -71,46 +73,55 @@ pub fn band_volume_depth_stencil(bias: wgpu::DepthBiasState) -> wgpu::DepthStenc
     stencil_state(wgpu::CompareFunction::Greater, front, back, bias)
 }
 
-/// A pipeline that counts volumes in a band ([`band_volume_depth_stencil`]) from vertex stage
-/// `vertex_entry` and fragment `fs_volume` of `module`, inside a light pass whose colour
-/// attachment is the light's visibility slot (left untouched), with the host's groups and then
-/// `groups`.
-pub fn band_volume_pipeline(
-    ctx: &RenderContext<'_>,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    vertex_entry: &str,
-    groups: &[&wgpu::BindGroupLayout],
-    bias: wgpu::DepthBiasState,
-) -> wgpu::RenderPipeline {
-    let layout = pipeline_layout(ctx, &format!("{label} layout"), groups);
+/// The volume vertex buffers of a draw ([`VOLUME_VERTEX_LAYOUT`]).
+pub const VOLUME_BUFFERS: &[Option<wgpu::VertexBufferLayout<'static>>] =
+    &[Some(VOLUME_VERTEX_LAYOUT)];
+
+/// A stage that draws volumes with `depth_stencil` ([`volume_depth_stencil`],
+/// [`band_volume_depth_stencil`]) from vertex entry `vertex` of `shader` and its fragment
+/// `fs_volume`, inside a light pass whose colour attachment is the light's visibility slot
+/// (left untouched). `shadow-volumes/draw.wgsl` has both entries.
+pub fn volume_stage<'a>(
+    shader: &'a str,
+    vertex: &'a str,
+    depth_stencil: wgpu::DepthStencilState,
+) -> StageBuilder<'a> {
     let untouched = Some(wgpu::ColorTargetState {
         write_mask: wgpu::ColorWrites::empty(),
         ..slot_target()
     });
-    ctx.gpu
-        .device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some(vertex_entry),
-                compilation_options: Default::default(),
-                buffers: &[Some(VOLUME_VERTEX_LAYOUT)],
-            },
-            primitive: volume_primitive(),
-            depth_stencil: Some(band_volume_depth_stencil(bias)),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module,
-                entry_point: Some("fs_volume"),
-                compilation_options: Default::default(),
-                targets: &[untouched],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+    Stage::render(shader, vertex)
+        .vertex_buffers(VOLUME_BUFFERS)
+        .primitive(volume_primitive())
+        .depth_stencil(depth_stencil)
+        .fragment("fs_volume")
+        .targets(&[untouched])
+}
+
+/// A state that keeps depth and stencil and passes where the stencil `compare`s true with the
+/// reference: the passes that read the counts.
+pub fn stencil_test(compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
+    let keep = wgpu::StencilOperation::Keep;
+    let face = wgpu::StencilFaceState {
+        compare,
+        fail_op: keep,
+        depth_fail_op: keep,
+        pass_op: keep,
+    };
+    stencil_state(
+        wgpu::CompareFunction::Always,
+        face,
+        face,
+        Default::default(),
+    )
+}
+
+/// The resolve: in a light pass over the counted stencil (reference 0), writes visibility 0
+/// wherever the count is not 0.
+pub fn resolve_stage(ctx: &RenderContext<'_>) -> TechniqueResult<Stage> {
+    Stage::fullscreen(STENCIL_READ, "fs_shadowed")
+        .depth_stencil(stencil_test(wgpu::CompareFunction::NotEqual))
+        .build(ctx)
 }
 
 /// A state on the G-buffer's depth-stencil that tests depth with `depth_compare` (never

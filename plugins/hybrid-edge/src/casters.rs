@@ -1,55 +1,69 @@
-//! Passes that render every caster triangle's id from one shadow-map layer with the vertices
-//! pulled from the scene's storage buffers (`shaders/hybrid-edge/casters.wgsl`): the
-//! triangle-id maps and the coverage maps. Group 1 holds the layer camera (a dynamic offset
-//! into the map set's camera buffer) and the scene's vertices and indices.
+//! Caster id maps: each shadow-map layer rendered once more from its camera, every caster
+//! triangle's id written per texel, with the vertices pulled from the scene's storage buffers
+//! (`shaders/hybrid-edge/casters.wgsl`). Two kinds:
+//! - triangle-id maps (`shaders/hybrid-edge/ids.wgsl`): depth and the index of the front-most
+//!   caster triangle per texel, rendered into the map set's depth maps in place of the
+//!   library's depth pass, so the depth maps and the ids come from one rasterisation;
+//! - coverage maps (`shaders/hybrid-edge/coverage.wgsl`): rendered conservatively into depth
+//!   maps of their own, so every texel a caster touches holds the id of a triangle touching
+//!   it, the one nearest the light at the texel's centre. The band pass tests a pixel's own
+//!   light ray against that triangle's plane: where the depth map's samples say lit but a
+//!   caster thinner than a texel may cross the ray, the pixel joins the edge band and the
+//!   exact pass decides.
 
-use zoo_host::gpu::{GpuType, PassRecorder};
-use zoo_host::kit::{bind_group, bind_group_layout, storage};
+use zoo_host::gpu::PassRecorder;
+use zoo_host::kit::{SharedGroup, Stage, StageBindGroup};
 use zoo_host::render::drawn_runs;
-use zoo_host::{RenderContext, TechniqueResult, wgpu};
-use zoo_shadow_maps::{CAMERA_STRIDE, DepthState, LayerCamera, MAP_FORMAT, MapArray, TilePass};
+use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
+use zoo_shadow_maps::{DepthState, MAP_FORMAT, MapArray, ShadowMapSet, TilePass};
 
 use crate::NO_TRIANGLE;
 
-/// A pipeline that writes, per texel of each tile it renders, depth and the id of a caster
-/// triangle (`R32Uint`), from the layer's camera.
-pub(crate) struct CasterIdPass {
-    pipeline: wgpu::RenderPipeline,
-    camera_layout: wgpu::BindGroupLayout,
+/// What a kind of caster id map is drawn with.
+pub(crate) struct CasterIds<'a> {
+    /// Names the maps and passes.
+    pub(crate) label: &'a str,
+    pub(crate) shader: &'a str,
+    pub(crate) entries: (&'a str, &'a str),
+    /// Culling and bias of the rasterisation.
+    pub(crate) state: DepthState,
+    /// Whether the maps have depth maps of their own (coverage), or render into the set's.
+    pub(crate) own_depth: bool,
 }
 
-impl CasterIdPass {
-    /// The pipeline of `shader`'s `vertex` and `fragment` entry points, rasterised with
-    /// `state`'s culling and bias; `label` names its objects.
+/// The maps made for one set of depth maps and scene.
+struct Bound {
+    /// The depth maps and scene vertices these were made for.
+    made_for: (wgpu::Texture, wgpu::Buffer),
+    ids: MapArray,
+    depth: Option<MapArray>,
+    scene: StageBindGroup,
+}
+
+/// A kind of caster id map: its stage and, once prepared, its maps.
+pub(crate) struct CasterIdMaps {
+    label: String,
+    own_depth: bool,
+    stage: Stage,
+    bound: Option<Bound>,
+}
+
+impl CasterIdMaps {
+    /// Builds the stage of `ids`, reading `set`'s layer cameras.
     pub(crate) fn new(
         ctx: &RenderContext<'_>,
-        label: &str,
-        shader: &str,
-        (vertex, fragment): (&str, &str),
-        state: DepthState,
-    ) -> TechniqueResult<CasterIdPass> {
-        let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, shader)?;
-        let camera_layout = caster_layout(device, &format!("{label} camera layout"));
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&format!("{label} pipeline layout")),
-            bind_group_layouts: &[Some(&ctx.frame.layout), Some(&camera_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(&format!("{label} pipeline")),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some(vertex),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
+        set: &ShadowMapSet,
+        ids: CasterIds<'_>,
+    ) -> TechniqueResult<CasterIdMaps> {
+        let (vertex, fragment) = ids.entries;
+        let state = ids.state;
+        let stage = Stage::render(ids.shader, vertex)
+            .fragment(fragment)
+            .primitive(wgpu::PrimitiveState {
                 cull_mode: state.cull_front.then_some(wgpu::Face::Front),
                 ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
+            })
+            .depth_stencil(wgpu::DepthStencilState {
                 format: MAP_FORMAT,
                 depth_write_enabled: Some(true),
                 depth_compare: Some(wgpu::CompareFunction::LessEqual),
@@ -59,47 +73,85 @@ impl CasterIdPass {
                     slope_scale: state.slope_bias,
                     clamp: 0.0,
                 },
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(fragment),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        Ok(CasterIdPass {
-            pipeline,
-            camera_layout,
+            })
+            .targets(&[Some(wgpu::TextureFormat::R32Uint.into())])
+            .shared(&[&set.layer_camera(0)])
+            .build(ctx)?;
+        Ok(CasterIdMaps {
+            label: ids.label.to_string(),
+            own_depth: ids.own_depth,
+            stage,
+            bound: None,
         })
     }
 
-    /// Group 1 over the layer cameras `cameras`.
-    pub(crate) fn camera_group(
-        &self,
+    /// Makes maps like `depth` (the set's depth maps) when those or the scene changed;
+    /// returns whether it did.
+    pub(crate) fn prepare(
+        &mut self,
         ctx: &RenderContext<'_>,
-        label: &str,
-        cameras: &wgpu::Buffer,
-    ) -> wgpu::BindGroup {
-        caster_group(ctx, label, &self.camera_layout, cameras)
+        depth: &MapArray,
+    ) -> TechniqueResult<bool> {
+        let vertices = &ctx.scene_buffers.vertices;
+        let current = (self.bound.as_ref())
+            .is_some_and(|b| b.made_for.0 == depth.texture && &b.made_for.1 == vertices);
+        if current {
+            return Ok(false);
+        }
+        let label = &self.label;
+        let (resolution, layers) = (depth.resolution, depth.layers);
+        let own_depth = (self.own_depth)
+            .then(|| MapArray::new(ctx.gpu, &format!("{label} depth"), resolution, layers));
+        let ids = MapArray::with_format(
+            ctx.gpu,
+            &format!("{label} maps"),
+            resolution,
+            layers,
+            wgpu::TextureFormat::R32Uint,
+        );
+        let scene = self.stage.bind(
+            ctx,
+            &format!("{label} scene triangles"),
+            &[
+                ("scene_vertices", vertices.as_entire_binding()),
+                (
+                    "scene_indices",
+                    ctx.scene_buffers.indices.as_entire_binding(),
+                ),
+            ],
+        )?;
+        self.bound = Some(Bound {
+            made_for: (depth.texture.clone(), vertices.clone()),
+            ids,
+            depth: own_depth,
+            scene,
+        });
+        Ok(true)
     }
 
-    /// Renders the tile of each of `passes` into the pages of `ids` and `depth` (group 1
-    /// `cameras`, from [`Self::camera_group`]), one pass each named by [`TilePass::name`] with
-    /// `base`, drawing the casters `reaches(light, object)` accepts.
-    #[allow(clippy::too_many_arguments)]
+    /// The id maps, once prepared.
+    pub(crate) fn maps(&self) -> Option<&MapArray> {
+        self.bound.as_ref().map(|b| &b.ids)
+    }
+
+    /// Renders the tile of each of `passes` into the id maps and the depth maps (their own,
+    /// or `set`'s), one pass each named by [`TilePass::name`] with `base`, drawing the casters
+    /// `reaches(light, object)` accepts.
     pub(crate) fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-        (ids, depth): (&MapArray, &MapArray),
-        cameras: &wgpu::BindGroup,
-        passes: &[TilePass<'_>],
-        base: &str,
+        set: &ShadowMapSet,
+        (passes, base): (&[TilePass<'_>], &str),
         reaches: &dyn Fn(usize, usize) -> bool,
-    ) {
+    ) -> TechniqueResult {
+        let bound = self
+            .bound
+            .as_ref()
+            .ok_or_else(TechniqueError::not_prepared)?;
+        let depth = (bound.depth.as_ref())
+            .or(set.maps())
+            .ok_or_else(TechniqueError::not_prepared)?;
         let none = wgpu::Color {
             r: NO_TRIANGLE as f64,
             ..wgpu::Color::TRANSPARENT
@@ -107,81 +159,21 @@ impl CasterIdPass {
         for tile_pass in passes {
             let page = tile_pass.tile.page as usize;
             let colors = [zoo_host::gpu::color_attachment(
-                &ids.layer_views[page],
+                &bound.ids.layer_views[page],
                 tile_pass.load_op(none),
             )];
             let depth_view = &depth.layer_views[page];
-            let mut pass =
-                tile_pass.begin(recorder, base, &colors, depth_view, tile_pass.load_op(1.0));
-            draw_casters(ctx, &mut pass, &self.pipeline, cameras, tile_pass, reaches);
+            let load = tile_pass.load_op(1.0);
+            let mut pass = tile_pass.begin(recorder, base, &colors, depth_view, load);
+            let camera = [&set.layer_camera(tile_pass.layer) as &dyn SharedGroup];
+            self.stage
+                .set_on(ctx, &mut pass, &[&bound.scene], &camera)?;
+            let light = tile_pass.maps.light;
+            let drawn = |i, o: &zoo_host::scene::SceneObject| o.casts_shadows && reaches(light, i);
+            for (indices, objects) in drawn_runs(ctx.scene, drawn) {
+                pass.draw(indices, objects);
+            }
         }
-    }
-}
-
-/// Group 1 of a caster pass.
-fn caster_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
-    let vertex = wgpu::ShaderStages::VERTEX;
-    bind_group_layout(
-        device,
-        label,
-        &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: vertex,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
-                },
-                count: None,
-            },
-            storage(1, vertex, true),
-            storage(2, vertex, true),
-        ],
-    )
-}
-
-/// Group 1 of a caster pass over the layer cameras `cameras` and the context's scene.
-fn caster_group(
-    ctx: &RenderContext<'_>,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    cameras: &wgpu::Buffer,
-) -> wgpu::BindGroup {
-    let buffers = ctx.scene_buffers;
-    bind_group(
-        &ctx.gpu.device,
-        label,
-        layout,
-        &[
-            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: cameras,
-                offset: 0,
-                size: wgpu::BufferSize::new(LayerCamera::SIZE as u64),
-            }),
-            buffers.vertices.as_entire_binding(),
-            buffers.indices.as_entire_binding(),
-        ],
-    )
-}
-
-/// Draws every caster triangle `reaches(light, object)` accepts with `pipeline` from the
-/// camera of `tile_pass`'s layer, each object's stored index range with the object as the
-/// instance.
-fn draw_casters(
-    ctx: &RenderContext<'_>,
-    pass: &mut wgpu::RenderPass<'_>,
-    pipeline: &wgpu::RenderPipeline,
-    group: &wgpu::BindGroup,
-    tile_pass: &TilePass<'_>,
-    reaches: &dyn Fn(usize, usize) -> bool,
-) {
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-    let offset = (tile_pass.layer as u64 * CAMERA_STRIDE) as u32;
-    pass.set_bind_group(1, group, &[offset]);
-    let light = tile_pass.maps.light;
-    for (indices, objects) in drawn_runs(ctx.scene, |i, o| o.casts_shadows && reaches(light, i)) {
-        pass.draw(indices, objects);
+        Ok(())
     }
 }

@@ -25,22 +25,22 @@
 //!   measure what the restriction saves.
 
 mod casters;
-mod coverage;
-mod ids;
 mod tiles;
 
 use zoo_host::gpu::PassRecorder;
 use zoo_host::gpu::layout::ChoiceCodes;
-use zoo_host::kit::{SharedGroup, Stage, light_pass_name, pipeline_layout};
+use zoo_host::kit::{NamedTextures, Stage, StageBindGroup, TextureSpec, light_pass_name};
 use zoo_host::prelude::*;
 use zoo_host::render::gbuffer::DEPTH_FORMAT;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::{DepthState, LightMaps, LookupPass, LookupShader, MapHeader, ShadowMapSet};
 
-use coverage::CoverageMaps;
-use ids::IdMaps;
+use casters::{CasterIdMaps, CasterIds};
 use tiles::Tiles;
-use zoo_shadow_volumes::{VolumeGenerator, Volumes, band_volume_pipeline, stencil_state};
+use zoo_shadow_volumes::{
+    COUNTS_FORMAT, StencilCounts, VolumeGenerator, Volumes, band_volume_depth_stencil,
+    piece_pass_name, resolve_stage, volume_stage,
+};
 
 zoo_host::param_choice! {
     /// Where shadow volumes are counted.
@@ -72,6 +72,17 @@ zoo_host::technique_params! {
         volume_bias: u32 = 16, range(0, 65536), step(1), flags(rebuild);
         /// Light whose classification the debug view shows.
         debug_light: u32 = 0, range(0, 1023), step(1);
+        /// Largest volume vertex buffer in MiB (0: as large as the device binds). Volumes that
+        /// may need more are generated and drawn in pieces that fit it, their stencil counts
+        /// adding up, so the band stays exact; smaller pieces take less memory and more passes.
+        volume_buffer_mib: u32 = 0, range(0, 4096), step(1), flags(rebuild);
+    }
+}
+
+impl HybridParams {
+    /// The volume buffer's budget in bytes, if one is set.
+    fn volume_budget(&self) -> Option<u64> {
+        (self.volume_buffer_mib > 0).then(|| u64::from(self.volume_buffer_mib) << 20)
     }
 }
 
@@ -107,44 +118,24 @@ const CLASS_VIEW: &str = "classification";
 const COUNTS_VIEW: &str = "stencil counts";
 const TILES_VIEW: &str = "active tiles";
 const COVERAGE_VIEW: &str = "coverage maps";
-const COUNTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
-/// Stencil levels the count view distinguishes, shown as ids 1..=10: counts 1..=8, then 255 and
-/// 254 (-1 and -2 wrapped); any other non-zero count is id 11.
-const COUNT_LEVELS: [u32; 10] = [1, 2, 3, 4, 5, 6, 7, 8, 255, 254];
+/// The band's depth-stencil: the edge pixels' depth, 1 elsewhere, and the volumes' counts.
+const BAND_TARGET: &str = "band depth-stencil";
 
 /// Screen-sized targets: the band's depth-stencil and the debug views.
-struct Targets {
-    band: (wgpu::Texture, wgpu::TextureView),
-    class: (wgpu::Texture, wgpu::TextureView),
-    counts: (wgpu::Texture, wgpu::TextureView),
-    tiles: (wgpu::Texture, wgpu::TextureView),
-}
-
-impl Targets {
-    fn new(device: &wgpu::Device, size: zoo_host::glam::UVec2) -> Targets {
-        let target =
-            |label, format, usage| zoo_host::gpu::render_target(device, label, size, format, usage);
-        // The tile restriction reads the band's depth.
-        let sampled = wgpu::TextureUsages::TEXTURE_BINDING;
-        Targets {
-            band: target("hybrid band depth-stencil", DEPTH_FORMAT, sampled),
-            class: target(
-                "hybrid classification",
-                CLASS_FORMAT,
-                wgpu::TextureUsages::empty(),
-            ),
-            counts: target(
-                "hybrid stencil counts",
-                COUNTS_FORMAT,
-                wgpu::TextureUsages::empty(),
-            ),
-            tiles: target(
-                "hybrid active tiles",
-                tiles::OVERLAY_FORMAT,
-                wgpu::TextureUsages::empty(),
-            ),
-        }
-    }
+fn targets() -> NamedTextures {
+    let color = Some(ViewMapping::Color { min: 0.0, max: 1.0 });
+    let mut band = TextureSpec::screen_target(BAND_TARGET, DEPTH_FORMAT, None);
+    // The tile restriction reads the band's depth.
+    band.usage |= wgpu::TextureUsages::TEXTURE_BINDING;
+    NamedTextures::new(
+        "hybrid",
+        [
+            TextureSpec::screen_target(CLASS_VIEW, CLASS_FORMAT, color),
+            band,
+            TextureSpec::screen_target(COUNTS_VIEW, COUNTS_FORMAT, Some(ViewMapping::Integer)),
+            TextureSpec::screen_target(TILES_VIEW, tiles::OVERLAY_FORMAT, color),
+        ],
+    )
 }
 
 /// Maps, volumes, pipelines and targets, built at the first `prepare`.
@@ -154,19 +145,19 @@ struct Gpu {
     /// The band's classification: volumes next, or exact id tests.
     band: LookupPass<EdgeLight>,
     band_ids: LookupPass<EdgeLight>,
-    coverage: CoverageMaps,
-    ids: IdMaps,
+    coverage: CasterIdMaps,
+    ids: CasterIdMaps,
     /// The tile restriction, built when first chosen.
     tiles: Option<Tiles>,
     volume_bias: wgpu::DepthBiasState,
     /// The band shader's value of each `Restriction`.
     restriction_codes: ChoiceCodes,
-    volume: wgpu::RenderPipeline,
+    volume: Stage,
     resolve: Stage,
-    /// The count view: any non-zero count, then one level at a time.
-    count_any: wgpu::RenderPipeline,
-    count_equal: wgpu::RenderPipeline,
-    targets: Targets,
+    counts: StencilCounts,
+    targets: NamedTextures,
+    /// The band passes' groups over the coverage maps (and the id maps), once made.
+    band_groups: [Option<StageBindGroup>; 2],
     /// Lights the volume buffers were made for.
     lights: usize,
 }
@@ -190,107 +181,82 @@ impl Gpu {
             ..DepthState::default()
         };
         let maps = ShadowMapSet::new(ctx, "hybrid shadow maps", state, None)?;
-        let generator = VolumeGenerator::new(ctx, "hybrid")?;
-        let coverage = CoverageMaps::new(ctx)?;
-        let ids = IdMaps::new(ctx, state)?;
-        let device = &ctx.gpu.device;
-        let module = ctx.shaders.create_module(device, SHADER)?;
-        let draw_module = ctx
-            .shaders
-            .create_module(device, "shadow-volumes/draw.wgsl")?;
+        let coverage = CasterIds {
+            label: "hybrid coverage",
+            shader: "hybrid-edge/coverage.wgsl",
+            entries: ("vs_coverage", "fs_coverage"),
+            // Both faces, no bias: a caster's every triangle counts, whichever way it faces.
+            state: DepthState::default(),
+            own_depth: true,
+        };
+        let ids = CasterIds {
+            label: "hybrid triangle ids",
+            shader: "hybrid-edge/ids.wgsl",
+            entries: ("vs_ids", "fs_ids"),
+            state,
+            own_depth: false,
+        };
         let source = ctx.shaders.compose(SHADER)?.source;
         let restriction_codes = ChoiceCodes::read(&source, "RESTRICTION", Restriction::NAMES)
             .map_err(|e| TechniqueError::Other(format!("{SHADER}: {e}")))?;
-        let band_pass = |entry, shared: &dyn SharedGroup| {
+        let band_pass = |entry| {
             let shader = LookupShader {
                 shader: SHADER,
                 entry,
                 diagnostics: &[CLASS_FORMAT],
                 depth_stencil: Some(band_depth_state()),
-                shared: &[shared],
+                shared: &[],
             };
             LookupPass::new(ctx, &maps, BAND_PASS, shader)
         };
-        let band = band_pass("fs_band", &coverage.lookup())?;
-        let band_ids = band_pass("fs_band_ids", &ids.lookup())?;
         let bias = wgpu::DepthBiasState {
             constant: p.volume_bias as i32,
             slope_scale: 0.0,
             clamp: 0.0,
         };
-        let volume = band_volume_pipeline(
-            ctx,
-            "hybrid volume pipeline",
-            &draw_module,
-            "vs_volume",
-            &[],
-            bias,
-        );
-        let keep = wgpu::StencilOperation::Keep;
-        let not_zero = wgpu::StencilFaceState {
-            compare: wgpu::CompareFunction::NotEqual,
-            fail_op: keep,
-            depth_fail_op: keep,
-            pass_op: keep,
-        };
-        let always = wgpu::CompareFunction::Always;
-        let resolve = Stage::fullscreen(SHADER, "fs_shadowed")
-            .depth_stencil(stencil_state(
-                always,
-                not_zero,
-                not_zero,
-                Default::default(),
-            ))
-            .build(ctx)?;
-        let count = |compare| {
-            let face = wgpu::StencilFaceState {
-                compare,
-                fail_op: keep,
-                depth_fail_op: keep,
-                pass_op: keep,
-            };
-            let layout = pipeline_layout(ctx, "hybrid stencil count layout", &[]);
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("hybrid stencil count pipeline"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_count"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: Some(stencil_state(always, face, face, Default::default())),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_count"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(COUNTS_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let count_any = count(wgpu::CompareFunction::NotEqual);
-        let count_equal = count(wgpu::CompareFunction::Equal);
+        let draw = "shadow-volumes/draw.wgsl";
+        let volume = volume_stage(draw, "vs_volume", band_volume_depth_stencil(bias));
         Ok(Gpu {
-            count_any,
-            count_equal,
+            band: band_pass("fs_band")?,
+            band_ids: band_pass("fs_band_ids")?,
+            coverage: CasterIdMaps::new(ctx, &maps, coverage)?,
+            ids: CasterIdMaps::new(ctx, &maps, ids)?,
             maps,
-            generator,
-            band,
-            band_ids,
-            coverage,
-            ids,
+            generator: VolumeGenerator::new(ctx, "hybrid")?,
             tiles: None,
             volume_bias: bias,
             restriction_codes,
-            volume,
-            resolve,
-            targets: Targets::new(device, ctx.size),
+            volume: volume.build(ctx)?,
+            resolve: resolve_stage(ctx)?,
+            counts: StencilCounts::new(ctx)?,
+            targets: targets(),
+            band_groups: [None, None],
             lights: 0,
         })
+    }
+
+    /// Makes the band passes' groups again over the current coverage and id maps.
+    fn bind_band_groups(&mut self, ctx: &RenderContext<'_>) -> TechniqueResult {
+        let Some(coverage) = self.coverage.maps() else {
+            return Ok(());
+        };
+        let scene = ctx.scene_buffers;
+        let mut resources = vec![
+            (
+                "coverage_ids",
+                wgpu::BindingResource::TextureView(&coverage.array_view),
+            ),
+            ("scene_vertices", scene.vertices.as_entire_binding()),
+            ("scene_indices", scene.indices.as_entire_binding()),
+        ];
+        let label = "hybrid band lookups";
+        self.band_groups[0] = Some(self.band.stage().bind(ctx, label, &resources)?);
+        if let Some(ids) = self.ids.maps() {
+            let view = wgpu::BindingResource::TextureView(&ids.array_view);
+            resources.push(("triangle_ids", view));
+            self.band_groups[1] = Some(self.band_ids.stage().bind(ctx, label, &resources)?);
+        }
+        Ok(())
     }
 }
 
@@ -324,32 +290,79 @@ fn record_counts(
     light: usize,
 ) -> TechniqueResult {
     let name = light_pass_name(DEBUG_PASS, light);
-    let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
-    let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(&name),
-        color_attachments: &[zoo_host::gpu::color_attachment(
-            &gpu.targets.counts.1,
-            clear,
-        )],
-        depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
-            &gpu.targets.band.1,
-            wgpu::LoadOp::Load,
-        ),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-    pass.set_bind_group(1, &ctx.gbuffer.bind_group, &[]);
-    // Any non-zero count first (id 11), then the exact levels over it.
-    pass.set_pipeline(&gpu.count_any);
-    pass.set_stencil_reference(0);
-    pass.draw(0..3, 11..12);
-    pass.set_pipeline(&gpu.count_equal);
-    for (k, level) in COUNT_LEVELS.iter().enumerate() {
-        pass.set_stencil_reference(*level);
-        let id = k as u32 + 1;
-        pass.draw(0..3, id..id + 1);
+    let (Some(band), Some(counts)) = (gpu.targets.view(BAND_TARGET), gpu.targets.view(COUNTS_VIEW))
+    else {
+        return Err(TechniqueError::not_prepared());
+    };
+    gpu.counts.record(ctx, recorder, (band, counts), &name)
+}
+
+/// Counts light `light`'s volumes in its band, piece by piece into the band's stencil (only
+/// into the listed edge tiles where `tiled`), and shadows the band pixels with a non-zero
+/// count; `debug`: the light the debug views show.
+fn record_volumes(
+    ctx: &RenderContext<'_>,
+    recorder: &mut PassRecorder<'_>,
+    gpu: &Gpu,
+    (light, debug): (usize, bool),
+    tiled: bool,
+) -> TechniqueResult {
+    let (Some(volume), Some(args)) = (gpu.generator.volume(), gpu.generator.args()) else {
+        return Err(TechniqueError::not_prepared());
+    };
+    let showing = |view| debug && ctx.debug_view == Some(view);
+    let tiles = gpu.tiles.as_ref().filter(|_| tiled);
+    if let Some(tiles) = tiles {
+        tiles.record_list(ctx, recorder, &light_pass_name(TILES_PASS, light))?;
+        if showing(TILES_VIEW) {
+            let name = light_pass_name(DEBUG_PASS, light);
+            let view = (gpu.targets.view(TILES_VIEW)).ok_or_else(TechniqueError::not_prepared)?;
+            tiles.record_overlay(ctx, recorder, view, &name)?;
+        }
+    }
+    let band = (gpu.targets.view(BAND_TARGET)).ok_or_else(TechniqueError::not_prepared)?;
+    let pieces = gpu.generator.pieces(light);
+    for piece in 0..pieces {
+        let generation = piece_pass_name(GENERATION_PASS, light, piece);
+        gpu.generator
+            .record(ctx, recorder, (light, piece), &generation)?;
+        let last = piece + 1 == pieces;
+        // The next piece counts on; the count view reads the stencil after the last.
+        let keep = match !last || showing(COUNTS_VIEW) {
+            true => wgpu::StoreOp::Store,
+            false => wgpu::StoreOp::Discard,
+        };
+        let depth = wgpu::RenderPassDepthStencilAttachment {
+            view: band,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: keep,
+            }),
+            stencil_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: keep,
+            }),
+        };
+        if let Some(tiles) = tiles {
+            tiles.take_vertex_count(recorder, args)?;
+        }
+        let name = piece_pass_name(VOLUME_PASS, light, piece);
+        let mut pass = ctx.light_pass(recorder, &name, light, Some(depth));
+        if let Some(tiles) = tiles {
+            tiles.draw(ctx, &mut pass, volume)?;
+        } else {
+            gpu.volume.set_on(ctx, &mut pass, &[], &[])?;
+            pass.set_vertex_buffer(0, volume.slice(..));
+            pass.draw_indirect(args, 0);
+        }
+        if last {
+            gpu.resolve.set_on(ctx, &mut pass, &[], &[])?;
+            pass.set_stencil_reference(0);
+            pass.draw(0..3, 0..1);
+        }
+    }
+    if showing(COUNTS_VIEW) {
+        record_counts(ctx, recorder, gpu, light)?;
     }
     Ok(())
 }
@@ -379,26 +392,7 @@ impl ShadowTechnique for Hybrid {
         if let Some(maps) = gpu.maps.maps() {
             out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
         }
-        out.push(ResourceInfo::texture(
-            CLASS_VIEW,
-            &gpu.targets.class.0,
-            true,
-        ));
-        out.push(ResourceInfo::texture(
-            "band depth-stencil",
-            &gpu.targets.band.0,
-            false,
-        ));
-        out.push(ResourceInfo::texture(
-            COUNTS_VIEW,
-            &gpu.targets.counts.0,
-            true,
-        ));
-        out.push(ResourceInfo::texture(
-            TILES_VIEW,
-            &gpu.targets.tiles.0,
-            true,
-        ));
+        out.extend(gpu.targets.resources());
         if let Some(coverage) = gpu.coverage.maps() {
             out.push(ResourceInfo::texture(
                 COVERAGE_VIEW,
@@ -414,19 +408,23 @@ impl ShadowTechnique for Hybrid {
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
         let gpu = self.gpu.prepare(false, || Gpu::new(ctx, &self.params))?;
-        if changes.resolution {
-            gpu.targets = Targets::new(&ctx.gpu.device, ctx.size);
-        }
+        gpu.targets.prepare(ctx);
         if changes.scene || ctx.lights.len() != gpu.lights || gpu.generator.volume().is_none() {
-            gpu.generator.prepare(ctx, Volumes::Silhouette);
+            let budget = self.params.volume_budget();
+            gpu.generator.prepare(ctx, Volumes::Silhouette, budget)?;
             gpu.lights = ctx.lights.len();
+        } else if changes.lights {
+            // The casters each light reaches, and so its pieces, follow the lights.
+            gpu.generator.plan(ctx);
         }
         gpu.maps.prepare(ctx, changes, self.params.map_size, true);
-        if let (Some(depth), Some(cameras)) = (gpu.maps.maps(), gpu.maps.cameras()) {
-            gpu.coverage.prepare(ctx, depth, cameras);
-            let coverage = gpu.coverage.maps().expect("prepared above");
+        if let Some(depth) = gpu.maps.maps() {
+            let mut remade = gpu.coverage.prepare(ctx, depth)?;
             if self.params.restriction == Restriction::TriangleIds {
-                gpu.ids.prepare(ctx, depth, cameras, coverage);
+                remade |= gpu.ids.prepare(ctx, depth)?;
+            }
+            if remade {
+                gpu.bind_band_groups(ctx)?;
             }
         }
         if self.params.restriction == Restriction::Tiles {
@@ -434,7 +432,8 @@ impl ShadowTechnique for Hybrid {
                 gpu.tiles = Some(tiles_for(ctx, gpu.volume_bias)?);
             }
             let tiles = gpu.tiles.as_mut().expect("built above");
-            tiles.prepare(ctx, &gpu.targets.band.0, ctx.size, self.params.tile_size);
+            let band = (gpu.targets.texture(BAND_TARGET)).expect("prepared above");
+            tiles.prepare(ctx, band, ctx.size, self.params.tile_size)?;
         }
         Ok(())
     }
@@ -456,12 +455,10 @@ impl ShadowTechnique for Hybrid {
         let reaches = |light, object| maps.reaches(&ctx.lights[light], object);
         let passes = maps.tile_passes();
         if exact {
-            let depth = maps.maps().ok_or_else(TechniqueError::not_prepared)?;
-            gpu.ids
-                .record(ctx, recorder, depth, &passes, IDS_PASS, &reaches)?;
+            (gpu.ids).record(ctx, recorder, maps, (&passes, IDS_PASS), &reaches)?;
         }
         if p.coverage {
-            (gpu.coverage).record(ctx, recorder, &passes, COVERAGE_PASS, &reaches)?;
+            (gpu.coverage).record(ctx, recorder, maps, (&passes, COVERAGE_PASS), &reaches)?;
         }
         let restriction = gpu.restriction_codes.code(p.restriction.index());
         let uniform = |l: &LightMaps, _| Some(edge_light(p, l, restriction));
@@ -470,16 +467,19 @@ impl ShadowTechnique for Hybrid {
             false => gpu.band.write(ctx, &gpu.maps, p.debug_light, uniform),
         };
         let band_pass = if exact { &gpu.band_ids } else { &gpu.band };
-        let group = match exact {
-            true => gpu.ids.lookup(),
-            false => gpu.coverage.lookup(),
+        let group = gpu.band_groups[usize::from(exact)]
+            .as_ref()
+            .ok_or_else(TechniqueError::not_prepared)?;
+        let (Some(band), Some(class)) =
+            (gpu.targets.view(BAND_TARGET), gpu.targets.view(CLASS_VIEW))
+        else {
+            return Err(TechniqueError::not_prepared());
         };
         for (k, lookup) in lookups.iter().enumerate() {
             let light = lookup.maps.light;
-            let band = &gpu.targets.band.1;
             {
                 let clear = zoo_host::gpu::clear_first(k == 0, wgpu::Color::TRANSPARENT);
-                let class = [zoo_host::gpu::color_attachment(&gpu.targets.class.1, clear)];
+                let class = [zoo_host::gpu::color_attachment(class, clear)];
                 let depth = wgpu::RenderPassDepthStencilAttachment {
                     view: band,
                     depth_ops: Some(wgpu::Operations {
@@ -491,7 +491,7 @@ impl ShadowTechnique for Hybrid {
                         store: wgpu::StoreOp::Store,
                     }),
                 };
-                let groups = (&[] as &[_], &[&group as &dyn SharedGroup] as &[_]);
+                let groups = (&[group] as &[_], &[] as &[_]);
                 band_pass.record_one(
                     ctx,
                     recorder,
@@ -505,58 +505,14 @@ impl ShadowTechnique for Hybrid {
             if exact {
                 continue;
             }
-            let (Some(volume), Some(args)) = (gpu.generator.volume(), gpu.generator.args()) else {
-                return Err(TechniqueError::not_prepared());
-            };
-            let generation = light_pass_name(GENERATION_PASS, light);
-            gpu.generator.record(ctx, recorder, light, &generation)?;
-            let showing = |view| lookup.debug && ctx.debug_view == Some(view);
-            // The count view reads the stencil after the volumes.
-            let keep = if showing(COUNTS_VIEW) {
-                wgpu::StoreOp::Store
-            } else {
-                wgpu::StoreOp::Discard
-            };
-            let depth = wgpu::RenderPassDepthStencilAttachment {
-                view: band,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: keep,
-                }),
-                stencil_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: keep,
-                }),
-            };
-            let tiles = gpu
-                .tiles
-                .as_ref()
-                .filter(|_| p.restriction == Restriction::Tiles);
-            if let Some(tiles) = tiles {
-                tiles.record_list(recorder, &light_pass_name(TILES_PASS, light), args)?;
-                if showing(TILES_VIEW) {
-                    let name = light_pass_name(DEBUG_PASS, light);
-                    tiles.record_overlay(ctx, recorder, &gpu.targets.tiles.1, &name)?;
-                }
-            }
-            let name = light_pass_name(VOLUME_PASS, light);
-            let mut pass = ctx.light_pass(recorder, &name, light, Some(depth));
-            if let Some(tiles) = tiles {
-                tiles.draw(&mut pass, volume)?;
-            } else {
-                pass.set_pipeline(&gpu.volume);
-                pass.set_vertex_buffer(0, volume.slice(..));
-                pass.draw_indirect(args, 0);
-            }
-            gpu.resolve.set_on(ctx, &mut pass, &[], &[])?;
-            pass.set_stencil_reference(0);
-            pass.draw(0..3, 0..1);
-            drop(pass);
-            if showing(COUNTS_VIEW) {
-                record_counts(ctx, recorder, gpu, light)?;
-            }
+            let tiled = p.restriction == Restriction::Tiles;
+            record_volumes(ctx, recorder, gpu, (light, lookup.debug), tiled)?;
         }
         Ok(())
+    }
+
+    fn warnings(&self) -> Vec<String> {
+        (self.gpu.built()).map_or(Vec::new(), |gpu| gpu.generator.warnings())
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -566,26 +522,16 @@ impl ShadowTechnique for Hybrid {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        self.gpu
-            .built()
-            .map_or(Vec::new(), |gpu| gpu.maps.counters())
+        self.gpu.built().map_or(Vec::new(), |gpu| {
+            let mut out = gpu.maps.counters();
+            out.extend(gpu.generator.counters());
+            out
+        })
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
         let gpu = self.gpu.built()?;
         match resource {
-            CLASS_VIEW => Some(DebugImage {
-                view: &gpu.targets.class.1,
-                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
-            }),
-            TILES_VIEW => Some(DebugImage {
-                view: &gpu.targets.tiles.1,
-                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
-            }),
-            COUNTS_VIEW => Some(DebugImage {
-                view: &gpu.targets.counts.1,
-                mapping: ViewMapping::Integer,
-            }),
             "shadow maps" => gpu.maps.debug_image(self.params.debug_light),
             COVERAGE_VIEW => {
                 let light = gpu.maps.debug_light(self.params.debug_light)?;
@@ -594,7 +540,7 @@ impl ShadowTechnique for Hybrid {
                     mapping: ViewMapping::Integer,
                 })
             }
-            _ => None,
+            _ => gpu.targets.debug_view(resource),
         }
     }
 }

@@ -5,23 +5,29 @@
 //! triangles facing the light (and, for open or non-manifold meshes, from every triangle
 //! oriented toward it), and side quads on edges whose face orientations do not cancel, counted
 //! with multiplicity. Vertices are extruded to infinity (w = 0) and drawn with unclipped depth
-//! (`DEPTH_CLIP_CONTROL`), so counting is robust with the camera anywhere. One two-sided draw
+//! (`DEPTH_CLIP_CONTROL`), so counting is robust with the camera anywhere. A two-sided draw
 //! updates the G-buffer's stencil (z-fail: back faces increment and front faces decrement where
 //! the depth test fails, with wrap); a full-screen pass then writes visibility 0 where the count
-//! is not zero.
+//! is not zero. Where the volumes may need more vertices than one buffer the device binds holds
+//! (a crowd of instances), each light's are generated and drawn in pieces that fit it, their
+//! counts adding up in the one stencil, so no triangle count makes the shadows inexact.
 
+use std::sync::Mutex;
+
+use zoo_host::gpu::readback::ReadbackRing;
+use zoo_host::kit::{NamedTextures, light_pass_name};
 use zoo_host::params::TechniqueParams;
 use zoo_host::scene::LightKind;
-use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+use zoo_host::technique::{DebugImage, ResourceInfo};
 use zoo_host::{
     Changes, GpuContext, ParamUpdate, ParamValues, PassRecorder, RenderContext, ShadowTechnique,
     TechniqueError, wgpu,
 };
 
-mod pipelines;
+mod passes;
 
-use pipelines::{Buffers, COUNT_LEVELS, DebugTargets, Pipelines, SLOT};
-use zoo_shadow_volumes::ARGS_BYTES;
+use passes::{COUNTS_VIEW, OVERLAY_VIEW, Passes};
+use zoo_shadow_volumes::{ARGS_BYTES, piece_pass_name};
 pub use zoo_shadow_volumes::{Counting, Volumes, silhouette};
 
 zoo_host::technique_params! {
@@ -41,6 +47,18 @@ zoo_host::technique_params! {
         slope_bias: f32 = 0.0, range(0.0, 8.0), step(0.1), flags(rebuild);
         /// Light whose volumes and stencil counts the debug views show.
         debug_light: u32 = 0, range(0, 1023), step(1);
+        /// Largest volume vertex buffer in MiB (0: as large as the device binds). Volumes that
+        /// may need more are generated and drawn in pieces that fit it, their stencil counts
+        /// adding up, so the shadows stay exact; smaller pieces take less memory and more
+        /// passes.
+        volume_buffer_mib: u32 = 0, range(0, 4096), step(1), flags(rebuild);
+    }
+}
+
+impl SvParams {
+    /// The volume buffer's budget in bytes, if one is set.
+    fn volume_budget(&self) -> Option<u64> {
+        (self.volume_buffer_mib > 0).then(|| u64::from(self.volume_buffer_mib) << 20)
     }
 }
 
@@ -48,9 +66,10 @@ zoo_host::technique_params! {
 pub struct ShadowVolumes {
     params: SvParams,
     device: wgpu::Device,
-    pipelines: Option<Pipelines>,
-    buffers: Option<Buffers>,
-    debug: Option<DebugTargets>,
+    passes: Option<Passes>,
+    /// Draw arguments and silhouette counters per light, read back a frame or two late.
+    stats: Option<Mutex<ReadbackRing>>,
+    debug: NamedTextures,
     lights: usize,
 }
 
@@ -58,10 +77,10 @@ impl ShadowVolumes {
     /// Silhouette edges and volume triangles per light from the newest frame whose counters
     /// have arrived (empty until one has; never waits for the GPU).
     pub fn workload(&self) -> Vec<(u32, u32)> {
-        let Some(buffers) = &self.buffers else {
+        let Some(stats) = &self.stats else {
             return Vec::new();
         };
-        let Ok(mut ring) = buffers.stats.lock() else {
+        let Ok(mut ring) = stats.lock() else {
             return Vec::new();
         };
         let Some((_, bytes)) = ring.latest(&self.device) else {
@@ -73,58 +92,48 @@ impl ShadowVolumes {
             .collect();
         (0..self.lights)
             .map(|light| {
+                // The light's counters after its last piece.
                 let base = light * (ARGS_BYTES as usize / 4);
-                (words[base + 4], words[base] / 3)
+                (words[base + 4], words[base + 5] / 3)
             })
             .collect()
     }
 }
 
-fn volume_pass_name(light: usize) -> String {
-    format!("Shadow volumes: light {light}")
-}
-
-fn generation_pass_name(light: usize) -> String {
-    format!("Volume generation: light {light}")
-}
-
-fn debug_pass_name(light: usize) -> String {
-    format!("Volume debug: light {light}")
-}
+const VOLUME_PASS: &str = "Shadow volumes";
+const GENERATION_PASS: &str = "Volume generation";
+const DEBUG_PASS: &str = "Volume debug";
 
 impl ShadowTechnique for ShadowVolumes {
     fn resources(&self) -> Vec<ResourceInfo> {
-        let mut out = self
-            .pipelines
-            .as_ref()
+        let mut out = (self.passes.as_ref())
             .map(|p| p.generator.resources())
             .unwrap_or_default();
-        if let Some(d) = &self.debug {
-            out.push(ResourceInfo::texture("stencil counts", &d.counts.0, true));
-            out.push(ResourceInfo::texture("volumes", &d.overlay.0, true));
-        }
+        out.extend(self.debug.resources());
         out
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> Result<(), TechniqueError> {
-        if self.pipelines.is_none() {
-            self.pipelines = Some(Pipelines::new(ctx, &self.params)?);
-        }
+        let passes = match &mut self.passes {
+            Some(passes) => passes,
+            none => none.insert(Passes::new(ctx, &self.params)?),
+        };
         // Volume buffers and the counter ring depend on the scene and the number of lights,
         // not on where the lights are (moving one keeps its counters coming).
         let count_changed = ctx.lights.len() != self.lights;
-        if changes.scene || count_changed || self.buffers.is_none() {
+        if changes.scene || count_changed || self.stats.is_none() {
             self.lights = ctx.lights.len();
-            let generator = &mut self.pipelines.as_mut().expect("created above").generator;
-            generator.prepare(ctx, self.params.volumes);
-            self.buffers = Some(Buffers::new(
-                ctx,
-                self.pipelines.as_ref().expect("built above"),
-            ));
+            let budget = self.params.volume_budget();
+            passes.generator.prepare(ctx, self.params.volumes, budget)?;
+            let bytes = ctx.lights.len() as u64 * ARGS_BYTES;
+            let label = "sv-zfail workload counters";
+            let ring = ReadbackRing::new(&ctx.gpu.device, label, bytes, 3);
+            self.stats = Some(Mutex::new(ring));
+        } else if changes.lights {
+            // The casters each light reaches, and so its pieces, follow the lights.
+            passes.generator.plan(ctx);
         }
-        if changes.resolution || self.debug.is_none() {
-            self.debug = Some(DebugTargets::new(&ctx.gpu.device, ctx.size));
-        }
+        self.debug.prepare(ctx);
         Ok(())
     }
 
@@ -133,35 +142,29 @@ impl ShadowTechnique for ShadowVolumes {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> Result<(), TechniqueError> {
-        let (Some(p), Some(b), Some(debug)) = (&self.pipelines, &self.buffers, &self.debug) else {
-            return Err(TechniqueError::Other(
-                "sv-zfail: record before prepare".into(),
-            ));
-        };
-        let (Some(volume), Some(args)) = (p.generator.volume(), p.generator.args()) else {
+        let (Some(p), Some(stats)) = (&self.passes, &self.stats) else {
             return Err(TechniqueError::not_prepared());
         };
-        let stats = b
-            .stats
-            .lock()
-            .ok()
-            .and_then(|mut ring| ring.target().cloned());
+        let Some(args) = p.generator.args() else {
+            return Err(TechniqueError::not_prepared());
+        };
+        let stats = (stats.lock().ok()).and_then(|mut ring| ring.target().cloned());
+        let showing_debug = matches!(ctx.debug_view, Some(COUNTS_VIEW | OVERLAY_VIEW));
         for light in 0..self.lights {
-            p.generator
-                .record(ctx, recorder, light, &generation_pass_name(light))?;
-            {
-                let name = volume_pass_name(light);
-                let stencil = zoo_host::gpu::stencil_attachment(
-                    &ctx.gbuffer.depth_view,
-                    wgpu::LoadOp::Clear(0),
-                );
-                let mut pass = ctx.light_pass(recorder, &name, light, stencil);
-                pass.set_pipeline(&p.volume);
-                pass.set_vertex_buffer(0, volume.slice(..));
-                pass.draw_indirect(args, 0);
-                pass.set_pipeline(&p.resolve);
-                pass.set_stencil_reference(0);
-                pass.draw(0..3, 0..1);
+            let debug_here = showing_debug && light as u32 == self.params.debug_light;
+            let pieces = p.generator.pieces(light);
+            // Each piece is generated into the one buffer and counted into the light's
+            // stencil before the next.
+            for piece in 0..pieces {
+                let name = piece_pass_name(GENERATION_PASS, light, piece);
+                p.generator.record(ctx, recorder, (light, piece), &name)?;
+                let last = piece + 1 == pieces;
+                let name = piece_pass_name(VOLUME_PASS, light, piece);
+                p.record_volume(ctx, recorder, (light, piece, last), &name)?;
+                if debug_here {
+                    let name = piece_pass_name(DEBUG_PASS, light, piece);
+                    p.record_overlay(ctx, recorder, (&self.debug, piece), &name)?;
+                }
             }
             if let Some(stats) = &stats {
                 recorder.encoder().copy_buffer_to_buffer(
@@ -172,41 +175,16 @@ impl ShadowTechnique for ShadowVolumes {
                     ARGS_BYTES,
                 );
             }
-            let showing_debug = matches!(ctx.debug_view, Some("stencil counts" | "volumes"));
-            if showing_debug && light as u32 == self.params.debug_light {
-                let name = debug_pass_name(light);
-                let clear = |view| {
-                    zoo_host::gpu::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::BLACK))
-                };
-                let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(&name),
-                    color_attachments: &[clear(&debug.counts.1), clear(&debug.overlay.1)],
-                    depth_stencil_attachment: zoo_host::gpu::stencil_attachment(
-                        &ctx.gbuffer.depth_view,
-                        wgpu::LoadOp::Load,
-                    ),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_bind_group(0, &ctx.frame.bind_group, &[]);
-                // Any non-zero count first (level 9), then the exact levels.
-                pass.set_pipeline(&p.count_any);
-                pass.set_stencil_reference(0);
-                pass.set_bind_group(1, &b.levels_bind_group, &[0]);
-                pass.draw(0..3, 0..1);
-                pass.set_pipeline(&p.count_equal);
-                for (k, level) in COUNT_LEVELS.iter().enumerate() {
-                    pass.set_stencil_reference(*level);
-                    pass.set_bind_group(1, &b.levels_bind_group, &[((k as u64 + 1) * SLOT) as u32]);
-                    pass.draw(0..3, 0..1);
-                }
-                pass.set_pipeline(&p.overlay);
-                pass.set_vertex_buffer(0, volume.slice(..));
-                pass.draw_indirect(args, 0);
+            if debug_here {
+                let name = light_pass_name(DEBUG_PASS, light);
+                p.record_counts(ctx, recorder, &self.debug, &name)?;
             }
         }
         Ok(())
+    }
+
+    fn warnings(&self) -> Vec<String> {
+        (self.passes.as_ref()).map_or(Vec::new(), |p| p.generator.warnings())
     }
 
     fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
@@ -216,25 +194,12 @@ impl ShadowTechnique for ShadowVolumes {
     }
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
-        let debug = self.debug.as_ref()?;
-        match resource {
-            "stencil counts" => Some(DebugImage {
-                view: &debug.counts.1,
-                mapping: ViewMapping::Integer,
-            }),
-            "volumes" => Some(DebugImage {
-                view: &debug.overlay.1,
-                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
-            }),
-            _ => None,
-        }
+        self.debug.debug_view(resource)
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        self.workload()
-            .into_iter()
-            .enumerate()
-            .flat_map(|(light, (silhouettes, triangles))| {
+        let workload = self.workload().into_iter().enumerate().flat_map(
+            |(light, (silhouettes, triangles))| {
                 [
                     (
                         format!("light {light} silhouette edges"),
@@ -242,8 +207,10 @@ impl ShadowTechnique for ShadowVolumes {
                     ),
                     (format!("light {light} volume triangles"), triangles as f64),
                 ]
-            })
-            .collect()
+            },
+        );
+        let pieces = (self.passes.iter()).flat_map(|p| p.generator.counters());
+        workload.chain(pieces).collect()
     }
 }
 
@@ -254,9 +221,9 @@ fn create(
     Ok(Box::new(ShadowVolumes {
         params: SvParams::from_values(values)?,
         device: gpu.device.clone(),
-        pipelines: None,
-        buffers: None,
-        debug: None,
+        passes: None,
+        stats: None,
+        debug: passes::debug_targets(),
         lights: 0,
     }))
 }

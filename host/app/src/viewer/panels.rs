@@ -12,15 +12,24 @@ use super::split::SplitMode;
 use super::state::ViewerState;
 
 const ERROR_RED: egui::Color32 = egui::Color32::from_rgb(230, 60, 60);
+const WARNING_AMBER: egui::Color32 = egui::Color32::from_rgb(235, 170, 40);
 
 impl ViewerState {
-    /// The left panel: errors, scene, technique, parameters, view, settings and screenshot.
+    /// The left panel: errors and the technique's warnings, scene, technique, parameters, view, settings and screenshot.
     pub fn controls(&mut self, ui: &mut egui::Ui) {
         if let Some(error) = &self.error {
             ui.colored_label(ERROR_RED, format!("Technique failed: {error}"));
             if ui.button("Dismiss").clicked() {
                 self.error = None;
             }
+            ui.separator();
+        }
+        // What the running technique cannot meet here, for as long as it cannot.
+        let warnings = self.renderer.technique_instance().warnings();
+        for warning in &warnings {
+            ui.colored_label(WARNING_AMBER, format!("Warning: {warning}"));
+        }
+        if !warnings.is_empty() {
             ui.separator();
         }
         if let Some(error) = &self.shader_error {

@@ -220,6 +220,8 @@ pub struct Judged {
     /// Whether it treated the scene's alpha-masked casters as opaque (see
     /// [`crate::MaskedCasters`]).
     pub masks_opaque: bool,
+    /// What it could not meet in the judged frame ([`crate::ShadowTechnique::warnings`]).
+    pub warnings: Vec<String>,
 }
 
 impl Judged {
@@ -306,6 +308,7 @@ pub fn judge_technique(
         slot_count: renderer.slots().slot_count(),
         indirect: registration.adds_light.then(|| renderer.read_indirect()),
         masks_opaque: registration.masks_opaque_in(renderer.scene()),
+        warnings: renderer.technique_instance().warnings(),
     })
 }
 

@@ -1,6 +1,5 @@
-//! Terse bind group layout entries and pipeline layouts with the host's groups first.
-
-use crate::technique::RenderContext;
+//! Terse bind group layout entries and bind groups by position, for the owners of shared
+//! groups (stages read their own layouts from the WGSL).
 
 /// A uniform buffer at `binding` (no dynamic offset).
 pub fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
@@ -102,22 +101,4 @@ pub fn bind_group_layout(
         label: Some(label),
         entries,
     })
-}
-
-/// A pipeline layout of the frame (group 0) and G-buffer (group 1) layouts followed by a
-/// technique's own `groups` (2, 3, ...).
-pub fn pipeline_layout(
-    ctx: &RenderContext<'_>,
-    label: &str,
-    groups: &[&wgpu::BindGroupLayout],
-) -> wgpu::PipelineLayout {
-    let mut layouts = vec![Some(&ctx.frame.layout), Some(&ctx.gbuffer.layout)];
-    layouts.extend(groups.iter().map(|g| Some(*g)));
-    ctx.gpu
-        .device
-        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(label),
-            bind_group_layouts: &layouts,
-            immediate_size: 0,
-        })
 }

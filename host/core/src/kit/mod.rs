@@ -4,8 +4,8 @@
 //!   the channel) and open a pass on it with the frame and G-buffer groups bound.
 //! - [`uniforms`]: per-light (or per-draw) uniforms in one buffer, at the device's dynamic
 //!   offset alignment.
-//! - [`layouts`]: terse bind group layout entries, bind groups by position, and pipeline
-//!   layouts that put the frame (group 0) and G-buffer (group 1) layouts first.
+//! - [`layouts`]: terse bind group layout entries and bind groups by position, for the owners
+//!   of shared groups.
 //! - [`lazy`]: GPU state built at the first `prepare`, with the not-prepared error once.
 //! - [`light_pass`]: a full-screen fragment shader run once per light into its slot, with
 //!   per-light uniforms.
@@ -27,9 +27,7 @@ pub mod slot;
 pub mod stage;
 pub mod uniforms;
 
-pub use layouts::{
-    bind_group, bind_group_layout, pipeline_layout, sampler, storage, texture, uniform,
-};
+pub use layouts::{bind_group, bind_group_layout, sampler, storage, texture, uniform};
 pub use lazy::LazyGpu;
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use resources::{NamedTextures, TextureSize, TextureSpec};

@@ -143,7 +143,10 @@ impl<'a> StageBuilder<'a> {
         shared.extend_from_slice(&self.shared);
         let count = reflected.groups.keys().next_back().map_or(0, |&g| g + 1);
         let groups = (0..count)
-            .map(|index| StageGroup::new(device, &label, index, reflected.group(index), &shared))
+            .map(|index| {
+                let bindings = reflected.group(index);
+                StageGroup::new(device, (&label, &loaded.ir), index, bindings, &shared)
+            })
             .collect::<Result<Vec<_>, String>>()
             .map_err(error)?;
         let empty_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -261,13 +264,15 @@ enum StageGroup {
     Own {
         layout: wgpu::BindGroupLayout,
         bindings: Vec<ReflectedBinding>,
+        /// Every variable the shader declares in the group, used by the stage or not.
+        declared: Vec<String>,
     },
 }
 
 impl StageGroup {
     fn new(
         device: &wgpu::Device,
-        label: &str,
+        (label, module): (&str, &naga::Module),
         index: u32,
         bindings: &[ReflectedBinding],
         shared: &[&dyn SharedGroup],
@@ -295,6 +300,7 @@ impl StageGroup {
                 entries: &entries,
             }),
             bindings: bindings.to_vec(),
+            declared: super::reflect::declared_variables(module, index),
         })
     }
 
@@ -390,7 +396,9 @@ impl Stage {
 
     /// A bind group of the stage's own group that declares the named `resources`, each named
     /// as its WGSL variable: every variable of the group the stage uses must be given, once,
-    /// with a resource of its kind.
+    /// with a resource of its kind. Variables the shader declares in the group but the stage's
+    /// entries do not use may be given too and are left out, so one list serves every stage
+    /// of a shader.
     pub fn bind(
         &self,
         ctx: &RenderContext<'_>,
@@ -402,12 +410,14 @@ impl Stage {
             message,
         };
         let first = resources.first().map_or("", |(name, _)| *name);
-        let (index, layout, bindings) = (self.groups.iter().enumerate())
+        let (index, layout, bindings, declared) = (self.groups.iter().enumerate())
             .find_map(|(index, group)| match group {
-                StageGroup::Own { layout, bindings }
-                    if bindings.iter().any(|b| b.name == first) =>
-                {
-                    Some((index as u32, layout, bindings))
+                StageGroup::Own {
+                    layout,
+                    bindings,
+                    declared,
+                } if declared.iter().any(|name| name == first) => {
+                    Some((index as u32, layout, bindings, declared))
                 }
                 _ => None,
             })
@@ -417,7 +427,13 @@ impl Stage {
                     self.own_names()
                 ))
             })?;
-        let entries = match_resources(bindings, resources).map_err(error)?;
+        let used: Vec<_> = (resources.iter())
+            .filter(|(name, _)| {
+                bindings.iter().any(|b| b.name == *name) || !declared.iter().any(|d| d == name)
+            })
+            .cloned()
+            .collect();
+        let entries = match_resources(bindings, &used).map_err(error)?;
         let group = ctx
             .gpu
             .device
@@ -468,10 +484,22 @@ impl Stage {
         shared: &[&dyn SharedGroup],
         extent: [u32; 3],
     ) -> Result<(), TechniqueError> {
+        let mut pass = recorder.compute_pass(name);
+        self.dispatch_in(ctx, &mut pass, (own, shared), extent)
+    }
+
+    /// As [`Self::dispatch`], in compute pass `pass`: for a pass of many dispatches (one
+    /// entry in the pass timings).
+    pub fn dispatch_in(
+        &self,
+        ctx: &RenderContext<'_>,
+        pass: &mut wgpu::ComputePass<'_>,
+        (own, shared): (&[&StageBindGroup], &[&dyn SharedGroup]),
+        extent: [u32; 3],
+    ) -> Result<(), TechniqueError> {
         let StagePipeline::Compute(pipeline) = &self.pipeline else {
             return Err(self.misuse("dispatched"));
         };
-        let mut pass = recorder.compute_pass(name);
         pass.set_pipeline(pipeline);
         self.each_group(ctx, own, shared, |index, group, offsets| {
             pass.set_bind_group(index, group, offsets)
