@@ -1,14 +1,14 @@
 //! The technique kit's helpers: uniforms at the device's alignment, inline shaders with
 //! imports, and slot writes that leave the other lights' channels untouched.
 
-use glam::UVec2;
+use glam::{UVec2, UVec3};
 use zoo_host::ShaderLibrary;
 use zoo_host::gpu::ShaderError;
 use zoo_host::kit::{
     LightSlot, NamedTextures, TextureSize, TextureSpec, UniformSlots, UniformValue,
 };
 use zoo_host::render::frame::GpuLight;
-use zoo_host::technique::ViewMapping;
+use zoo_host::technique::{ViewMapping, VolumeAxis, VolumeSlice};
 use zoo_host::test_support::gpu;
 use zoo_host::wgpu;
 
@@ -123,7 +123,6 @@ fn readback_ring_delivers_the_newest_results_without_waiting() {
 #[test]
 fn textures_are_made_again_only_when_their_shape_or_the_output_changes() {
     let gpu = gpu();
-    let device = &gpu.device;
     let format = wgpu::TextureFormat::R8Uint;
     let layered = TextureSpec {
         name: "layered",
@@ -140,14 +139,14 @@ fn textures_are_made_again_only_when_their_shape_or_the_output_changes() {
     );
     assert!(named.resources().is_empty() && named.view("ids").is_none());
     let screen = UVec2::new(16, 8);
-    assert!(named.prepare_at(device, screen));
-    assert!(!named.prepare_at(device, screen), "nothing changed");
+    assert!(named.prepare_at(&gpu, screen));
+    assert!(!named.prepare_at(&gpu, screen), "nothing changed");
     let texture = named.texture("ids").unwrap().clone();
     // A new view is not a new texture.
     named.respec("ids", |s| {
         s.view = Some(ViewMapping::Color { min: 0.0, max: 1.0 })
     });
-    assert!(!named.prepare_at(device, screen));
+    assert!(!named.prepare_at(&gpu, screen));
     assert_eq!(named.texture("ids").unwrap(), &texture);
     let shown = named.debug_view("ids").unwrap().mapping;
     assert_eq!(shown, ViewMapping::Color { min: 0.0, max: 1.0 });
@@ -165,10 +164,73 @@ fn textures_are_made_again_only_when_their_shape_or_the_output_changes() {
         ]
     );
     // A new output size or shape makes them again.
-    assert!(named.prepare_at(device, UVec2::new(32, 8)));
+    assert!(named.prepare_at(&gpu, UVec2::new(32, 8)));
     assert_ne!(named.texture("ids").unwrap(), &texture);
     named.respec("layered", |s| s.layers = 4);
-    assert!(named.prepare_at(device, UVec2::new(32, 8)));
+    assert!(named.prepare_at(&gpu, UVec2::new(32, 8)));
     assert_eq!(named.resources()[1].size, [16, 4, 4]);
+    assert!(gpu.take_uncaptured_errors().is_empty());
+}
+
+#[test]
+fn volumes_one_layer_arrays_and_aliases_are_made_and_shown_as_declared() {
+    let gpu = gpu();
+    let color = |max| ViewMapping::Color { min: 0.0, max };
+    let volume = TextureSpec {
+        size: TextureSize::Volume(UVec3::new(4, 4, 8)),
+        usage: wgpu::TextureUsages::STORAGE_BINDING,
+        aliases: vec![("grid b", color(2.0))],
+        ..TextureSpec::screen_target("grid a", wgpu::TextureFormat::Rgba16Float, Some(color(1.0)))
+    };
+    let array = TextureSpec {
+        size: TextureSize::Fixed(UVec2::new(16, 8)),
+        array: true,
+        ..TextureSpec::screen_target("array", wgpu::TextureFormat::R8Unorm, Some(color(1.0)))
+    };
+    let mut named = NamedTextures::new("test", [volume, array]);
+    assert!(named.prepare_at(&gpu, UVec2::new(16, 8)));
+    let grid = named.texture("grid a").unwrap();
+    assert_eq!(grid.dimension(), wgpu::TextureDimension::D3);
+    assert_eq!(grid.depth_or_array_layers(), 8);
+    assert!(
+        named.layer_view("grid a", 0).is_none(),
+        "a volume has no layers"
+    );
+    // A volume is shown as a slice, under each of its names, never as a 2D image.
+    let slice = VolumeSlice {
+        axis: VolumeAxis::Z,
+        index: 3,
+    };
+    assert!(named.debug_view("grid b").is_none());
+    assert_eq!(
+        named.debug_volume("grid b", slice).unwrap().mapping,
+        color(2.0)
+    );
+    assert_eq!(named.debug_volume("grid a", slice).unwrap().slice, slice);
+    assert!(named.debug_volume("array", slice).is_none());
+    assert_eq!(named.debug_view("array").unwrap().mapping, color(1.0));
+    assert!(named.layer_view("array", 0).is_some());
+    // The alias is listed after its texture, with no memory of its own.
+    let listed: Vec<_> = (named.resources().into_iter())
+        .map(|r| (r.name, r.size, r.bytes > 0))
+        .collect();
+    assert_eq!(
+        listed,
+        [
+            ("grid a".to_string(), [4, 4, 8], true),
+            ("grid b".to_string(), [4, 4, 8], false),
+            (
+                "array".to_string(),
+                [
+                    16,
+                    8,
+                    named.texture("array").unwrap().depth_or_array_layers()
+                ],
+                true
+            ),
+        ]
+    );
+    // Neither follows the output's size.
+    assert!(!named.prepare_at(&gpu, UVec2::new(32, 8)));
     assert!(gpu.take_uncaptured_errors().is_empty());
 }

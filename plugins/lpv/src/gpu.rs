@@ -1,12 +1,15 @@
 //! The GPU side of the light propagation volumes: the reflective shadow maps and the pass that
 //! fills them, the grids' buffers and the compute passes over them.
 
-use zoo_host::glam::{Mat4, UVec2, Vec3, Vec4};
+use zoo_host::glam::{Mat4, UVec2, UVec3, Vec3, Vec4};
 use zoo_host::gpu::GpuType;
-use zoo_host::kit::{self, SharedGroup, Stage, UniformSlots};
+use zoo_host::kit::{
+    self, NamedTextures, SharedGroup, Stage, TextureSize, TextureSpec, UniformSlots,
+};
 use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
 use zoo_host::render::SceneBuffers;
+use zoo_host::technique::ViewMapping;
 use zoo_shadow_maps::light_space::LightFrustum;
 
 use crate::LpvParams;
@@ -144,122 +147,74 @@ impl RsmCamera {
 }
 
 /// The reflective shadow maps (flux, normal and area, position; a layer per light) and the
-/// pass that renders them.
+/// pass that renders them into [`RSM_MAPS`] and [`RSM_DEPTH`].
 pub struct Rsm {
     stage: Stage,
     cameras: UniformSlots<RsmCamera>,
-    /// (flux, normal, position, depth) arrays, once sized.
-    pub targets: Option<RsmTargets>,
 }
 
-/// The maps of [`Rsm`].
-pub struct RsmTargets {
-    pub resolution: u32,
-    pub layers: u32,
-    pub flux: (wgpu::Texture, wgpu::TextureView),
-    pub normal: (wgpu::Texture, wgpu::TextureView),
-    pub position: (wgpu::Texture, wgpu::TextureView),
-    depth: wgpu::Texture,
-    /// Per layer: views of the three colour maps and the depth.
-    layer_views: Vec<[wgpu::TextureView; 4]>,
-}
-
-/// Formats of the flux, normal and position maps.
-pub const RSM_FORMATS: [wgpu::TextureFormat; 3] = [
-    wgpu::TextureFormat::Rgba16Float,
-    wgpu::TextureFormat::Rgba16Float,
-    wgpu::TextureFormat::Rgba16Float,
+/// The reflective shadow maps' colour targets: name, format and how the debug view shows it.
+pub const RSM_MAPS: [(&str, wgpu::TextureFormat, ViewMapping); 3] = [
+    // Flux: scaled so a texel of the sun's brightness shows.
+    (
+        "RSM flux",
+        wgpu::TextureFormat::Rgba16Float,
+        color(0.0, 1e-3),
+    ),
+    (
+        "RSM normals",
+        wgpu::TextureFormat::Rgba16Float,
+        color(-1.0, 1.0),
+    ),
+    (
+        "RSM positions",
+        wgpu::TextureFormat::Rgba16Float,
+        color(-20.0, 20.0),
+    ),
 ];
+/// The reflective shadow maps' depth.
+pub const RSM_DEPTH: &str = "RSM depth";
+/// The volume debug views, in the order of `DEBUG_SOURCE_*` in `lpv/debug.wgsl` (one grid drawn
+/// into one volume), each with its mapping.
+pub static VOLUME_VIEWS: [(&str, ViewMapping); 3] = [
+    ("light volume", color(0.0, 0.05)),
+    ("geometry volume", color(0.0, 0.5)),
+    ("emitter normals", color(0.0, 1.0)),
+];
+/// The grid bounds drawn over the screen.
+pub const BOUNDS_VIEW: &str = "cascade bounds";
 
-fn array_texture(
-    gpu: &GpuContext,
-    label: &str,
-    resolution: u32,
-    layers: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: resolution,
-            height: resolution,
-            depth_or_array_layers: zoo_host::gpu::array_layers(gpu, resolution, resolution, layers),
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    })
+const fn color(min: f32, max: f32) -> ViewMapping {
+    ViewMapping::Color { min, max }
 }
 
-fn layer_view(texture: &wgpu::Texture, label: &str, layer: u32) -> wgpu::TextureView {
-    texture.create_view(&wgpu::TextureViewDescriptor {
-        label: Some(label),
-        dimension: Some(wgpu::TextureViewDimension::D2),
-        base_array_layer: layer,
-        array_layer_count: Some(1),
-        ..Default::default()
-    })
-}
-
-fn array_view(texture: &wgpu::Texture, label: &str, layers: u32) -> wgpu::TextureView {
-    texture.create_view(&wgpu::TextureViewDescriptor {
-        label: Some(label),
-        dimension: Some(wgpu::TextureViewDimension::D2Array),
-        array_layer_count: Some(layers),
-        ..Default::default()
-    })
-}
-
-impl RsmTargets {
-    fn new(gpu: &GpuContext, resolution: u32, layers: u32) -> RsmTargets {
-        let layers = layers.max(1);
-        let names = ["lpv rsm flux", "lpv rsm normal", "lpv rsm position"];
-        let maps: Vec<wgpu::Texture> = names
-            .iter()
-            .zip(RSM_FORMATS)
-            .map(|(name, format)| array_texture(gpu, name, resolution, layers, format))
-            .collect();
-        let depth = array_texture(
-            gpu,
-            "lpv rsm depth",
-            resolution,
-            layers,
-            wgpu::TextureFormat::Depth32Float,
-        );
-        let layer_views = (0..layers)
-            .map(|l| {
-                [
-                    layer_view(&maps[0], "lpv rsm flux layer", l),
-                    layer_view(&maps[1], "lpv rsm normal layer", l),
-                    layer_view(&maps[2], "lpv rsm position layer", l),
-                    layer_view(&depth, "lpv rsm depth layer", l),
-                ]
-            })
-            .collect();
-        let with_view = |t: &wgpu::Texture, name: &str| (t.clone(), array_view(t, name, layers));
-        RsmTargets {
-            resolution,
-            layers,
-            flux: with_view(&maps[0], "lpv rsm flux (array)"),
-            normal: with_view(&maps[1], "lpv rsm normal (array)"),
-            position: with_view(&maps[2], "lpv rsm position (array)"),
-            depth,
-            layer_views,
-        }
-    }
-
-    /// The layer-0 view of map `k` (0 flux, 1 normal, 2 position), for debug views.
-    pub fn first_layer(&self, k: usize) -> &wgpu::TextureView {
-        &self.layer_views[0][k]
-    }
-
-    /// The depth array (for the memory table).
-    pub fn depth(&self) -> &wgpu::Texture {
-        &self.depth
-    }
+/// Every texture: the reflective shadow maps of `rsm_layers` lights at `rsm_size` texels a
+/// side, the debug volume of one `grid_size`³ grid and the grid bounds image.
+pub fn texture_specs(rsm_size: u32, rsm_layers: u32, grid_size: u32) -> Vec<TextureSpec> {
+    let rsm = |name, format, view| TextureSpec {
+        size: TextureSize::Fixed(UVec2::splat(rsm_size)),
+        layers: rsm_layers.max(1),
+        array: true,
+        ..TextureSpec::screen_target(name, format, view)
+    };
+    let mut specs: Vec<TextureSpec> = (RSM_MAPS.iter())
+        .map(|&(name, format, view)| rsm(name, format, Some(view)))
+        .collect();
+    specs.push(rsm(RSM_DEPTH, wgpu::TextureFormat::Depth32Float, None));
+    let [(volume, view), ref rest @ ..] = VOLUME_VIEWS;
+    let storage = wgpu::TextureUsages::STORAGE_BINDING;
+    specs.push(TextureSpec {
+        size: TextureSize::Volume(UVec3::splat(grid_size)),
+        usage: storage,
+        aliases: rest.to_vec(),
+        ..TextureSpec::screen_target(volume, wgpu::TextureFormat::Rgba16Float, Some(view))
+    });
+    let bounds = wgpu::TextureFormat::Rgba8Unorm;
+    specs.push(TextureSpec {
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | storage,
+        ..TextureSpec::screen_target(BOUNDS_VIEW, bounds, Some(color(0.0, 1.0)))
+    });
+    specs
 }
 
 /// The reflective shadow map passes (one per light, `"LPV RSM: light {l}"`).
@@ -286,11 +241,11 @@ impl Rsm {
     pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Rsm> {
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let cameras = UniformSlots::new(ctx.gpu, "lpv rsm cameras", 1, stages);
-        let targets: Vec<Option<wgpu::ColorTargetState>> = RSM_FORMATS
+        let targets: Vec<Option<wgpu::ColorTargetState>> = RSM_MAPS
             .iter()
-            .map(|format| {
+            .map(|&(_, format, _)| {
                 Some(wgpu::ColorTargetState {
-                    format: *format,
+                    format,
                     blend: None,
                     write_mask: wgpu::ColorWrites::ALL,
                 })
@@ -309,50 +264,38 @@ impl Rsm {
             })
             .shared(&[&cameras.at(0)])
             .build(ctx)?;
-        Ok(Rsm {
-            stage,
-            cameras,
-            targets: None,
-        })
+        Ok(Rsm { stage, cameras })
     }
 
-    /// Sizes the maps and uploads one camera per layer.
-    pub fn prepare(&mut self, ctx: &RenderContext<'_>, resolution: u32, cameras: &[RsmCamera]) {
-        let layers = cameras.len() as u32;
-        if self
-            .targets
-            .as_ref()
-            .is_none_or(|t| (t.resolution, t.layers) != (resolution, layers.max(1)))
-        {
-            self.targets = Some(RsmTargets::new(ctx.gpu, resolution, layers));
-        }
+    /// Uploads one camera per layer.
+    pub fn prepare(&mut self, ctx: &RenderContext<'_>, cameras: &[RsmCamera]) {
         self.cameras.write(ctx.gpu, cameras);
     }
 
-    /// Renders every layer: one pass per light, `"LPV RSM: light {l}"`.
+    /// Renders every layer of the maps in `targets` (see [`texture_specs`]): one pass per
+    /// light, `"LPV RSM: light {l}"`.
     pub fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
+        targets: &NamedTextures,
         lights: &[usize],
     ) -> TechniqueResult {
-        let targets = self
-            .targets
-            .as_ref()
-            .ok_or_else(TechniqueError::not_prepared)?;
         for (layer, light) in lights.iter().enumerate() {
-            let views = &targets.layer_views[layer];
+            let view = |name| {
+                (targets.layer_view(name, layer as u32)).ok_or_else(TechniqueError::not_prepared)
+            };
             let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
-            let colors: Vec<_> = views[..3]
-                .iter()
-                .map(|v| zoo_host::gpu::color_attachment(v, clear))
-                .collect();
+            let colors = (RSM_MAPS.iter())
+                .map(|m| Ok(zoo_host::gpu::color_attachment(view(m.0)?, clear)))
+                .collect::<TechniqueResult<Vec<_>>>()?;
+            let depth = view(RSM_DEPTH)?;
             let label = kit::light_pass_name(RSM_PASS, *light);
             let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(&label),
                 color_attachments: &colors,
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &views[3],
+                    view: depth,
                     depth_ops: Some(wgpu::Operations {
                         load: wgpu::LoadOp::Clear(1.0),
                         store: wgpu::StoreOp::Store,
@@ -415,47 +358,6 @@ impl Volumes {
                 buffer("lpv emitter moments a", light),
                 buffer("lpv emitter moments b", light),
             ],
-        }
-    }
-}
-
-/// The debug images: one grid as a volume, and the grid bounds on screen.
-pub struct DebugTargets {
-    pub volume: (wgpu::Texture, wgpu::TextureView),
-    pub bounds: (wgpu::Texture, wgpu::TextureView),
-}
-
-impl DebugTargets {
-    /// A `grid`³ volume and a `size` image.
-    pub fn new(gpu: &GpuContext, grid: u32, size: UVec2) -> DebugTargets {
-        let volume = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("lpv debug volume"),
-            size: wgpu::Extent3d {
-                width: grid,
-                height: grid,
-                depth_or_array_layers: grid,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D3,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let volume_view = volume.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("lpv debug volume view"),
-            ..Default::default()
-        });
-        let bounds = zoo_host::gpu::render_target(
-            &gpu.device,
-            "lpv debug bounds",
-            size,
-            wgpu::TextureFormat::Rgba8Unorm,
-            wgpu::TextureUsages::STORAGE_BINDING,
-        );
-        DebugTargets {
-            volume: (volume, volume_view),
-            bounds,
         }
     }
 }

@@ -23,15 +23,16 @@ pub mod sh;
 
 use zoo_host::glam::Vec3;
 use zoo_host::gpu::{GpuStruct, GpuType, gpu_bytes};
-use zoo_host::kit::{FullscreenLightPass, SharedGroup, Stage, StageBindGroup};
+use zoo_host::kit::{FullscreenLightPass, NamedTextures, SharedGroup, Stage, StageBindGroup};
 use zoo_host::prelude::*;
-use zoo_host::technique::{
-    DebugImage, DebugVolume, ResourceInfo, ViewMapping, VolumeAxis, VolumeSlice,
-};
+use zoo_host::technique::{DebugImage, DebugVolume, ResourceInfo, VolumeAxis, VolumeSlice};
 use zoo_shadow_maps::light_space::{directional_frustum_over, spot_frustum};
 use zoo_shadow_maps::{DepthState, ShadowMapSet, object_bounds};
 
-use gpu::{DebugTargets, LpvData, LpvSettings, Rsm, RsmCamera, Volumes};
+use gpu::{
+    BOUNDS_VIEW, LpvData, LpvSettings, RSM_DEPTH, Rsm, RsmCamera, VOLUME_VIEWS, Volumes,
+    texture_specs,
+};
 
 zoo_host::param_choice! {
     /// The axis the volume debug views cut across.
@@ -151,9 +152,6 @@ fn spread_pass_names() -> Vec<String> {
         .collect()
 }
 
-const VOLUME_VIEWS: [&str; 3] = ["light volume", "geometry volume", "emitter normals"];
-const RSM_VIEWS: [&str; 3] = ["RSM flux", "RSM normals", "RSM positions"];
-
 /// The compute stages.
 struct Stages {
     inject: Stage,
@@ -211,14 +209,15 @@ struct Gpu {
     stages: Stages,
     volumes: Option<Volumes>,
     data: wgpu::Buffer,
-    debug: Option<DebugTargets>,
+    /// The reflective shadow maps and the debug images ([`texture_specs`]).
+    targets: NamedTextures,
     groups: Option<Groups>,
     /// Lights with a reflective shadow map, one per layer.
     rsm_lights: Vec<usize>,
 }
 
 impl Gpu {
-    fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Gpu> {
+    fn new(ctx: &RenderContext<'_>, p: &LpvParams) -> TechniqueResult<Gpu> {
         let state = DepthState {
             slope_bias: 1.5,
             ..DepthState::default()
@@ -243,10 +242,96 @@ impl Gpu {
             stages: Stages::new(ctx)?,
             volumes: None,
             data,
-            debug: None,
+            targets: NamedTextures::new("lpv", texture_specs(p.rsm_size, 1, p.grid_size)),
             groups: None,
             rsm_lights: Vec::new(),
         })
+    }
+
+    /// Texels along a side of the reflective shadow maps, once made.
+    fn rsm_resolution(&self) -> Option<u32> {
+        self.targets.texture(RSM_DEPTH).map(|t| t.width())
+    }
+
+    /// Spreads the emitters' moments and propagates the light through the grids.
+    fn record_propagation(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        (groups, volumes): (&Groups, &Volumes),
+        p: &LpvParams,
+    ) -> TechniqueResult {
+        let n = p.grid_size;
+        let extent = [n, n, n * p.cascades];
+        if p.emitter_orientation {
+            // Two boxes along each axis make a tent: a -> b -> a -> b -> a -> b -> a, so the
+            // spread moments end in a.
+            for (i, name) in spread_pass_names().iter().enumerate() {
+                let stage = &self.stages.spread[i % 3];
+                let group = &groups.spread[i % 2];
+                stage.dispatch(ctx, recorder, name, &[group], &[], extent)?;
+            }
+        }
+        // Coarser grids keep what they hold after half the steps: the share of their light
+        // the next finer grid (half the cell, as many steps) carries in finer detail.
+        // (Rounded down: with odd iterations the finer grid's last half step of reach is
+        // counted twice.)
+        let near_steps = p.iterations / 2;
+        let keep_near = p.coarse_far_light && p.cascades > 1;
+        if keep_near && near_steps == 0 {
+            copy_whole(recorder.encoder(), &volumes.accumulated, &volumes.near);
+        }
+        for i in 0..p.iterations {
+            let name = format!("{} {}", gpu::PROPAGATE_PASS, i + 1);
+            let group = &groups.propagate[(i % 2) as usize];
+            let stage = &self.stages.propagate;
+            stage.dispatch(ctx, recorder, &name, &[group], &[], extent)?;
+            if keep_near && i + 1 == near_steps {
+                copy_whole(recorder.encoder(), &volumes.accumulated, &volumes.near);
+            }
+        }
+        Ok(())
+    }
+
+    /// Draws debug view `name` when it is a volume view or the grid bounds.
+    fn record_debug(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        groups: &Groups,
+        name: &str,
+        grid_size: u32,
+    ) -> TechniqueResult {
+        let volume = VOLUME_VIEWS.iter().position(|v| v.0 == name);
+        if let Some(source) = volume {
+            // The settings start `LpvData`.
+            let offset = gpu_offset::<LpvSettings>("debug_source");
+            let code = source as u32;
+            ctx.gpu
+                .queue
+                .write_buffer(&self.data, offset, bytemuck::bytes_of(&code));
+            let g = grid_size;
+            let stage = &self.stages.debug_volume;
+            stage.dispatch(
+                ctx,
+                recorder,
+                gpu::DEBUG_VOLUME_PASS,
+                &[&groups.debug_volume],
+                &[],
+                [g, g, g],
+            )?;
+        } else if name == BOUNDS_VIEW {
+            let stage = &self.stages.debug_bounds;
+            stage.dispatch(
+                ctx,
+                recorder,
+                gpu::DEBUG_BOUNDS_PASS,
+                &[&groups.debug_bounds],
+                &[],
+                [ctx.size.x, ctx.size.y, 1],
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -295,14 +380,7 @@ impl ShadowTechnique for Lpv {
         let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
-        let mut out = Vec::new();
-        if let Some(t) = &gpu.rsm.targets {
-            for (k, name) in RSM_VIEWS.into_iter().enumerate() {
-                let texture = [&t.flux.0, &t.normal.0, &t.position.0][k];
-                out.push(ResourceInfo::texture(name, texture, true));
-            }
-            out.push(ResourceInfo::texture("RSM depth", t.depth(), false));
-        }
+        let mut out = gpu.targets.resources();
         if let Some(v) = &gpu.volumes {
             // (name, buffer, what a cell holds)
             let buffers = [
@@ -320,14 +398,6 @@ impl ShadowTechnique for Lpv {
                 out.push(ResourceInfo::buffer(name, buffer, layout));
             }
         }
-        if let Some(d) = &gpu.debug {
-            for (k, name) in VOLUME_VIEWS.into_iter().enumerate() {
-                let mut info = ResourceInfo::texture(name, &d.volume.0, true);
-                info.bytes *= u64::from(k == 0);
-                out.push(info);
-            }
-            out.push(ResourceInfo::texture("cascade bounds", &d.bounds.0, true));
-        }
         if let Some(maps) = gpu.maps.maps() {
             out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
         }
@@ -335,7 +405,8 @@ impl ShadowTechnique for Lpv {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        self.gpu.prepare(changes.scene, || Gpu::new(ctx))?;
+        self.gpu
+            .prepare(changes.scene, || Gpu::new(ctx, &self.params))?;
         let rsm_lights = self.rsm_lights(ctx.lights);
         let p = self.params.clone();
         let gpu = self.gpu.get_mut()?;
@@ -358,7 +429,10 @@ impl ShadowTechnique for Lpv {
                 RsmCamera::new(&frustum, l, p.rsm_size, origin)
             })
             .collect();
-        gpu.rsm.prepare(ctx, p.rsm_size, &cameras);
+        gpu.rsm.prepare(ctx, &cameras);
+        let specs = texture_specs(p.rsm_size, rsm_lights.len() as u32, p.grid_size);
+        gpu.targets.respec_all(specs);
+        gpu.targets.prepare(ctx);
         gpu.rsm_lights = rsm_lights.clone();
         // The grids, in front of the camera.
         let diagonal = bounds.0.distance(bounds.1);
@@ -373,13 +447,6 @@ impl ShadowTechnique for Lpv {
         let new_volumes = gpu.volumes.as_ref().is_none_or(|v| v.cells != cells);
         if new_volumes {
             gpu.volumes = Some(Volumes::new(ctx.gpu, cells));
-        }
-        let new_debug = gpu.debug.as_ref().is_none_or(|d| {
-            d.volume.0.width() != p.grid_size
-                || (d.bounds.0.width(), d.bounds.0.height()) != (ctx.size.x, ctx.size.y)
-        });
-        if new_debug {
-            gpu.debug = Some(DebugTargets::new(ctx.gpu, p.grid_size, ctx.size));
         }
         let settings = LpvSettings {
             params: gpu::ShaderParams(p.shader_block()),
@@ -405,13 +472,13 @@ impl ShadowTechnique for Lpv {
     ) -> TechniqueResult {
         let p = self.params.clone();
         let gpu = self.gpu.get_mut()?;
-        let (Some(groups), Some(volumes), Some(targets)) =
-            (&gpu.groups, &gpu.volumes, &gpu.rsm.targets)
+        let (Some(groups), Some(volumes), Some(resolution)) =
+            (&gpu.groups, &gpu.volumes, gpu.rsm_resolution())
         else {
             return Err(TechniqueError::not_prepared());
         };
         gpu.maps.record(ctx, recorder, MAP_PASS)?;
-        gpu.rsm.record(ctx, recorder, &gpu.rsm_lights)?;
+        (gpu.rsm).record(ctx, recorder, &gpu.targets, &gpu.rsm_lights)?;
         let encoder = recorder.encoder();
         encoder.clear_buffer(&volumes.light_sums, 0, None);
         encoder.clear_buffer(&volumes.occluder_sums, 0, None);
@@ -425,7 +492,7 @@ impl ShadowTechnique for Lpv {
                 gpu::INJECT_PASS,
                 &[&groups.inject],
                 &[],
-                [targets.resolution, targets.resolution, layers],
+                [resolution, resolution, layers],
             )?;
         } else {
             drop(recorder.compute_pass(gpu::INJECT_PASS));
@@ -450,34 +517,7 @@ impl ShadowTechnique for Lpv {
             &[],
             [entries, 1, 1],
         )?;
-        let n = p.grid_size;
-        if p.emitter_orientation {
-            // Two boxes along each axis make a tent: a -> b -> a -> b -> a -> b -> a, so the
-            // spread moments end in a.
-            for (i, name) in spread_pass_names().iter().enumerate() {
-                let stage = &s.spread[i % 3];
-                let group = &groups.spread[i % 2];
-                stage.dispatch(ctx, recorder, name, &[group], &[], [n, n, n * p.cascades])?;
-            }
-        }
-        // Coarser grids keep what they hold after half the steps: the share of their light
-        // the next finer grid (half the cell, as many steps) carries in finer detail.
-        // (Rounded down: with odd iterations the finer grid's last half step of reach is
-        // counted twice.)
-        let near_steps = p.iterations / 2;
-        let keep_near = p.coarse_far_light && p.cascades > 1;
-        if keep_near && near_steps == 0 {
-            copy_whole(recorder.encoder(), &volumes.accumulated, &volumes.near);
-        }
-        for i in 0..p.iterations {
-            let name = format!("{} {}", gpu::PROPAGATE_PASS, i + 1);
-            let group = &groups.propagate[(i % 2) as usize];
-            s.propagate
-                .dispatch(ctx, recorder, &name, &[group], &[], [n, n, n * p.cascades])?;
-            if keep_near && i + 1 == near_steps {
-                copy_whole(recorder.encoder(), &volumes.accumulated, &volumes.near);
-            }
-        }
+        gpu.record_propagation(ctx, recorder, (groups, volumes), &p)?;
         s.lookup.dispatch(
             ctx,
             recorder,
@@ -486,53 +526,9 @@ impl ShadowTechnique for Lpv {
             &[],
             screen,
         )?;
-        let lights = gpu.maps.lights().to_vec();
-        let shadow = |light: usize| {
-            let maps = &lights[light];
-            let scale = maps.scale();
-            LpvShadow {
-                first_layer: maps.first_layer,
-                layer_count: maps.frustums.len() as u32,
-                light: light as u32,
-                perspective: u32::from(scale.perspective),
-                texel_scale: scale.texel_scale,
-                normal_offset: 1.5,
-            }
-        };
-        let lookup = [&gpu.maps.lookup() as &dyn SharedGroup];
-        (gpu.shadows).record_with(ctx, recorder, SHADOW_PASS, shadow, &[], &lookup)?;
-        // Debug views.
-        let shown = ctx.debug_view;
-        if let Some(name) = shown {
-            let volume = VOLUME_VIEWS.iter().position(|v| *v == name);
-            if let Some(source) = volume {
-                // The settings start `LpvData`.
-                let offset = gpu_offset::<LpvSettings>("debug_source");
-                let code = source as u32;
-                ctx.gpu
-                    .queue
-                    .write_buffer(&gpu.data, offset, bytemuck::bytes_of(&code));
-                let g = p.grid_size;
-                let stage = &gpu.stages.debug_volume;
-                stage.dispatch(
-                    ctx,
-                    recorder,
-                    gpu::DEBUG_VOLUME_PASS,
-                    &[&groups.debug_volume],
-                    &[],
-                    [g, g, g],
-                )?;
-            } else if name == "cascade bounds" {
-                let stage = &gpu.stages.debug_bounds;
-                stage.dispatch(
-                    ctx,
-                    recorder,
-                    gpu::DEBUG_BOUNDS_PASS,
-                    &[&groups.debug_bounds],
-                    &[],
-                    screen,
-                )?;
-            }
+        record_shadows((&gpu.maps, &mut gpu.shadows), ctx, recorder)?;
+        if let Some(name) = ctx.debug_view {
+            gpu.record_debug(ctx, recorder, groups, name, p.grid_size)?;
         }
         Ok(())
     }
@@ -542,52 +538,20 @@ impl ShadowTechnique for Lpv {
         if resource == "shadow maps" {
             return gpu.maps.debug_image(0);
         }
-        if resource == "cascade bounds" {
-            return Some(DebugImage {
-                view: &gpu.debug.as_ref()?.bounds.1,
-                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
-            });
-        }
-        let k = RSM_VIEWS.iter().position(|v| *v == resource)?;
-        let targets = gpu.rsm.targets.as_ref()?;
-        let mapping = match k {
-            // Flux: scaled so a texel of the sun's brightness shows.
-            0 => ViewMapping::Color {
-                min: 0.0,
-                max: 1e-3,
-            },
-            1 => ViewMapping::Color {
-                min: -1.0,
-                max: 1.0,
-            },
-            _ => ViewMapping::Color {
-                min: -20.0,
-                max: 20.0,
-            },
-        };
-        Some(DebugImage {
-            view: targets.first_layer(k),
-            mapping,
-        })
+        gpu.targets.debug_view(resource)
     }
 
     fn debug_volume(&self, resource: &str) -> Option<DebugVolume<'_>> {
-        let source = VOLUME_VIEWS.iter().position(|v| *v == resource)?;
-        let gpu = self.gpu.built()?;
         let axis = match self.params.slice_axis {
             SliceAxis::X => VolumeAxis::X,
             SliceAxis::Y => VolumeAxis::Y,
             SliceAxis::Z => VolumeAxis::Z,
         };
-        let max = [0.05, 0.5, 1.0][source];
-        Some(DebugVolume {
-            view: &gpu.debug.as_ref()?.volume.1,
-            mapping: ViewMapping::Color { min: 0.0, max },
-            slice: VolumeSlice {
-                axis,
-                index: self.params.slice_index,
-            },
-        })
+        let slice = VolumeSlice {
+            axis,
+            index: self.params.slice_index,
+        };
+        self.gpu.built()?.targets.debug_volume(resource, slice)
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -600,14 +564,37 @@ impl ShadowTechnique for Lpv {
             return Vec::new();
         };
         let mut counters = gpu.maps.counters();
-        let vpls = gpu.rsm.targets.as_ref().map_or(0, |t| {
-            u64::from(t.resolution).pow(2) * gpu.rsm_lights.len() as u64
+        let vpls = gpu.rsm_resolution().map_or(0, |resolution| {
+            u64::from(resolution).pow(2) * gpu.rsm_lights.len() as u64
         });
         counters.push(("virtual point lights".into(), vpls as f64));
         let cells = gpu.volumes.as_ref().map_or(0, |v| v.cells);
         counters.push(("grid cells".into(), cells as f64));
         counters
     }
+}
+
+/// Draws each light's direct shadows from its shadow `maps` into its visibility slot.
+fn record_shadows(
+    (maps, shadows): (&ShadowMapSet, &mut FullscreenLightPass<LpvShadow>),
+    ctx: &RenderContext<'_>,
+    recorder: &mut PassRecorder<'_>,
+) -> TechniqueResult {
+    let lights = maps.lights();
+    let shadow = |light: usize| {
+        let maps = &lights[light];
+        let scale = maps.scale();
+        LpvShadow {
+            first_layer: maps.first_layer,
+            layer_count: maps.frustums.len() as u32,
+            light: light as u32,
+            perspective: u32::from(scale.perspective),
+            texel_scale: scale.texel_scale,
+            normal_offset: 1.5,
+        }
+    };
+    let lookup = [&maps.lookup() as &dyn SharedGroup];
+    shadows.record_with(ctx, recorder, SHADOW_PASS, shadow, &[], &lookup)
 }
 
 /// Copies all of `from` into `to` (buffers of one size).
@@ -618,13 +605,90 @@ fn copy_whole(encoder: &mut wgpu::CommandEncoder, from: &wgpu::Buffer, to: &wgpu
 /// Bind groups over the current data, buffers and maps.
 fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> TechniqueResult<Groups> {
     let v = gpu.volumes.as_ref().expect("made in prepare");
-    let t = gpu.rsm.targets.as_ref().expect("made in prepare");
-    let d = gpu.debug.as_ref().expect("made in prepare");
     let s = &gpu.stages;
-    fn buffer(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
-        b.as_entire_binding()
-    }
-    let view = wgpu::BindingResource::TextureView;
+    let buffer = wgpu::Buffer::as_entire_binding;
+    let view = |name| {
+        let view = gpu.targets.view(name).expect("made in prepare");
+        wgpu::BindingResource::TextureView(view)
+    };
+    let [flux, normal, position] = gpu::RSM_MAPS.map(|m| view(m.0));
+    let data = || ("lpv", buffer(&gpu.data));
+    let (propagate, spread) = ping_pong_groups(ctx, gpu)?;
+    Ok(Groups {
+        inject: s.inject.bind(
+            ctx,
+            "lpv inject group",
+            &[
+                data(),
+                ("rsm_flux", flux),
+                ("rsm_normal", normal),
+                ("rsm_position", position),
+                ("light_sums", buffer(&v.light_sums)),
+                ("occluder_sums", buffer(&v.occluder_sums)),
+                ("moment_sums", buffer(&v.moment_sums)),
+            ],
+        )?,
+        camera_occluders: s.camera_occluders.bind(
+            ctx,
+            "lpv camera occluders group",
+            &[data(), ("occluder_sums", buffer(&v.occluder_sums))],
+        )?,
+        resolve: s.resolve.bind(
+            ctx,
+            "lpv resolve group",
+            &[
+                data(),
+                ("light_sums", buffer(&v.light_sums)),
+                ("light", buffer(&v.steps[0])),
+                ("accumulated", buffer(&v.accumulated)),
+                ("moment_sums", buffer(&v.moment_sums)),
+                ("moments", buffer(&v.moments[0])),
+            ],
+        )?,
+        propagate,
+        spread,
+        lookup: s.lookup.bind(
+            ctx,
+            "lpv lookup group",
+            &[
+                data(),
+                ("accumulated", buffer(&v.accumulated)),
+                (
+                    "indirect_out",
+                    wgpu::BindingResource::TextureView(&ctx.indirect.view),
+                ),
+                ("near", buffer(&v.near)),
+                ("moments", buffer(&v.moments[0])),
+                ("occluder_sums", buffer(&v.occluder_sums)),
+            ],
+        )?,
+        debug_volume: s.debug_volume.bind(
+            ctx,
+            "lpv debug volume group",
+            &[
+                data(),
+                ("accumulated", buffer(&v.accumulated)),
+                ("occluder_sums", buffer(&v.occluder_sums)),
+                ("volume_out", view(VOLUME_VIEWS[0].0)),
+                ("moments", buffer(&v.moments[0])),
+            ],
+        )?,
+        debug_bounds: s.debug_bounds.bind(
+            ctx,
+            "lpv debug bounds group",
+            &[data(), ("bounds_out", view(BOUNDS_VIEW))],
+        )?,
+    })
+}
+
+/// The propagation steps' and the spread's bind groups, each a to b and b to a.
+type PingPong = ([StageBindGroup; 2], [StageBindGroup; 2]);
+
+/// The groups of the passes that ping-pong between two buffers: propagation and spread.
+fn ping_pong_groups(ctx: &RenderContext<'_>, gpu: &Gpu) -> TechniqueResult<PingPong> {
+    let v = gpu.volumes.as_ref().expect("made in prepare");
+    let s = &gpu.stages;
+    let buffer = wgpu::Buffer::as_entire_binding;
     let data = || ("lpv", buffer(&gpu.data));
     let propagate = |from: usize| {
         s.propagate.bind(
@@ -650,68 +714,7 @@ fn bind(ctx: &RenderContext<'_>, gpu: &Gpu) -> TechniqueResult<Groups> {
             ],
         )
     };
-    Ok(Groups {
-        inject: s.inject.bind(
-            ctx,
-            "lpv inject group",
-            &[
-                data(),
-                ("rsm_flux", view(&t.flux.1)),
-                ("rsm_normal", view(&t.normal.1)),
-                ("rsm_position", view(&t.position.1)),
-                ("light_sums", buffer(&v.light_sums)),
-                ("occluder_sums", buffer(&v.occluder_sums)),
-                ("moment_sums", buffer(&v.moment_sums)),
-            ],
-        )?,
-        camera_occluders: s.camera_occluders.bind(
-            ctx,
-            "lpv camera occluders group",
-            &[data(), ("occluder_sums", buffer(&v.occluder_sums))],
-        )?,
-        resolve: s.resolve.bind(
-            ctx,
-            "lpv resolve group",
-            &[
-                data(),
-                ("light_sums", buffer(&v.light_sums)),
-                ("light", buffer(&v.steps[0])),
-                ("accumulated", buffer(&v.accumulated)),
-                ("moment_sums", buffer(&v.moment_sums)),
-                ("moments", buffer(&v.moments[0])),
-            ],
-        )?,
-        propagate: [propagate(0)?, propagate(1)?],
-        spread: [spread(0)?, spread(1)?],
-        lookup: s.lookup.bind(
-            ctx,
-            "lpv lookup group",
-            &[
-                data(),
-                ("accumulated", buffer(&v.accumulated)),
-                ("indirect_out", view(&ctx.indirect.view)),
-                ("near", buffer(&v.near)),
-                ("moments", buffer(&v.moments[0])),
-                ("occluder_sums", buffer(&v.occluder_sums)),
-            ],
-        )?,
-        debug_volume: s.debug_volume.bind(
-            ctx,
-            "lpv debug volume group",
-            &[
-                data(),
-                ("accumulated", buffer(&v.accumulated)),
-                ("occluder_sums", buffer(&v.occluder_sums)),
-                ("volume_out", view(&d.volume.1)),
-                ("moments", buffer(&v.moments[0])),
-            ],
-        )?,
-        debug_bounds: s.debug_bounds.bind(
-            ctx,
-            "lpv debug bounds group",
-            &[data(), ("bounds_out", view(&d.bounds.1))],
-        )?,
-    })
+    Ok(([propagate(0)?, propagate(1)?], [spread(0)?, spread(1)?]))
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
@@ -759,7 +762,7 @@ mod tests {
         let codes = zoo_host::gpu::layout::ChoiceCodes::read(&source, "DEBUG_SOURCE", &names);
         let codes = codes.unwrap();
         assert_eq!(names.len(), VOLUME_VIEWS.len());
-        for (k, view) in VOLUME_VIEWS.iter().enumerate() {
+        for (k, (view, _)) in VOLUME_VIEWS.iter().enumerate() {
             assert_eq!(codes.code(k), k as u32, "{view} is written as its position");
         }
     }

@@ -1,13 +1,13 @@
-//! The GPU side of the layered soft shadows: the layered targets and the compute passes
-//! (penumbra, two blur passes, debug views) with their bind groups.
+//! The GPU side of the layered soft shadows: the declarations of the layered targets and the
+//! compute passes (penumbra, two blur passes, debug views) with their bind groups.
 
 use zoo_host::glam::{UVec2, UVec4};
-use zoo_host::gpu::array_layers;
 use zoo_host::gpu::gpu_struct::round_up;
 use zoo_host::gpu::{GpuStruct, GpuType};
-use zoo_host::kit::{SharedGroup, Stage, StageBindGroup};
+use zoo_host::kit::{NamedTextures, SharedGroup, Stage, StageBindGroup, TextureSize, TextureSpec};
 use zoo_host::params::shader::padded_words;
 use zoo_host::prelude::*;
+use zoo_host::technique::{ResourceInfo, ViewMapping};
 use zoo_shadow_maps::{ShadowMapSet, TranslucentPass};
 
 use crate::SsssParams;
@@ -100,128 +100,74 @@ pub fn debug_mode_offset() -> u64 {
     member.expect("a member of the settings").offset as u64
 }
 
-/// A layered screen-size target: its texture and an array view.
-pub struct Layered {
-    pub texture: wgpu::Texture,
-    pub view: wgpu::TextureView,
-}
+/// Blur sigma in pixels, four layers per texel.
+pub const PENUMBRA: &str = "layered penumbra";
+/// Occluded then tinted bits, 32 layers per texel.
+pub const BITS: &str = "layered bits";
+/// Tint colour per layer (translucent scenes; one dummy layer otherwise).
+pub const TINTS: &str = "layered tints";
+/// Each blur pass's output on the blur grid: occlusion, four layers per texel, and the colour
+/// that arrives per layer (translucent scenes).
+pub const BLURRED: [[&str; 2]; 2] = [
+    ["blurred occlusion 1", "blurred light 1"],
+    ["blurred occlusion 2", "blurred light 2"],
+];
+/// The views the debug pass draws into its one image: each view's name and the name of its
+/// `DEBUG_*` constant in `ssss/debug.wgsl`.
+pub const DEBUG_VIEWS: [(&str, &str); 5] = [
+    ("layer assignment", "Layers"),
+    ("penumbra sizes", "Penumbra"),
+    ("hard shadows", "Hard"),
+    ("blurred shadows", "Blurred"),
+    ("translucency", "Translucency"),
+];
 
-impl Layered {
-    fn new(
-        gpu: &GpuContext,
-        label: &str,
-        size: UVec2,
-        layers: u32,
-        format: wgpu::TextureFormat,
-    ) -> Layered {
-        let layers = layers.max(1);
-        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: size.x,
-                height: size.y,
-                depth_or_array_layers: array_layers(gpu, size.x, size.y, layers),
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some(&format!("{label} (array)")),
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            array_layer_count: Some(layers),
-            ..Default::default()
-        });
-        Layered { texture, view }
+/// Every screen-size target, for `layer_count` layers, with colour layers when `translucent`
+/// and the blur grid at half size when `half_resolution`.
+pub fn target_specs(
+    layer_count: u32,
+    translucent: bool,
+    half_resolution: bool,
+) -> Vec<TextureSpec> {
+    use wgpu::TextureFormat as F;
+    let groups = layer_count.div_ceil(4);
+    let words = layer_count.div_ceil(32);
+    let colored = if translucent { layer_count } else { 1 };
+    let grid = TextureSize::Screen {
+        divisor: if half_resolution { 2 } else { 1 },
+    };
+    let layered = |name, size, layers, format| TextureSpec {
+        name,
+        size,
+        layers,
+        array: true,
+        format,
+        usage: wgpu::TextureUsages::STORAGE_BINDING,
+        view: None,
+        aliases: Vec::new(),
+    };
+    let screen = TextureSize::SCREEN;
+    let mut specs = vec![
+        debug_spec(),
+        layered(PENUMBRA, screen, groups, F::Rgba16Float),
+        layered(BITS, screen, 2 * words, F::R32Uint),
+        layered(TINTS, screen, colored, F::Rgba16Float),
+    ];
+    for [occlusion, light] in BLURRED {
+        specs.push(layered(occlusion, grid, groups, F::Rgba16Float));
+        specs.push(layered(light, grid, colored, F::Rgba16Float));
     }
+    specs
 }
 
-/// Every screen-size target, sized for a layer count.
-pub struct Targets {
-    pub size: UVec2,
-    pub layer_count: u32,
-    pub translucent: bool,
-    pub half_resolution: bool,
-    /// Blur sigma in pixels, four layers per texel.
-    pub penumbra: Layered,
-    /// Occluded then tinted bits, 32 layers per texel.
-    pub bits: Layered,
-    /// Tint colour per layer (translucent scenes; one dummy layer otherwise).
-    pub tints: Layered,
-    /// Each blur pass's output on the blur grid: occlusion, four layers per texel, and the
-    /// colour that arrives per layer (translucent scenes).
-    pub blurred: [(Layered, Layered); 2],
-    /// Debug views.
-    pub debug: (wgpu::Texture, wgpu::TextureView),
-}
-
-impl Targets {
-    /// Targets for `layer_count` layers at output `size`, with colour layers when
-    /// `translucent` and the blur grid at half size when `half_resolution`.
-    pub fn new(
-        gpu: &GpuContext,
-        size: UVec2,
-        layer_count: u32,
-        translucent: bool,
-        half_resolution: bool,
-    ) -> Targets {
-        let groups = layer_count.div_ceil(4);
-        let words = layer_count.div_ceil(32);
-        let colored = if translucent { layer_count } else { 1 };
-        let grid = if half_resolution {
-            size.map(|side| side.div_ceil(2))
-        } else {
-            size
-        };
-        use wgpu::TextureFormat as F;
-        let layered =
-            |label: &str, size, layers, format| Layered::new(gpu, label, size, layers, format);
-        let blurred = |pass| {
-            (
-                layered(
-                    &format!("ssss blurred occlusion {pass}"),
-                    grid,
-                    groups,
-                    F::Rgba16Float,
-                ),
-                layered(
-                    &format!("ssss blurred light {pass}"),
-                    grid,
-                    colored,
-                    F::Rgba16Float,
-                ),
-            )
-        };
-        Targets {
-            size,
-            layer_count,
-            translucent,
-            half_resolution,
-            penumbra: layered("ssss penumbra", size, groups, F::Rgba16Float),
-            bits: layered("ssss hard shadow bits", size, 2 * words, F::R32Uint),
-            tints: layered("ssss tints", size, colored, F::Rgba16Float),
-            blurred: [blurred(1), blurred(2)],
-            debug: zoo_host::gpu::render_target(
-                &gpu.device,
-                "ssss debug view",
-                size,
-                F::Rgba8Unorm,
-                wgpu::TextureUsages::STORAGE_BINDING,
-            ),
-        }
-    }
-
-    /// Whether these targets serve `layer_count` layers at `size`.
-    pub fn fit(&self, size: UVec2, layer_count: u32, translucent: bool, half: bool) -> bool {
-        self.size == size
-            && self.translucent == translucent
-            && self.half_resolution == half
-            && self.layer_count.div_ceil(4) == layer_count.div_ceil(4)
-            && (!translucent || self.layer_count == layer_count)
-            && self.layer_count.div_ceil(32) == layer_count.div_ceil(32)
+/// The debug pass's image, shown under the name of each of [`DEBUG_VIEWS`].
+fn debug_spec() -> TextureSpec {
+    let shown = ViewMapping::Color { min: 0.0, max: 1.0 };
+    let [(first, _), rest @ ..] = DEBUG_VIEWS;
+    TextureSpec {
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::STORAGE_BINDING,
+        aliases: rest.iter().map(|(name, _)| (*name, shown)).collect(),
+        ..TextureSpec::screen_target(first, wgpu::TextureFormat::Rgba8Unorm, Some(shown))
     }
 }
 
@@ -269,7 +215,7 @@ impl Passes {
         &mut self,
         ctx: &RenderContext<'_>,
         data: &[wgpu::Buffer],
-        targets: &Targets,
+        targets: &NamedTextures,
         translucency: &wgpu::TextureView,
         min_maps: &wgpu::TextureView,
     ) -> TechniqueResult {
@@ -283,22 +229,23 @@ impl Passes {
         &self,
         ctx: &RenderContext<'_>,
         data: &wgpu::Buffer,
-        targets: &Targets,
+        targets: &NamedTextures,
         translucency: &wgpu::TextureView,
         min_maps: &wgpu::TextureView,
     ) -> TechniqueResult<[StageBindGroup; 5]> {
         let view = wgpu::BindingResource::TextureView;
         let data = || ("data", data.as_entire_binding());
-        let t = targets;
-        let [(occlusion_1, light_1), (occlusion_2, light_2)] = &t.blurred;
+        let target = |name| targets.view(name).expect("made in prepare");
+        let t = |name| view(target(name));
+        let [[occlusion_1, light_1], [occlusion_2, light_2]] = BLURRED.map(|pass| pass.map(target));
         let penumbra = self.penumbra.bind(
             ctx,
             "ssss penumbra group",
             &[
                 data(),
-                ("penumbra_out", view(&t.penumbra.view)),
-                ("bits_out", view(&t.bits.view)),
-                ("tint_out", view(&t.tints.view)),
+                ("penumbra_out", t(PENUMBRA)),
+                ("bits_out", t(BITS)),
+                ("tint_out", t(TINTS)),
                 ("translucency", view(translucency)),
                 ("min_maps", view(min_maps)),
             ],
@@ -308,11 +255,11 @@ impl Passes {
             "ssss blur 1 group",
             &[
                 data(),
-                ("penumbra", view(&t.penumbra.view)),
-                ("bits", view(&t.bits.view)),
-                ("tints", view(&t.tints.view)),
-                ("occlusion_out", view(&occlusion_1.view)),
-                ("light_out", view(&light_1.view)),
+                ("penumbra", t(PENUMBRA)),
+                ("bits", t(BITS)),
+                ("tints", t(TINTS)),
+                ("occlusion_out", view(occlusion_1)),
+                ("light_out", view(light_1)),
             ],
         )?;
         let blur_second = self.blur_second.bind(
@@ -320,11 +267,11 @@ impl Passes {
             "ssss blur 2 group",
             &[
                 data(),
-                ("penumbra", view(&t.penumbra.view)),
-                ("occlusion_in", view(&occlusion_1.view)),
-                ("light_in", view(&light_1.view)),
-                ("occlusion_out", view(&occlusion_2.view)),
-                ("light_out", view(&light_2.view)),
+                ("penumbra", t(PENUMBRA)),
+                ("occlusion_in", view(occlusion_1)),
+                ("light_in", view(light_1)),
+                ("occlusion_out", view(occlusion_2)),
+                ("light_out", view(light_2)),
             ],
         )?;
         let resolve = self.resolve.bind(
@@ -332,11 +279,11 @@ impl Passes {
             "ssss resolve group",
             &[
                 data(),
-                ("penumbra", view(&t.penumbra.view)),
-                ("bits", view(&t.bits.view)),
-                ("tints", view(&t.tints.view)),
-                ("occlusion_in", view(&occlusion_2.view)),
-                ("light_in", view(&light_2.view)),
+                ("penumbra", t(PENUMBRA)),
+                ("bits", t(BITS)),
+                ("tints", t(TINTS)),
+                ("occlusion_in", view(occlusion_2)),
+                ("light_in", view(light_2)),
                 ("visibility_out", view(&ctx.visibility.array_view)),
                 ("transmittance_out", view(&ctx.transmittance.array_view)),
             ],
@@ -346,11 +293,11 @@ impl Passes {
             "ssss debug group",
             &[
                 data(),
-                ("penumbra", view(&t.penumbra.view)),
-                ("bits", view(&t.bits.view)),
+                ("penumbra", t(PENUMBRA)),
+                ("bits", t(BITS)),
                 ("visibility", view(&ctx.visibility.array_view)),
                 ("transmittance", view(&ctx.transmittance.array_view)),
-                ("image", view(&t.debug.1)),
+                ("image", t(DEBUG_VIEWS[0].0)),
             ],
         )?;
         Ok([penumbra, blur_first, blur_second, resolve, debug])
@@ -412,8 +359,8 @@ impl Passes {
 /// (`ssss/min_depth.wgsl`), for the min-filter penumbra estimate.
 pub struct MinFilter {
     stage: Stage,
-    /// (maps, array view, resolution, layers) once made.
-    maps: Option<(wgpu::Texture, wgpu::TextureView, u32, u32)>,
+    /// The min maps ([`MIN_MAPS`]), made at the first prepare.
+    maps: NamedTextures,
     kept: Option<wgpu::Buffer>,
     kept_count: u32,
     group: Option<StageBindGroup>,
@@ -423,6 +370,19 @@ pub struct MinFilter {
 pub const MIN_BLOCK: u32 = 8;
 /// The pass that fills the min-filtered maps.
 pub const MIN_FILTER_PASS: &str = "SSSS min filter";
+/// The min-filtered maps: a layer per depth map layer.
+pub const MIN_MAPS: &str = "min-filtered depth";
+
+/// The min maps of `layers` layers of `resolution` texels a side.
+fn min_maps_spec(resolution: u32, layers: u32) -> TextureSpec {
+    TextureSpec {
+        size: TextureSize::Fixed(UVec2::splat(resolution)),
+        layers,
+        array: true,
+        usage: wgpu::TextureUsages::STORAGE_BINDING,
+        ..TextureSpec::screen_target(MIN_MAPS, wgpu::TextureFormat::R32Float, None)
+    }
+}
 
 impl MinFilter {
     /// Builds the reduction pipeline.
@@ -430,7 +390,7 @@ impl MinFilter {
         let stage = Stage::compute("ssss/min_depth.wgsl", "cs_min_depth").build(ctx)?;
         Ok(MinFilter {
             stage,
-            maps: None,
+            maps: NamedTextures::new("ssss", [min_maps_spec(1, 1)]),
             kept: None,
             kept_count: 0,
             group: None,
@@ -444,20 +404,8 @@ impl MinFilter {
         };
         let gpu = ctx.gpu;
         let resolution = depth.resolution.div_ceil(MIN_BLOCK).max(1);
-        if self
-            .maps
-            .as_ref()
-            .is_none_or(|m| (m.2, m.3) != (resolution, depth.layers))
-        {
-            let layered = Layered::new(
-                gpu,
-                "ssss min-filtered depth",
-                zoo_host::glam::UVec2::splat(resolution),
-                depth.layers,
-                wgpu::TextureFormat::R32Float,
-            );
-            self.maps = Some((layered.texture, layered.view, resolution, depth.layers));
-        }
+        (self.maps).respec_all([min_maps_spec(resolution, depth.layers)]);
+        self.maps.prepare(ctx);
         // The atlas pages that hold a rendered tile.
         let kept = set.kept_pages();
         let bytes: &[u8] = bytemuck::cast_slice(&kept);
@@ -473,7 +421,7 @@ impl MinFilter {
         let buffer = self.kept.as_ref().expect("created above");
         gpu.queue.write_buffer(buffer, 0, bytes);
         self.kept_count = kept.len() as u32;
-        let maps = self.maps.as_ref().expect("created above");
+        let maps = self.maps.view(MIN_MAPS).expect("made above");
         let kept = wgpu::BufferBinding {
             buffer,
             offset: 0,
@@ -487,7 +435,7 @@ impl MinFilter {
                     "depth_maps",
                     wgpu::BindingResource::TextureView(&depth.array_view),
                 ),
-                ("min_maps", wgpu::BindingResource::TextureView(&maps.1)),
+                ("min_maps", wgpu::BindingResource::TextureView(maps)),
                 ("kept_layers", wgpu::BindingResource::Buffer(kept)),
             ],
         )?;
@@ -502,7 +450,12 @@ impl MinFilter {
 
     /// The min maps' array view, once prepared.
     pub fn view(&self) -> Option<&wgpu::TextureView> {
-        self.maps.as_ref().map(|m| &m.1)
+        self.maps.view(MIN_MAPS)
+    }
+
+    /// The min maps, once prepared, for `resources()`.
+    pub fn resources(&self) -> Vec<ResourceInfo> {
+        self.maps.resources()
     }
 
     /// Fills the min maps of the rendered layers.
@@ -511,13 +464,13 @@ impl MinFilter {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
     ) -> TechniqueResult {
-        let (Some(group), Some(maps)) = (&self.group, &self.maps) else {
+        let (Some(group), Some(maps)) = (&self.group, self.maps.texture(MIN_MAPS)) else {
             return Err(TechniqueError::not_prepared());
         };
         if self.kept_count == 0 {
             return Ok(());
         }
-        let extent = [maps.2, maps.2, self.kept_count];
+        let extent = [maps.width(), maps.height(), self.kept_count];
         (self.stage).dispatch(ctx, recorder, MIN_FILTER_PASS, &[group], &[], extent)
     }
 }

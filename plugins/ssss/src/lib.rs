@@ -19,16 +19,17 @@ pub mod layers;
 use zoo_host::glam::{Mat4, UVec4};
 use zoo_host::gpu::layout::ChoiceCodes;
 use zoo_host::gpu::{gpu_bytes, gpu_bytes_padded};
+use zoo_host::kit::NamedTextures;
 use zoo_host::prelude::*;
 use zoo_host::render::{SlotAssignment, SlotRequest};
 use zoo_host::scene::Scene;
-use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
+use zoo_host::technique::{DebugImage, ResourceInfo};
 use zoo_shadow_maps::culling::frusta_intersect;
 use zoo_shadow_maps::{DepthState, ShadowMapSet, TRANSLUCENT_FORMAT, TranslucentPass, light_size};
 
 use gpu::{
-    LIGHT_STRIDE, LIGHTS_OFFSET, MinFilter, Passes, Settings, ShaderParams, SsssLight, Targets,
-    debug_mode_offset,
+    DEBUG_VIEWS, LIGHT_STRIDE, LIGHTS_OFFSET, MinFilter, Passes, Settings, ShaderParams, SsssLight,
+    debug_mode_offset, target_specs,
 };
 use layers::{Layers, assign_layers};
 
@@ -88,22 +89,14 @@ zoo_host::technique_params! {
 
 const MAP_PASS: &str = "SSSS shadow map";
 const TRANSLUCENT_PASS: &str = "SSSS translucency";
-/// Debug views drawn by the debug pass, in the order of its `DEBUG_*` constants.
-const DEBUG_VIEWS: [&str; 5] = [
-    "layer assignment",
-    "penumbra sizes",
-    "hard shadows",
-    "blurred shadows",
-    "translucency",
-];
-const DEBUG_NAMES: [&str; 5] = ["Layers", "Penumbra", "Hard", "Blurred", "Translucency"];
 
 /// Maps, passes and targets, built at the first `prepare`.
 struct Gpu {
     maps: ShadowMapSet,
     translucent: Option<TranslucentPass>,
     passes: Passes,
-    targets: Option<Targets>,
+    /// The screen-size targets ([`target_specs`]), made at the first prepare.
+    targets: NamedTextures,
     /// One data buffer per batch of layers.
     data: Vec<wgpu::Buffer>,
     /// A white translucency map for scenes without translucent casters.
@@ -127,13 +120,13 @@ impl Gpu {
             .transpose()?;
         let passes = Passes::new(ctx, &maps)?;
         let source = ctx.shaders.compose("ssss/debug.wgsl")?.source;
-        let debug_codes = ChoiceCodes::read(&source, "DEBUG", &DEBUG_NAMES)
+        let debug_codes = ChoiceCodes::read(&source, "DEBUG", &DEBUG_VIEWS.map(|v| v.1))
             .map_err(|e| TechniqueError::Other(format!("ssss/debug.wgsl: {e}")))?;
         Ok(Gpu {
             maps,
             translucent,
             passes,
-            targets: None,
+            targets: NamedTextures::new("ssss", target_specs(1, false, params.half_resolution)),
             data: Vec::new(),
             placeholder: placeholder(ctx.gpu),
             min_filter: MinFilter::new(ctx)?,
@@ -267,6 +260,32 @@ fn batch_data(settings: Settings, records: &[SsssLight], batch: (u32, u32)) -> V
     bytes
 }
 
+/// One record per scene light: its maps and layer (none for lights without either).
+fn light_records(ctx: &RenderContext<'_>, set: &ShadowMapSet, layers: &Layers) -> Vec<SsssLight> {
+    let mut records = vec![SsssLight::default(); ctx.lights.len().max(1)];
+    for maps in set.lights() {
+        let (Some(layer), false) = (layers.of_light[maps.light], maps.frustums.is_empty()) else {
+            continue;
+        };
+        let scale = maps.scale();
+        records[maps.light] = SsssLight {
+            first_layer: maps.first_layer,
+            layer_count: maps.frustums.len() as u32,
+            layer,
+            perspective: u32::from(scale.perspective),
+            near: scale.near,
+            far: scale.far,
+            texel_scale: scale.texel_scale,
+            size: light_size(&ctx.lights[maps.light]),
+            scissor: UVec4::from_array(maps.scissor),
+            kept_faces: (0..maps.frustums.len() as u32)
+                .filter(|&k| set.is_kept(maps.first_layer + k))
+                .fold(0, |bits, k| bits | 1 << k),
+        };
+    }
+    records
+}
+
 /// Which of a light's map layers can shadow what the camera sees.
 fn layer_visible(layers: &Layers, view_proj: Mat4, light: usize, frustum: Mat4) -> bool {
     layers.of_light[light].is_some() && frusta_intersect(frustum, view_proj)
@@ -288,36 +307,8 @@ impl ShadowTechnique for Ssss {
                 false,
             ));
         }
-        if let Some(t) = &gpu.targets {
-            // One image serves every debug view: count its memory once.
-            for (k, name) in DEBUG_VIEWS.into_iter().enumerate() {
-                let mut info = ResourceInfo::texture(name, &t.debug.0, true);
-                info.bytes *= u64::from(k == 0);
-                out.push(info);
-            }
-            out.push(ResourceInfo::texture(
-                "layered penumbra",
-                &t.penumbra.texture,
-                false,
-            ));
-            out.push(ResourceInfo::texture(
-                "layered bits",
-                &t.bits.texture,
-                false,
-            ));
-            out.push(ResourceInfo::texture(
-                "layered tints",
-                &t.tints.texture,
-                false,
-            ));
-            for (k, (occlusion, light)) in t.blurred.iter().enumerate() {
-                let pass = k + 1;
-                let name = format!("blurred occlusion {pass}");
-                out.push(ResourceInfo::texture(name, &occlusion.texture, false));
-                let name = format!("blurred light {pass}");
-                out.push(ResourceInfo::texture(name, &light.texture, false));
-            }
-        }
+        out.extend(gpu.targets.resources());
+        out.extend(gpu.min_filter.resources());
         out
     }
 
@@ -377,42 +368,13 @@ impl ShadowTechnique for Ssss {
         if min_filter {
             gpu.min_filter.prepare(ctx, &gpu.maps)?;
         }
-        let translucent = gpu.translucent.is_some();
-        let half = p.half_resolution;
         // Batches run one after another through the same targets.
-        let layer_count = batches[0].1;
-        if !gpu
-            .targets
-            .as_ref()
-            .is_some_and(|t| t.fit(ctx.size, layer_count, translucent, half))
-        {
-            let targets = Targets::new(ctx.gpu, ctx.size, layer_count, translucent, half);
-            gpu.targets = Some(targets);
-        }
+        let specs = target_specs(batches[0].1, gpu.translucent.is_some(), p.half_resolution);
+        gpu.targets.respec_all(specs);
+        gpu.targets.prepare(ctx);
         // The data buffers: a batch's settings, then one record per scene light (lights of
         // other batches have no layers there).
-        let mut records = vec![SsssLight::default(); ctx.lights.len().max(1)];
-        for maps in gpu.maps.lights() {
-            let (Some(layer), false) = (self.layers.of_light[maps.light], maps.frustums.is_empty())
-            else {
-                continue;
-            };
-            let scale = maps.scale();
-            records[maps.light] = SsssLight {
-                first_layer: maps.first_layer,
-                layer_count: maps.frustums.len() as u32,
-                layer,
-                perspective: u32::from(scale.perspective),
-                near: scale.near,
-                far: scale.far,
-                texel_scale: scale.texel_scale,
-                size: light_size(&ctx.lights[maps.light]),
-                scissor: UVec4::from_array(maps.scissor),
-                kept_faces: (0..maps.frustums.len() as u32)
-                    .filter(|&k| gpu.maps.is_kept(maps.first_layer + k))
-                    .fold(0, |bits, k| bits | 1 << k),
-            };
-        }
+        let records = light_records(ctx, &gpu.maps, &self.layers);
         // Exactly the size of the data: the shaders take the light count from it.
         let size = (LIGHTS_OFFSET + LIGHT_STRIDE * records.len()) as u64;
         if gpu.data.len() != batches.len() || gpu.data[0].size() != size {
@@ -436,9 +398,8 @@ impl ShadowTechnique for Ssss {
             Some(view) if min_filter => view,
             _ => &gpu.placeholder.1,
         };
-        let targets = gpu.targets.as_ref().expect("created above");
         gpu.passes
-            .bind(ctx, &gpu.data, targets, translucency, min_maps)?;
+            .bind(ctx, &gpu.data, &gpu.targets, translucency, min_maps)?;
         Ok(())
     }
 
@@ -457,7 +418,7 @@ impl ShadowTechnique for Ssss {
         }
         let debug = ctx
             .debug_view
-            .and_then(|name| DEBUG_VIEWS.iter().position(|v| *v == name));
+            .and_then(|name| DEBUG_VIEWS.iter().position(|v| v.0 == name));
         if let (Some(view), Some(data)) = (debug, gpu.data.last()) {
             let code = gpu.debug_codes.code(view);
             ctx.gpu
@@ -474,11 +435,7 @@ impl ShadowTechnique for Ssss {
         if resource == "shadow maps" {
             return gpu.maps.debug_image(self.params.debug_light);
         }
-        let targets = gpu.targets.as_ref()?;
-        DEBUG_VIEWS.contains(&resource).then_some(DebugImage {
-            view: &targets.debug.1,
-            mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
-        })
+        gpu.targets.debug_view(resource)
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -560,8 +517,9 @@ mod tests {
 
     #[test]
     fn every_debug_view_has_a_shader_constant() {
-        let codes = ChoiceCodes::read(&shader("ssss/debug.wgsl"), "DEBUG", &DEBUG_NAMES).unwrap();
-        let mut values: Vec<u32> = (0..DEBUG_NAMES.len()).map(|i| codes.code(i)).collect();
+        let names = DEBUG_VIEWS.map(|v| v.1);
+        let codes = ChoiceCodes::read(&shader("ssss/debug.wgsl"), "DEBUG", &names).unwrap();
+        let mut values: Vec<u32> = (0..names.len()).map(|i| codes.code(i)).collect();
         values.sort();
         values.dedup();
         assert_eq!(values.len(), DEBUG_VIEWS.len());

@@ -1,11 +1,14 @@
 //! Named resources: a technique declares each texture once ([`TextureSpec`]: name, size,
 //! layers, format, usage, how to view it); [`NamedTextures`] makes them, makes them again
-//! when their spec or the output's size changes, and answers `resources()` and
-//! `debug_view()` from the declarations.
+//! when their spec or the output's size changes, and answers `resources()`, `debug_view()`
+//! and `debug_volume()` from the declarations.
 
-use glam::UVec2;
+use glam::{UVec2, UVec3};
 
-use crate::technique::{DebugImage, RenderContext, ResourceInfo, ViewMapping};
+use crate::GpuContext;
+use crate::technique::{
+    DebugImage, DebugVolume, RenderContext, ResourceInfo, ViewMapping, VolumeSlice,
+};
 
 /// The size of a named texture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -14,18 +17,23 @@ pub enum TextureSize {
     Screen { divisor: u32 },
     /// A size of its own.
     Fixed(UVec2),
+    /// A 3D texture of its own size: one layer, viewed whole as `D3` (shown through
+    /// [`NamedTextures::debug_volume`]).
+    Volume(UVec3),
 }
 
 impl TextureSize {
     /// The output's size.
     pub const SCREEN: TextureSize = TextureSize::Screen { divisor: 1 };
 
-    fn resolve(self, screen: UVec2) -> UVec2 {
+    /// Width, height and depth (1 for 2D textures) at output size `screen`.
+    fn resolve(self, screen: UVec2) -> UVec3 {
         match self {
-            TextureSize::Screen { divisor } => screen.map(|s| s.div_ceil(divisor.max(1))),
-            TextureSize::Fixed(size) => size,
+            TextureSize::Screen { divisor } => screen.map(|s| s.div_ceil(divisor.max(1))).extend(1),
+            TextureSize::Fixed(size) => size.extend(1),
+            TextureSize::Volume(size) => size,
         }
-        .max(UVec2::ONE)
+        .max(UVec3::ONE)
     }
 }
 
@@ -35,21 +43,52 @@ pub struct TextureSpec {
     /// As `resources()` lists it and the viewer's menu shows it.
     pub name: &'static str,
     pub size: TextureSize,
-    /// Array layers (1: a plain 2D texture).
+    /// Array layers (1: a plain 2D texture unless `array`).
     pub layers: u32,
+    /// Viewed whole as a 2D array even with one layer (which gets a spare layer on GL, see
+    /// [`crate::gpu::array_layers`]).
+    pub array: bool,
     pub format: wgpu::TextureFormat,
     /// Usages besides sampling (`TEXTURE_BINDING`), which every named texture has.
     pub usage: wgpu::TextureUsages,
     /// How the debug view shows it (its first layer); `None`: listed, not viewable.
     pub view: Option<ViewMapping>,
+    /// More names that show this texture, each as its mapping (one image that a debug pass
+    /// draws one of several things into): listed too, with no memory of their own.
+    pub aliases: Vec<(&'static str, ViewMapping)>,
 }
 
 /// What a texture is made of: its spec less how it is viewed.
-type Shape = (TextureSize, u32, wgpu::TextureFormat, wgpu::TextureUsages);
+type Shape = (
+    TextureSize,
+    u32,
+    bool,
+    wgpu::TextureFormat,
+    wgpu::TextureUsages,
+);
 
 impl TextureSpec {
     fn shape(&self) -> Shape {
-        (self.size, self.layers, self.format, self.usage)
+        (self.size, self.layers, self.array, self.format, self.usage)
+    }
+
+    /// What it is made for at output size `screen`: its shape, and the output's size where
+    /// its size follows it.
+    fn made_for(&self, screen: UVec2) -> (Shape, UVec2) {
+        let screen = match self.size {
+            TextureSize::Screen { .. } => screen,
+            _ => UVec2::ZERO,
+        };
+        (self.shape(), screen)
+    }
+
+    /// Whether it is viewed whole as a 2D array.
+    fn is_array(&self) -> bool {
+        !self.is_volume() && (self.array || self.layers != 1)
+    }
+
+    fn is_volume(&self) -> bool {
+        matches!(self.size, TextureSize::Volume(_))
     }
 
     /// A full-size render target of `format`, viewable as `view`.
@@ -62,10 +101,21 @@ impl TextureSpec {
             name,
             size: TextureSize::SCREEN,
             layers: 1,
+            array: false,
             format,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
             view,
+            aliases: Vec::new(),
         }
+    }
+
+    /// How it is shown as `name` (its own name or an alias), where viewable.
+    fn mapping(&self, name: &str) -> Option<ViewMapping> {
+        if self.name == name {
+            return self.view;
+        }
+        let alias = self.aliases.iter().find(|(alias, _)| *alias == name);
+        alias.map(|(_, mapping)| *mapping)
     }
 }
 
@@ -74,9 +124,9 @@ struct Made {
     /// The shape and output size it was made for.
     made_for: (Shape, UVec2),
     texture: wgpu::Texture,
-    /// The whole texture (a 2D array view where it has layers).
+    /// The whole texture (a 2D array view where it is an array, 3D where a volume).
     view: wgpu::TextureView,
-    /// One 2D view per layer.
+    /// One 2D view per layer (none for a volume).
     layer_views: Vec<wgpu::TextureView>,
 }
 
@@ -107,19 +157,27 @@ impl NamedTextures {
         }
     }
 
-    /// Makes every texture not yet made, or made for another spec or output size; returns
-    /// whether any was (bind groups over them must then be made again).
-    pub fn prepare(&mut self, ctx: &RenderContext<'_>) -> bool {
-        self.prepare_at(&ctx.gpu.device, ctx.size)
+    /// Replaces the spec of each texture named in `specs` by that spec, as [`Self::respec`]
+    /// does (for techniques that declare their textures with a function of their settings).
+    pub fn respec_all(&mut self, specs: impl IntoIterator<Item = TextureSpec>) {
+        for spec in specs {
+            self.respec(spec.name, |old| *old = spec);
+        }
     }
 
-    /// As [`Self::prepare`], for output size `screen` on `device`.
-    pub fn prepare_at(&mut self, device: &wgpu::Device, screen: UVec2) -> bool {
+    /// Makes every texture not yet made, or made for another shape or (screen-sized ones)
+    /// output size; returns whether any was (bind groups over them must then be made again).
+    pub fn prepare(&mut self, ctx: &RenderContext<'_>) -> bool {
+        self.prepare_at(ctx.gpu, ctx.size)
+    }
+
+    /// As [`Self::prepare`], for output size `screen` on `gpu`.
+    pub fn prepare_at(&mut self, gpu: &GpuContext, screen: UVec2) -> bool {
         let mut changed = false;
         for (spec, made) in self.specs.iter().zip(&mut self.made) {
-            let wanted = (spec.shape(), screen);
+            let wanted = spec.made_for(screen);
             if made.as_ref().is_none_or(|m| m.made_for != wanted) {
-                *made = Some(make(device, &self.label, spec, screen));
+                *made = Some(make(gpu, &self.label, spec, screen));
                 changed = true;
             }
         }
@@ -136,60 +194,105 @@ impl NamedTextures {
         self.find(name).map(|m| &m.texture)
     }
 
-    /// The whole of texture `name` (an array view where it has layers), once made.
+    /// The whole of texture `name` (an array view where it is an array, 3D where a volume),
+    /// once made.
     pub fn view(&self, name: &str) -> Option<&wgpu::TextureView> {
         self.find(name).map(|m| &m.view)
     }
 
-    /// Layer `layer` of texture `name` as a 2D view, once made.
+    /// Layer `layer` of texture `name` as a 2D view, once made (none for a volume).
     pub fn layer_view(&self, name: &str, layer: u32) -> Option<&wgpu::TextureView> {
         self.find(name)?.layer_views.get(layer as usize)
     }
 
-    /// Every made texture, for `resources()`.
+    /// Every made texture, then each of its aliases, for `resources()`.
     pub fn resources(&self) -> Vec<ResourceInfo> {
-        (self.specs.iter().zip(&self.made))
-            .filter_map(|(spec, made)| {
-                let made = made.as_ref()?;
-                Some(ResourceInfo::texture(
-                    spec.name,
-                    &made.texture,
-                    spec.view.is_some(),
-                ))
-            })
-            .collect()
+        let mut out = Vec::new();
+        for (spec, made) in self.specs.iter().zip(&self.made) {
+            let Some(made) = made else { continue };
+            let own = ResourceInfo::texture(spec.name, &made.texture, spec.view.is_some());
+            out.push(own);
+            for (alias, _) in &spec.aliases {
+                let mut info = ResourceInfo::texture(*alias, &made.texture, true);
+                info.bytes = 0;
+                out.push(info);
+            }
+        }
+        out
     }
 
-    /// The first layer of texture `name` as its spec says to show it, for `debug_view()`.
+    /// The made texture shown as `name` (its own name or an alias), with its spec and how
+    /// it is shown.
+    fn shown(&self, name: &str) -> Option<(&TextureSpec, &Made, ViewMapping)> {
+        (self.specs.iter().zip(&self.made)).find_map(|(spec, made)| {
+            let mapping = spec.mapping(name)?;
+            Some((spec, made.as_ref()?, mapping))
+        })
+    }
+
+    /// The first layer of the 2D texture shown as `name` as its spec says to show it, for
+    /// `debug_view()`.
     pub fn debug_view(&self, name: &str) -> Option<DebugImage<'_>> {
-        let index = self.specs.iter().position(|s| s.name == name)?;
-        let mapping = self.specs[index].view?;
-        let made = self.made[index].as_ref()?;
-        Some(DebugImage {
+        let (spec, made, mapping) = self.shown(name)?;
+        (!spec.is_volume()).then(|| DebugImage {
             view: &made.layer_views[0],
             mapping,
         })
     }
+
+    /// Slice `slice` of the volume shown as `name` as its spec says to show it, for
+    /// `debug_volume()`.
+    pub fn debug_volume(&self, name: &str, slice: VolumeSlice) -> Option<DebugVolume<'_>> {
+        let (spec, made, mapping) = self.shown(name)?;
+        spec.is_volume().then_some(DebugVolume {
+            view: &made.view,
+            mapping,
+            slice,
+        })
+    }
 }
 
-fn make(device: &wgpu::Device, label: &str, spec: &TextureSpec, screen: UVec2) -> Made {
+fn make(gpu: &GpuContext, label: &str, spec: &TextureSpec, screen: UVec2) -> Made {
     let size = spec.size.resolve(screen);
     let layers = spec.layers.max(1);
     let label = format!("{label} {}", spec.name);
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
+    let (dimension, depth) = if spec.is_volume() {
+        (wgpu::TextureDimension::D3, size.z)
+    } else if spec.is_array() {
+        let padded = crate::gpu::array_layers(gpu, size.x, size.y, layers);
+        (wgpu::TextureDimension::D2, padded)
+    } else {
+        (wgpu::TextureDimension::D2, layers)
+    };
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(&label),
         size: wgpu::Extent3d {
             width: size.x,
             height: size.y,
-            depth_or_array_layers: layers,
+            depth_or_array_layers: depth,
         },
         mip_level_count: 1,
         sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
+        dimension,
         format: spec.format,
         usage: wgpu::TextureUsages::TEXTURE_BINDING | spec.usage,
         view_formats: &[],
     });
+    let (view, layer_views) = views(&texture, &label, spec);
+    Made {
+        made_for: spec.made_for(screen),
+        texture,
+        view,
+        layer_views,
+    }
+}
+
+/// The whole view and the layer views of `texture`, made from `spec`.
+fn views(
+    texture: &wgpu::Texture,
+    label: &str,
+    spec: &TextureSpec,
+) -> (wgpu::TextureView, Vec<wgpu::TextureView>) {
     let view_of = |label: String, dimension, base_array_layer, count| {
         texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some(&label),
@@ -199,23 +302,24 @@ fn make(device: &wgpu::Device, label: &str, spec: &TextureSpec, screen: UVec2) -
             ..Default::default()
         })
     };
-    let whole = match spec.layers {
-        1 => wgpu::TextureViewDimension::D2,
-        _ => wgpu::TextureViewDimension::D2Array,
+    let layers = spec.layers.max(1);
+    use wgpu::TextureViewDimension as D;
+    let (dimension, count) = match (spec.is_volume(), spec.is_array()) {
+        (true, _) => (D::D3, 1),
+        (_, true) => (D::D2Array, layers),
+        _ => (D::D2, 1),
     };
-    let view = view_of(format!("{label} view"), whole, 0, layers);
+    let whole = view_of(format!("{label} view"), dimension, 0, count);
+    if spec.is_volume() {
+        return (whole, Vec::new());
+    }
     let layer_views = (0..layers)
         .map(|layer| {
             let label = format!("{label} layer {layer}");
-            view_of(label, wgpu::TextureViewDimension::D2, layer, 1)
+            view_of(label, D::D2, layer, 1)
         })
         .collect();
-    Made {
-        made_for: (spec.shape(), screen),
-        texture,
-        view,
-        layer_views,
-    }
+    (whole, layer_views)
 }
 
 #[cfg(test)]
@@ -225,11 +329,40 @@ mod tests {
     #[test]
     fn screen_sizes_follow_the_output_and_never_vanish() {
         let screen = UVec2::new(257, 128);
-        assert_eq!(TextureSize::SCREEN.resolve(screen), screen);
+        assert_eq!(TextureSize::SCREEN.resolve(screen), screen.extend(1));
         let half = TextureSize::Screen { divisor: 2 };
-        assert_eq!(half.resolve(screen), UVec2::new(129, 64));
-        assert_eq!(half.resolve(UVec2::new(1, 0)), UVec2::ONE);
+        assert_eq!(half.resolve(screen), UVec3::new(129, 64, 1));
+        assert_eq!(half.resolve(UVec2::new(1, 0)), UVec3::ONE);
         let fixed = TextureSize::Fixed(UVec2::new(8, 4));
-        assert_eq!(fixed.resolve(screen), UVec2::new(8, 4));
+        assert_eq!(fixed.resolve(screen), UVec3::new(8, 4, 1));
+    }
+
+    #[test]
+    fn volumes_keep_their_depth_and_are_never_arrays() {
+        let volume = TextureSize::Volume(UVec3::new(8, 4, 2));
+        assert_eq!(volume.resolve(UVec2::new(640, 480)), UVec3::new(8, 4, 2));
+        assert_eq!(
+            TextureSize::Volume(UVec3::ZERO).resolve(UVec2::ONE),
+            UVec3::ONE
+        );
+        let spec = TextureSpec {
+            size: volume,
+            array: true,
+            ..TextureSpec::screen_target("grid", wgpu::TextureFormat::Rgba16Float, None)
+        };
+        assert!(spec.is_volume() && !spec.is_array());
+    }
+
+    #[test]
+    fn aliases_show_the_texture_with_their_own_mapping() {
+        let own = ViewMapping::Color { min: 0.0, max: 1.0 };
+        let other = ViewMapping::Color { min: 0.0, max: 2.0 };
+        let spec = TextureSpec {
+            aliases: vec![("other", other)],
+            ..TextureSpec::screen_target("own", wgpu::TextureFormat::Rgba8Unorm, Some(own))
+        };
+        assert_eq!(spec.mapping("own"), Some(own));
+        assert_eq!(spec.mapping("other"), Some(other));
+        assert_eq!(spec.mapping("neither"), None);
     }
 }
