@@ -14,12 +14,19 @@ use zoo_host::{
     TechniqueResult, View,
 };
 
-/// A full-screen stage: the frame group (`lights`, by its name), an own storage buffer.
+/// A full-screen stage: the frame group (`lights`, by its name), an own storage buffer, and
+/// a second one that only another entry reads.
 const SHADER: &str = r#"
 #import "common/frame.wgsl"
 #import "common/fullscreen.wgsl"
 
 @group(2) @binding(0) var<storage, read> levels: array<f32>;
+@group(2) @binding(1) var<storage, read> offsets: array<f32>;
+
+@fragment
+fn fs_offset_level() -> @location(0) vec4<f32> {
+    return vec4<f32>(levels[0] + offsets[0]);
+}
 
 @fragment
 fn fs_level() -> @location(0) vec4<f32> {
@@ -77,7 +84,13 @@ impl ShadowTechnique for Levels {
                     .unwrap()
                     .to_string(),
             );
-            let group = stage.bind(ctx, "test", &[("levels", buffer.as_entire_binding())])?;
+            // One list serves every entry of the shader: `offsets`, declared in the group but
+            // not read by `fs_level`, is left out (and may come first).
+            let shared_list = [
+                ("offsets", buffer.as_entire_binding()),
+                ("levels", buffer.as_entire_binding()),
+            ];
+            let group = stage.bind(ctx, "test", &shared_list)?;
             self.passes.push((stage, group));
         }
         let mixed = Stage::compute("test/mixed.wgsl", "cs_mixed")
