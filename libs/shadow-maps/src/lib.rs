@@ -28,6 +28,7 @@ pub mod moment_technique;
 pub mod moments;
 pub mod params;
 pub mod planning;
+pub mod sample_fit;
 pub mod set;
 pub mod tile_pass;
 pub mod translucent;
@@ -48,6 +49,7 @@ pub use planning::{
     LayerPlan, LightMaps, MapScale, PlanInputs, StandardLayers, light_scissor, light_size,
     object_bounds, plan_with,
 };
+pub use sample_fit::{SampleFit, SampleReduction};
 pub use set::ShadowMapSet;
 pub use tile_pass::{TilePass, layer_pass_name};
 pub use translucent::{TRANSLUCENT_FORMAT, TranslucentPass};

@@ -147,8 +147,9 @@ impl Gpu {
 pub struct Pssm {
     params: PssmParams,
     gpu: LazyGpu<Gpu>,
-    /// The depth range to split (sdsm's, from the depth buffer); `None` fits it to the boxes.
-    range: Option<(f32, f32)>,
+    /// Where the view's samples are (sdsm's, from the depth buffer); `None` fits the splits
+    /// to the objects' boxes.
+    samples: Option<std::sync::Arc<zoo_shadow_maps::SampleFit>>,
 }
 
 impl Pssm {
@@ -156,7 +157,7 @@ impl Pssm {
         Ok(Pssm {
             params: PssmParams::from_values(values)?,
             gpu: LazyGpu::default(),
-            range: None,
+            samples: None,
         })
     }
 
@@ -165,7 +166,7 @@ impl Pssm {
             splits: self.params.splits,
             lambda: self.params.lambda,
             blend: self.params.blend,
-            range: self.range,
+            samples: self.samples.clone(),
         }
     }
 }

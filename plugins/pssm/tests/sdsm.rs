@@ -32,16 +32,18 @@ fn sdsm_within_pssms_bounds_and_no_worse_than_pssm_on_vista() {
     // The bounds and parameters of pssm's vista test.
     let (run, sdsm, pssm) = sdsm_and_pssm("vista.ron", &FOUR_BY_2048);
     run.assert_core_bounds(0.005, 0.01);
-    assert!(sdsm <= pssm, "sdsm {sdsm} against pssm {pssm}");
+    // Crops cut to each split's samples: about half pssm's error (0.0010 against 0.0019).
+    assert!(sdsm <= 0.75 * pssm, "sdsm {sdsm} against pssm {pssm}");
 }
 
 #[test]
 fn sdsm_no_worse_than_pssm_and_within_bounds_with_log_splits_on_kilometre() {
     // With λ = 0.5 the first split reaches hundreds of metres over the kilometre's ground and
     // neither holds the near figure's edges within 0.005 false shadow (pssm 0.0064, sdsm
-    // 0.0073), though sdsm's core error is the lower; logarithmic splits hold the bounds.
+    // 0.0067), though sdsm's core error is the lower (0.0099 against 0.0148); logarithmic
+    // splits hold the bounds.
     let (_, sdsm, pssm) = sdsm_and_pssm("kilometre.ron", &FOUR_BY_2048);
-    assert!(sdsm <= pssm, "sdsm {sdsm} against pssm {pssm}");
+    assert!(sdsm <= 0.75 * pssm, "sdsm {sdsm} against pssm {pssm}");
     let logarithmic = [("splits", "4"), ("map_size", "2048"), ("lambda", "1")];
     let run = judge("kilometre.ron", "sdsm", &logarithmic, SIZE);
     eprintln!("kilometre, sdsm {logarithmic:?}: {:?}", run.metrics(0));
