@@ -11,6 +11,8 @@
 #import "shadow-maps/fit_params.wgsl"
 
 const DEPTH_BINS: u32 = 64u;
+// Side of a workgroup's square of pixels.
+const FIT_SIDE: u32 = 16u;
 // Per bin: the smallest x, y and z, then the largest.
 const BOX_WORDS: u32 = 6u;
 
@@ -43,14 +45,14 @@ fn depth_bin(depth: f32) -> u32 {
     return min(u32(max(t, 0.0) * f32(DEPTH_BINS)), DEPTH_BINS - 1u);
 }
 
-@compute @workgroup_size(16, 16, 1)
+@compute @workgroup_size(FIT_SIDE, FIT_SIDE, 1)
 fn cs_sample_fit(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
     let words = DEPTH_BINS * BOX_WORDS;
-    for (var i = local; i < words; i += 256u) {
+    for (var i = local; i < words; i += FIT_SIDE * FIT_SIDE) {
         atomicStore(&group_boxes[i], select(0u, 0xffffffffu, i % BOX_WORDS < 3u));
     }
     if local == 0u {
@@ -82,7 +84,7 @@ fn cs_sample_fit(
         atomicMax(&fit_result.far, atomicLoad(&group_far));
     }
     if light < fit_params.lights {
-        for (var i = local; i < words; i += 256u) {
+        for (var i = local; i < words; i += FIT_SIDE * FIT_SIDE) {
             let value = atomicLoad(&group_boxes[i]);
             let slot = light * words + i;
             if i % BOX_WORDS < 3u {

@@ -19,7 +19,8 @@ pub const ERROR_MODULE: &str = "ray-tracing/gbuffer_error.wgsl";
 /// `f32`s (Rust's shortest round-trip form).
 fn error_module() -> String {
     format!(
-        "// Generated from `zoo_judge::GBUFFER_POSITION_ERROR` (libs/ray-tracing/src/origin.rs).\n\
+        "// Generated from `zoo_judge::GBUFFER_POSITION_ERROR` and `RASTER_SUBPIXEL`\n\
+         // (libs/ray-tracing/src/origin.rs).\n\
          const RT_GBUFFER_POSITION_ERROR: f32 = {GBUFFER_POSITION_ERROR:?};\n\
          const RT_RASTER_SUBPIXEL: f32 = {RASTER_SUBPIXEL:?};\n"
     )

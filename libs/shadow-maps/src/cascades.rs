@@ -81,8 +81,6 @@ impl LayerPlan for Cascades {
         let aspect = inputs.size.x as f32 / inputs.size.y.max(1) as f32;
         let c = self.distances(inputs.camera, aspect, inputs.objects, inputs.stable);
         let stable = inputs.stable.then_some(resolution);
-        // The planner hands over its own lights, so the light's index is where it lies.
-        let index = (inputs.lights.iter()).position(|l| std::ptr::eq(l, light));
         (0..c.len() - 1)
             .map(|i| {
                 let start = match i {
@@ -90,8 +88,8 @@ impl LayerPlan for Cascades {
                     _ => c[i] - self.blend * (c[i] - c[i - 1]),
                 };
                 let corners = slice_corners(inputs.camera, aspect, start, c[i + 1]);
-                let samples = (self.samples.as_ref().zip(index))
-                    .and_then(|(fit, index)| fit.samples_box(index, (start, c[i + 1])));
+                let samples = (self.samples.as_ref())
+                    .and_then(|fit| fit.samples_box(light.direction, (start, c[i + 1])));
                 match samples {
                     Some(samples) => {
                         let fit = (samples, resolution);

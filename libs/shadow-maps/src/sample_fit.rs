@@ -26,8 +26,9 @@ zoo_host::gpu_struct! {
     /// The reduction's uniform (`shadow-maps/sample_fit.wgsl`).
     #[derive(Debug, Clone, Copy)]
     pub struct FitParams {
-        /// The camera's clip planes, which the bins span.
+        /// The camera's near clip plane, where the first bin starts.
         pub near: f32,
+        /// The camera's far clip plane, where the last bin ends.
         pub far: f32,
         /// Directional lights with boxes.
         pub lights: u32,
@@ -52,15 +53,17 @@ fn from_ordered_bits(bits: u32) -> f32 {
 /// A light-space box: smallest and largest corner.
 pub type LightBox = (Vec3, Vec3);
 
-/// One frame's samples: their view-depth range and, per light, their boxes by depth bin.
+/// One frame's samples: their view-depth range and, per directional light, their boxes by
+/// depth bin.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SampleFit {
     /// Nearest and farthest view depth of the surfaces; `None` when the view shows none.
     pub range: Option<(f32, f32)>,
     /// The view depths the bins span (the camera's clip planes).
     span: (f32, f32),
-    /// Per light of the frame, its bins' boxes (none for lights other than directional).
-    boxes: Vec<Vec<Option<LightBox>>>,
+    /// Per direction of the frame's directional lights (the boxes depend on nothing else), its
+    /// bins' boxes.
+    boxes: Vec<(Vec3, Vec<Option<LightBox>>)>,
 }
 
 impl SampleFit {
@@ -71,11 +74,12 @@ impl SampleFit {
         ((t.max(0.0) * DEPTH_BINS as f32) as usize).min(DEPTH_BINS - 1)
     }
 
-    /// The light-space box ([`fit_view`]) of light `light`'s samples at view depths
-    /// `start..=end`, from every bin that overlaps them (and one more each side, for the
-    /// rounding of bin edges): a box that holds them all; `None` where there are none.
-    pub fn samples_box(&self, light: usize, (start, end): (f32, f32)) -> Option<LightBox> {
-        let bins = self.boxes.get(light)?;
+    /// The light-space box ([`fit_view`]) of the samples at view depths `start..=end` for a
+    /// directional light along `direction`, from every bin that overlaps them (and one more
+    /// each side, for the rounding of bin edges): a box that holds them all; `None` where there
+    /// are none or the frame had no such light.
+    pub fn samples_box(&self, direction: Vec3, (start, end): (f32, f32)) -> Option<LightBox> {
+        let (_, bins) = self.boxes.iter().find(|(d, _)| *d == direction)?;
         let first = self.depth_bin(start).saturating_sub(1);
         let last = (self.depth_bin(end) + 1).min(DEPTH_BINS - 1);
         (bins.get(first..=last)?.iter().flatten())
@@ -100,7 +104,6 @@ struct Sized {
     ring: ReadbackRing,
     /// The reset values of `result`.
     start: Vec<u32>,
-    frames: u64,
 }
 
 impl SampleReduction {
@@ -161,7 +164,6 @@ impl SampleReduction {
             group,
             ring,
             start,
-            frames: 0,
         })
     }
 
@@ -171,54 +173,48 @@ impl SampleReduction {
         ctx: &RenderContext<'_>,
         rec: &mut PassRecorder<'_>,
     ) -> TechniqueResult<Arc<SampleFit>> {
-        let directional: Vec<usize> = (ctx.lights.iter().enumerate())
-            .filter(|(_, l)| l.kind == LightKind::Directional)
-            .map(|(i, _)| i)
+        let directions: Vec<Vec3> = (ctx.lights.iter())
+            .filter(|l| l.kind == LightKind::Directional)
+            .map(|l| l.direction)
             .collect();
         if self
             .sized
             .as_ref()
-            .is_none_or(|s| s.lights != directional.len())
+            .is_none_or(|s| s.lights != directions.len())
         {
-            self.sized = Some(self.sized(ctx, directional.len())?);
+            self.sized = Some(self.sized(ctx, directions.len())?);
         }
         let s = self.sized.as_mut().expect("sized above");
         let (gpu, camera) = (ctx.gpu, ctx.camera);
         let params = FitParams {
             near: camera.near,
             far: camera.far,
-            lights: directional.len() as u32,
+            lights: directions.len() as u32,
         };
-        let views: Vec<Mat4> = (directional.iter())
-            .map(|&i| fit_view(ctx.lights[i].direction))
-            .collect();
+        let views: Vec<Mat4> = directions.iter().map(|&d| fit_view(d)).collect();
         gpu.queue
             .write_buffer(&self.params, 0, &gpu_bytes(&[params]));
         gpu.queue
             .write_buffer(&s.views, 0, bytemuck::cast_slice(&views));
         gpu.queue
             .write_buffer(&s.result, 0, bytemuck::cast_slice(&s.start));
-        let extent = [ctx.size.x, ctx.size.y, directional.len().max(1) as u32];
+        let extent = [ctx.size.x, ctx.size.y, directions.len().max(1) as u32];
         (self.stage).dispatch(ctx, rec, "Sample fit", &[&s.group], &[], extent)?;
         let target = s.ring.target().ok_or_else(TechniqueError::not_prepared)?;
         let bytes = 4 * s.start.len() as u64;
         rec.encoder()
             .copy_buffer_to_buffer(&s.result, 0, target, 0, bytes);
-        s.frames += 1;
+        let frame = s.ring.frames();
         rec.flush();
         // The ring maps what arrived at one poll and returns it at the next.
         for _ in 0..3 {
             gpu.wait_idle();
-            if let Some((frame, data)) = s.ring.latest(&gpu.device)
-                && frame == s.frames
+            if let Some((arrived, data)) = s.ring.latest(&gpu.device)
+                && arrived == frame
             {
                 let words: &[u32] = bytemuck::cast_slice(data);
-                return Ok(Arc::new(decode(
-                    words,
-                    (camera.near, camera.far),
-                    ctx,
-                    &directional,
-                )));
+                let span = (camera.near, camera.far);
+                return Ok(Arc::new(decode(words, span, &directions)));
             }
         }
         Err(TechniqueError::Other(
@@ -227,27 +223,23 @@ impl SampleReduction {
     }
 }
 
-/// The fit in read-back `words` over bins spanning `span`, for the context's lights of
-/// which `directional` have boxes.
-fn decode(
-    words: &[u32],
-    span: (f32, f32),
-    ctx: &RenderContext<'_>,
-    directional: &[usize],
-) -> SampleFit {
+/// The fit in read-back `words` over bins spanning `span`, with boxes for directional lights
+/// along `directions`, in order.
+fn decode(words: &[u32], span: (f32, f32), directions: &[Vec3]) -> SampleFit {
     // Without surfaces the depths stay (u32::MAX, 0).
     let (near, far) = (f32::from_bits(words[0]), f32::from_bits(words[1]));
     let range = (far > 0.0).then(|| (near, far.max(near * 1.001)));
-    let mut boxes = vec![Vec::new(); ctx.lights.len()];
-    for (slot, &light) in directional.iter().enumerate() {
+    let mut boxes = Vec::new();
+    for (slot, &direction) in directions.iter().enumerate() {
         let light_words = &words[2 + slot * DEPTH_BINS * BOX_WORDS..][..DEPTH_BINS * BOX_WORDS];
-        boxes[light] = (light_words.chunks_exact(BOX_WORDS))
+        let bins = (light_words.chunks_exact(BOX_WORDS))
             .map(|w| {
                 let corner =
                     |w: &[u32]| Vec3::from_array([0, 1, 2].map(|k| from_ordered_bits(w[k])));
                 (w[0] != u32::MAX).then(|| (corner(&w[..3]), corner(&w[3..])))
             })
             .collect();
+        boxes.push((direction, bins));
     }
     SampleFit { range, span, boxes }
 }
@@ -290,20 +282,22 @@ mod tests {
         let fit = SampleFit {
             range: Some((1.0, 100.0)),
             span: (0.1, 1000.0),
-            boxes: vec![Vec::new(), bins],
+            boxes: vec![(Vec3::NEG_Y, bins)],
         };
         // The bin edges: 0.1 * 10^(4 k / 64).
         let edge = |k: f32| 0.1 * 10f32.powf(4.0 * k / DEPTH_BINS as f32);
-        let whole = fit.samples_box(1, (edge(10.5), edge(20.5))).unwrap();
+        let whole = fit
+            .samples_box(Vec3::NEG_Y, (edge(10.5), edge(20.5)))
+            .unwrap();
         assert_eq!(
             whole,
             (Vec3::new(10.0, -20.0, 0.0), Vec3::new(21.0, -9.0, 1.0))
         );
-        assert_eq!(fit.samples_box(1, (edge(23.0), edge(27.0))), None);
+        assert_eq!(fit.samples_box(Vec3::NEG_Y, (edge(23.0), edge(27.0))), None);
         assert_eq!(
-            fit.samples_box(0, (0.1, 1000.0)),
+            fit.samples_box(Vec3::X, (0.1, 1000.0)),
             None,
-            "not a directional light"
+            "no light along that direction"
         );
         assert_eq!(fit.depth_bin(0.01), 0);
         assert_eq!(fit.depth_bin(1e6), DEPTH_BINS - 1);

@@ -274,12 +274,13 @@ impl VolumeGenerator {
             ("volume", volume.as_entire_binding()),
             ("draw", args.as_entire_binding()),
         ];
-        let group_label = format!("{label} generation group");
         let [caps, sides, tally] = &self.stages;
+        let group =
+            |stage: &Stage, what| stage.bind(ctx, &format!("{label} {what} group"), &resources);
         let groups = [
-            caps.bind(ctx, &group_label, &resources)?,
-            sides.bind(ctx, &group_label, &resources)?,
-            tally.bind(ctx, &group_label, &resources)?,
+            group(caps, "caps")?,
+            group(sides, "sides")?,
+            group(tally, "vertex tally")?,
         ];
         Ok(Buffers {
             triangle_flags,

@@ -23,6 +23,7 @@ use crate::NO_TRIANGLE;
 pub(crate) struct CasterIds<'a> {
     /// Names the maps and passes.
     pub(crate) label: &'a str,
+    /// The library shader and its vertex and fragment entries.
     pub(crate) shader: &'a str,
     pub(crate) entries: (&'a str, &'a str),
     /// Culling and bias of the rasterisation.

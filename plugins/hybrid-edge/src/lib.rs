@@ -249,11 +249,12 @@ impl Gpu {
             ("scene_vertices", scene.vertices.as_entire_binding()),
             ("scene_indices", scene.indices.as_entire_binding()),
         ];
-        let label = "hybrid band lookups";
+        let label = "hybrid band lookups (coverage)";
         self.band_groups[0] = Some(self.band.stage().bind(ctx, label, &resources)?);
         if let Some(ids) = self.ids.maps() {
             let view = wgpu::BindingResource::TextureView(&ids.array_view);
             resources.push(("triangle_ids", view));
+            let label = "hybrid band lookups (triangle ids)";
             self.band_groups[1] = Some(self.band_ids.stage().bind(ctx, label, &resources)?);
         }
         Ok(())

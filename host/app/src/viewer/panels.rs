@@ -15,7 +15,8 @@ const ERROR_RED: egui::Color32 = egui::Color32::from_rgb(230, 60, 60);
 const WARNING_AMBER: egui::Color32 = egui::Color32::from_rgb(235, 170, 40);
 
 impl ViewerState {
-    /// The left panel: errors and the technique's warnings, scene, technique, parameters, view, settings and screenshot.
+    /// The left panel: errors and the technique's warnings, scene, technique, parameters,
+    /// view, settings and screenshot.
     pub fn controls(&mut self, ui: &mut egui::Ui) {
         if let Some(error) = &self.error {
             ui.colored_label(ERROR_RED, format!("Technique failed: {error}"));

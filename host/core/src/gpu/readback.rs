@@ -201,6 +201,11 @@ impl ReadbackRing {
         Some(&slot.buffer)
     }
 
+    /// The frames counted so far by [`Self::target`] calls (the last one's number).
+    pub fn frames(&self) -> u64 {
+        self.frame
+    }
+
     /// The newest results that have arrived (and the frame they come from, counted by
     /// [`Self::target`] calls), without waiting for the GPU.
     pub fn latest(&mut self, device: &wgpu::Device) -> Option<(u64, &[u8])> {
