@@ -25,7 +25,15 @@ fn vs_shadow(
 ) -> ShadowOut {
     let world = placed_position(placement, position);
     var out: ShadowOut;
-    out.clip = camera.view_proj * (projection.shadow_matrix * vec4<f32>(world, 1.0));
+    var flattened = projection.shadow_matrix * vec4<f32>(world, 1.0);
+    // A point beyond the light projects with w < 0, which clipping removes. Unless caster
+    // parts on the wrong side are discarded (`params.w` 0, to show the artifact), it lands
+    // mirrored on the plane, as a Cartesian projection along the light's rays puts it: an
+    // anti-shadow.
+    if projection.params.w < 0.5 && flattened.w < 0.0 {
+        flattened = -flattened;
+    }
+    out.clip = camera.view_proj * flattened;
     out.world = world;
     out.uv = uv;
     out.object = object;
@@ -36,10 +44,10 @@ fn vs_shadow(
 fn fs_shadow(in: ShadowOut) -> Targets {
     let height = dot(projection.plane, vec4<f32>(in.world, 1.0));
     let light_height = dot(projection.plane, projection.light);
-    // Below the plane: a false shadow. At or beyond the light: an anti-shadow. A hole of the
-    // caster's mask: no shadow.
-    if height < 0.0 || (projection.light.w > 0.0 && height >= light_height)
-        || !covered(in.object, in.uv) {
+    // Below the plane: a false shadow. At or beyond the light: an anti-shadow (both kept where
+    // `params.w` is 0, to show them). A hole of the caster's mask: no shadow.
+    let wrong_side = height < 0.0 || (projection.light.w > 0.0 && height >= light_height);
+    if (wrong_side && projection.params.w > 0.5) || !covered(in.object, in.uv) {
         discard;
     }
     var out: Targets;

@@ -3,7 +3,8 @@
 // `triangles`: every shadow-casting triangle gets a weight: +1 when it faces the light, -1 when
 // it faces away and belongs to an open (or non-manifold) mesh, whose triangles all block light
 // and are oriented toward it, 0 otherwise. Weighted triangles emit a near cap (the triangle
-// oriented toward the light) and a far cap (extruded to infinity, reversed).
+// oriented toward the light) and a far cap (extruded, reversed) unless `params.caps` is 0.
+// Vertices are extruded to infinity (w = 0), or by `params.extrusion` where it is not 0.
 // `edges`: each edge emits |m| side quads, m = sum over its faces of weight x traversal sign,
 // so sides shared by two emitting triangles cancel and boundary or non-manifold edges close
 // the volume exactly as per-triangle volumes would.
@@ -61,13 +62,23 @@ fn directional() -> bool {
     return lights[params.light].kind == LIGHT_DIRECTIONAL;
 }
 
-// A point at infinity away from the light.
+// Whether the volume ends in one point (a directional light extruded to infinity): its sides
+// are single triangles and it has no far cap (`VolumeShape::collapses` in the library).
+fn collapses() -> bool {
+    return directional() && params.extrusion <= 0.0;
+}
+
+// `p` moved away from the light: to infinity, or by `params.extrusion` where it is finite.
 fn extrude(p: vec3<f32>) -> vec4<f32> {
     let light = lights[params.light];
+    var away = p - light.position;
     if light.kind == LIGHT_DIRECTIONAL {
-        return vec4<f32>(light.direction, 0.0);
+        away = light.direction;
     }
-    return vec4<f32>(p - light.position, 0.0);
+    if params.extrusion > 0.0 {
+        return vec4<f32>(p + normalize(away) * params.extrusion, 1.0);
+    }
+    return vec4<f32>(away, 0.0);
 }
 
 // The first of `count` vertices in the volume, or 0xffffffff where the piece is full (its
@@ -89,7 +100,7 @@ fn emit_triangle(base: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) {
 
 // Outward side of the volume along the directed edge u -> v of a triangle facing the light.
 fn emit_side(u: vec3<f32>, v: vec3<f32>) {
-    if directional() {
+    if collapses() {
         // Both far vertices are the same point at infinity: one triangle.
         let base = allocate(3u);
         if base != 0xffffffffu {
@@ -101,6 +112,22 @@ fn emit_side(u: vec3<f32>, v: vec3<f32>) {
     if base != 0xffffffffu {
         emit_triangle(base, vec4<f32>(v, 1.0), vec4<f32>(u, 1.0), extrude(u));
         emit_triangle(base + 3u, vec4<f32>(v, 1.0), extrude(u), extrude(v));
+    }
+}
+
+// Near cap of the triangle a b c (oriented toward the light) and, unless the volume collapses,
+// the far cap, reversed.
+fn emit_caps(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) {
+    var count = 3u;
+    if !collapses() {
+        count = 6u;
+    }
+    let base = allocate(count);
+    if base != 0xffffffffu {
+        emit_triangle(base, vec4<f32>(a, 1.0), vec4<f32>(b, 1.0), vec4<f32>(c, 1.0));
+        if !collapses() {
+            emit_triangle(base + 3u, extrude(a), extrude(c), extrude(b));
+        }
     }
 }
 
@@ -147,17 +174,8 @@ fn triangles(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgrou
         b = c;
         c = swap;
     }
-    // Near cap, and (for point and spot lights) the far cap at infinity, reversed.
-    var count = 3u;
-    if !directional() {
-        count = 6u;
-    }
-    let base = allocate(count);
-    if base != 0xffffffffu {
-        emit_triangle(base, vec4<f32>(a, 1.0), vec4<f32>(b, 1.0), vec4<f32>(c, 1.0));
-        if !directional() {
-            emit_triangle(base + 3u, extrude(a), extrude(c), extrude(b));
-        }
+    if params.caps != 0u {
+        emit_caps(a, b, c);
     }
     if params.mode == MODE_PER_TRIANGLE {
         emit_side(a, b);

@@ -28,6 +28,38 @@ zoo_host::param_choice! {
     pub enum Volumes { Silhouette, PerTriangle }
 }
 
+/// The shape of the volumes: how they are built, whether caps close them and how far their
+/// sides reach. The default is exact: silhouette volumes, capped, extruded to infinity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VolumeShape {
+    /// From silhouette edges or one volume per triangle.
+    pub volumes: Volumes,
+    /// Near and far caps. Z-fail needs them: without, the counts go wrong where a ray from the
+    /// camera leaves the volume through its open ends (cracks).
+    pub caps: bool,
+    /// How far each vertex is extruded away from the light (0: to infinity). A finite distance
+    /// makes volumes too short: shadows end where they do.
+    pub extrusion: f32,
+}
+
+impl Default for VolumeShape {
+    fn default() -> VolumeShape {
+        VolumeShape {
+            volumes: Volumes::Silhouette,
+            caps: true,
+            extrusion: 0.0,
+        }
+    }
+}
+
+impl VolumeShape {
+    /// Whether a light's volume ends in one point (a directional light extruded to infinity):
+    /// its sides are single triangles and it has no far cap.
+    pub fn collapses(self, directional: bool) -> bool {
+        directional && self.extrusion <= 0.0
+    }
+}
+
 pub(crate) const FLAG_CASTS: u32 = 1;
 const FLAG_CLOSED: u32 = 2;
 pub(crate) const FLAG_PLACED: u32 = 4;
@@ -50,6 +82,10 @@ zoo_host::gpu_struct! {
         pub mode: u32,
         /// Vertices the volume buffer holds.
         pub capacity: u32,
+        /// 1: emit near and far caps ([`VolumeShape::caps`]).
+        pub caps: u32,
+        /// [`VolumeShape::extrusion`] (0: to infinity).
+        pub extrusion: f32,
     }
 }
 
@@ -120,7 +156,7 @@ struct Buffers {
     args: wgpu::Buffer,
     /// The generation group of each stage: caps, sides, tally.
     groups: [StageBindGroup; 3],
-    volumes: Volumes,
+    shape: VolumeShape,
     /// Vertices the volume buffer holds.
     capacity: u64,
     /// The work, one uniform slot each.
@@ -166,16 +202,17 @@ impl VolumeGenerator {
     }
 
     /// (Re)creates the buffers and the units of work for the context's scene and number of
-    /// lights, with `volumes` built from silhouette edges or per triangle, in pieces of at most
+    /// lights, with volumes of `shape`, in pieces of at most
     /// `budget` bytes where given (and never more than the device binds), and plans each
     /// light's pieces. Fails, saying why, where the scene's per-triangle data exceeds what the
     /// device binds.
     pub fn prepare(
         &mut self,
         ctx: &RenderContext<'_>,
-        volumes: Volumes,
+        shape: VolumeShape,
         budget: Option<u64>,
     ) -> TechniqueResult {
+        let volumes = shape.volumes;
         let device = &ctx.gpu.device;
         let label = &self.label;
         let scene = ctx.scene;
@@ -210,23 +247,25 @@ impl VolumeGenerator {
                 light: light as u32,
                 mode: u32::from(volumes == Volumes::PerTriangle),
                 capacity: capacity as u32,
+                caps: u32::from(shape.caps),
+                extrusion: shape.extrusion.max(0.0),
             })
             .collect();
         let parts: Vec<Part> = work.units.iter().map(|u| u.part).collect();
         self.params.write(ctx.gpu, &params);
         self.parts.write(ctx.gpu, &parts);
-        self.buffers = Some(self.buffers(ctx, &flags, (volumes, capacity), work)?);
+        self.buffers = Some(self.buffers(ctx, &flags, (shape, capacity), work)?);
         self.plan(ctx);
         Ok(())
     }
 
-    /// The buffers for `work` on the context's scene and lights, with `volumes` built into
-    /// a buffer of `capacity` vertices.
+    /// The buffers for `work` on the context's scene and lights, with volumes of `shape` built
+    /// into a buffer of `capacity` vertices.
     fn buffers(
         &self,
         ctx: &RenderContext<'_>,
         flags: &[u32],
-        (volumes, capacity): (Volumes, u64),
+        (shape, capacity): (VolumeShape, u64),
         work: crate::pieces::Units,
     ) -> TechniqueResult<Buffers> {
         let device = &ctx.gpu.device;
@@ -288,7 +327,7 @@ impl VolumeGenerator {
             volume,
             args,
             groups,
-            volumes,
+            shape,
             capacity,
             units: work.units,
             pieces: Vec::new(),
@@ -305,11 +344,12 @@ impl VolumeGenerator {
         b.pieces = (ctx.lights.iter())
             .map(|light| {
                 let directional = light.kind == zoo_host::LightKind::Directional;
+                let collapses = b.shape.collapses(directional);
                 let needed = |unit: &Unit| {
                     let reached = unit.object.is_none_or(|i| {
                         (scene.objects[i].bounds).is_none_or(|bounds| reaches_box(light, bounds))
                     });
-                    reached.then(|| unit.emitters.vertices(b.volumes, directional))
+                    reached.then(|| unit.emitters.vertices(b.shape.volumes, collapses))
                 };
                 pack(&b.units, b.capacity, needed)
             })

@@ -14,8 +14,8 @@ pub mod stencil;
 
 pub use counts::{COUNT_LEVELS, COUNTS_FORMAT, StencilCounts};
 pub use generation::{
-    ARGS_BYTES, VolumeGenerator, Volumes, dispatch_size, piece_pass_name, piece_vertices,
-    triangle_flags,
+    ARGS_BYTES, VolumeGenerator, VolumeShape, Volumes, dispatch_size, piece_pass_name,
+    piece_vertices, triangle_flags,
 };
 pub use stencil::{
     Counting, VOLUME_BUFFERS, VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil, resolve_stage,

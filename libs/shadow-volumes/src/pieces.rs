@@ -25,14 +25,15 @@ pub struct Emitters {
 }
 
 impl Emitters {
-    /// The most vertices they emit for a light: 6 per cap or side for point and spot lights
-    /// (far caps, two points at infinity per side), 3 for a directional one.
-    pub fn vertices(self, volumes: Volumes, directional: bool) -> u64 {
-        let per = if directional { 3 } else { 6 };
+    /// The most vertices they emit for a light: 6 per cap or side where the volume has a far
+    /// end (far caps, two far points per side), 3 where it `collapses` to one point (a
+    /// directional light extruded to infinity).
+    pub fn vertices(self, volumes: Volumes, collapses: bool) -> u64 {
+        let per = if collapses { 3 } else { 6 };
         match volumes {
             Volumes::Silhouette => per * (self.triangles + self.incidences),
-            // A near cap, a far cap (not for directional lights) and three sides.
-            Volumes::PerTriangle => self.triangles * if directional { 12 } else { 24 },
+            // A near cap, a far cap (not where it collapses) and three sides.
+            Volumes::PerTriangle => self.triangles * if collapses { 12 } else { 24 },
         }
     }
 

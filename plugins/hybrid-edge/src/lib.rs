@@ -38,7 +38,7 @@ use zoo_shadow_maps::{DepthState, LightMaps, LookupPass, LookupShader, MapHeader
 use casters::{CasterIdMaps, CasterIds};
 use tiles::Tiles;
 use zoo_shadow_volumes::{
-    COUNTS_FORMAT, StencilCounts, VolumeGenerator, Volumes, band_volume_depth_stencil,
+    COUNTS_FORMAT, StencilCounts, VolumeGenerator, VolumeShape, band_volume_depth_stencil,
     piece_pass_name, resolve_stage, volume_stage,
 };
 
@@ -412,7 +412,7 @@ impl ShadowTechnique for Hybrid {
         gpu.targets.prepare(ctx);
         if changes.scene || ctx.lights.len() != gpu.lights || gpu.generator.volume().is_none() {
             let budget = self.params.volume_budget();
-            gpu.generator.prepare(ctx, Volumes::Silhouette, budget)?;
+            gpu.generator.prepare(ctx, VolumeShape::default(), budget)?;
             gpu.lights = ctx.lights.len();
         } else if changes.lights {
             // The casters each light reaches, and so its pieces, follow the lights.

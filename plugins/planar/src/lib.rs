@@ -7,7 +7,9 @@
 //! parts beyond the light (anti-shadows) or below the plane (false shadows) are discarded per
 //! fragment; a light behind a plane casts nothing onto it; and the shadow is not depth-tested
 //! against the receiver, so it cannot z-fight with it. It is a planar-only technique: no
-//! self-shadowing, nothing on curved receivers.
+//! self-shadowing, nothing on curved receivers. Each of those fixes can be switched off to
+//! show its classic artifact (`stencil_once`, `clip_casters`, `depth_test` with
+//! `depth_offset`).
 
 pub mod matrix;
 
@@ -36,6 +38,22 @@ zoo_host::technique_params! {
         /// Depth bias (depth-buffer units, toward the camera) of the plane-marking draw, so the
         /// plane wins the depth test against its own G-buffer depth.
         depth_offset: u32 = 16, range(0, 4096), step(1), flags(rebuild);
+        /// Each pixel of a plane is shadowed once (default): the shadow replaces the light's
+        /// visibility and the stencil is zeroed after the first write. Artifact when off
+        /// (double blending): the shadow is blended multiplicatively wherever a flattened
+        /// triangle lands, so where they overlap (a caster's front and back always do) it
+        /// darkens twice or more; the stencil's once-per-pixel test fixes it.
+        stencil_once: bool = true, flags(rebuild);
+        /// Caster parts below the plane or at and beyond the light are discarded (default).
+        /// Artifact when off: the projection is applied regardless, so parts below the plane
+        /// cast false shadows and parts beyond the light anti-shadows; clipping them (Herf and
+        /// Heckbert) fixes it.
+        clip_casters: bool = true;
+        /// Depth-test the flattened casters against the scene instead of relying on the
+        /// stencil alone (off by default). With `depth_offset` 0 this shows z-fighting: the
+        /// shadow's depths, computed through the shadow matrix, tie with the plane's own, so
+        /// about half its pixels lose; the offset toward the camera fixes it.
+        depth_test: bool = false, flags(rebuild);
     }
 }
 
@@ -49,7 +67,8 @@ zoo_host::gpu_struct! {
         plane: Vec4,
         /// Homogeneous light: (position, 1) or (direction toward the light, 0).
         light: Vec4,
-        /// x: visibility written in shadow, y: plane id, z: distance tolerance for plane pixels.
+        /// x: visibility written in shadow, y: plane id, z: distance tolerance for plane pixels,
+        /// w: 1 to discard caster parts below the plane or beyond the light.
         params: Vec4,
     }
 }
@@ -168,16 +187,13 @@ impl Planar {
             .targets(&[no_visibility, plane_ids_target(wgpu::ColorWrites::RED)])
             .shared(&[&slot])
             .build(ctx)?;
-        // Zero after the first write: each pixel is shadowed once per plane.
-        let once = (wgpu::CompareFunction::Equal, wgpu::StencilOperation::Zero);
-        let always = wgpu::CompareFunction::Always;
         let shadow = Stage::render("planar/shadow.wgsl", "vs_shadow")
             .fragment("fs_shadow")
             .vertex_buffers(&SceneBuffers::VERTEX_LAYOUTS)
             .primitive(BOTH_FACES)
-            .depth_stencil(depth_stencil(always, once, Default::default()))
+            .depth_stencil(self.shadow_depth_stencil(bias))
             .targets(&[
-                Some(slot_target()),
+                Some(self.shadow_target()),
                 plane_ids_target(wgpu::ColorWrites::empty()),
             ])
             .shared(&[&slot])
@@ -187,6 +203,42 @@ impl Planar {
             shadow,
             projections,
         })
+    }
+
+    /// The shadow pass's depth-stencil: on the marked plane's pixels, zeroing the stencil
+    /// after the first write unless `stencil_once` is off; depth-tested with the marking
+    /// draw's `bias` where `depth_test` is on.
+    fn shadow_depth_stencil(&self, bias: wgpu::DepthBiasState) -> wgpu::DepthStencilState {
+        let pass_op = match self.params.stencil_once {
+            true => wgpu::StencilOperation::Zero,
+            false => wgpu::StencilOperation::Keep,
+        };
+        let stencil = (wgpu::CompareFunction::Equal, pass_op);
+        match self.params.depth_test {
+            true => depth_stencil(wgpu::CompareFunction::LessEqual, stencil, bias),
+            false => depth_stencil(wgpu::CompareFunction::Always, stencil, Default::default()),
+        }
+    }
+
+    /// The light's slot, replaced by the shadow, or multiplied by it (the classic blended
+    /// shadow polygon: each overlapping draw darkens it again) where `stencil_once` is off.
+    fn shadow_target(&self) -> wgpu::ColorTargetState {
+        if self.params.stencil_once {
+            return slot_target();
+        }
+        // The selected channel becomes src x dst, the others keep dst.
+        let multiply = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::Dst,
+            dst_factor: wgpu::BlendFactor::OneMinusConstant,
+            operation: wgpu::BlendOperation::Add,
+        };
+        wgpu::ColorTargetState {
+            blend: Some(wgpu::BlendState {
+                color: multiply,
+                alpha: multiply,
+            }),
+            ..slot_target()
+        }
     }
 
     /// Plans the (light, plane) draws and fills the uniform buffer.
@@ -213,7 +265,12 @@ impl Planar {
                     shadow_matrix: shadow_matrix(receiver.plane, l),
                     plane: receiver.plane,
                     light: l,
-                    params: Vec4::new(1.0 - self.params.opacity, (r + 1) as f32, tolerance, 0.0),
+                    params: Vec4::new(
+                        1.0 - self.params.opacity,
+                        (r + 1) as f32,
+                        tolerance,
+                        f32::from(u8::from(self.params.clip_casters)),
+                    ),
                 });
             }
             if !planes.is_empty() {
@@ -301,8 +358,9 @@ impl ShadowTechnique for Planar {
     }
 
     fn update_params(&mut self, values: &ParamValues) -> Result<ParamUpdate, TechniqueError> {
-        // The depth offset is part of the marking pipeline (`flags(rebuild)`); receivers and
-        // opacity are in the projection uniforms `plan` rewrites.
+        // The depth offset, stencil and depth tests are part of the pipelines
+        // (`flags(rebuild)`); receivers, opacity and clipping are in the projection uniforms
+        // `plan` rewrites.
         Ok(self.params.update(values)?)
     }
 

@@ -27,7 +27,7 @@ use zoo_host::{
 mod passes;
 
 use passes::{COUNTS_VIEW, OVERLAY_VIEW, Passes};
-use zoo_shadow_volumes::{ARGS_BYTES, piece_pass_name};
+use zoo_shadow_volumes::{ARGS_BYTES, VolumeShape, piece_pass_name};
 pub use zoo_shadow_volumes::{Counting, Volumes, silhouette};
 
 zoo_host::technique_params! {
@@ -37,6 +37,14 @@ zoo_host::technique_params! {
         counting: Counting = Counting::ZFail, flags(rebuild);
         /// Volumes from silhouette edges (default) or one volume per triangle (seed 004's baseline).
         volumes: Volumes = Volumes::Silhouette, flags(rebuild);
+        /// Near and far caps close the volumes (default). Artifact when off: z-fail counts
+        /// where rays leave a volume, so where one leaves through an open end the count goes
+        /// wrong and shadows crack (lit faces of casters darken, shadows vanish).
+        caps: bool = true, flags(rebuild);
+        /// Extrusion distance of the volumes' sides (0: to infinity, the default). Artifact when
+        /// not 0: volumes too short, so shadows end that far from their casters; extruding to
+        /// infinity (w = 0, with unclipped depth) fixes it.
+        extrusion: f32 = 0.0, range(0.0, 100.0), step(0.1), flags(rebuild);
         /// Constant depth bias pushing volume faces back, so a lit surface is never shadowed by
         /// its own near cap (depth-buffer units).
         depth_bias: u32 = 16, range(0, 65536), step(1), flags(rebuild);
@@ -56,6 +64,15 @@ zoo_host::technique_params! {
 }
 
 impl SvParams {
+    /// The generator's volume shape.
+    fn shape(&self) -> VolumeShape {
+        VolumeShape {
+            volumes: self.volumes,
+            caps: self.caps,
+            extrusion: self.extrusion,
+        }
+    }
+
     /// The volume buffer's budget in bytes, if one is set.
     fn volume_budget(&self) -> Option<u64> {
         (self.volume_buffer_mib > 0).then(|| u64::from(self.volume_buffer_mib) << 20)
@@ -124,7 +141,7 @@ impl ShadowTechnique for ShadowVolumes {
         if changes.scene || count_changed || self.stats.is_none() {
             self.lights = ctx.lights.len();
             let budget = self.params.volume_budget();
-            passes.generator.prepare(ctx, self.params.volumes, budget)?;
+            passes.generator.prepare(ctx, self.params.shape(), budget)?;
             let bytes = ctx.lights.len() as u64 * ARGS_BYTES;
             let label = "sv-zfail workload counters";
             let ring = ReadbackRing::new(&ctx.gpu.device, label, bytes, 3);
