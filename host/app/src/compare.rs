@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::fs::File;
 use std::io::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use glam::Vec3;
@@ -195,6 +195,9 @@ fn configurations(args: &CompareArgs) -> anyhow::Result<Vec<Configuration>> {
     Ok(out)
 }
 
+/// A technique run that failed: (view, configuration label, error).
+type Failure<'a> = (usize, &'a str, String);
+
 /// Runs `shadow-zoo compare`.
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let configurations = configurations(args)?;
@@ -203,28 +206,70 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
     let csv_path = args.out.join("results.csv");
-    let mut csv = File::create(&csv_path)
+    let csv = File::create(&csv_path)
         .with_context(|| format!("output folder {} is not writable", args.out.display()))?;
 
     let gpu = headless_gpu()?;
     let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
     let adapter = gpu.describe();
-    println!(
-        "scene: {} ({}, {} lights); {} configurations at {}x{}, {} view{}",
-        scene.name,
-        scene.triangle_summary(),
-        scene.lights.len(),
-        configurations.len(),
-        args.size.x,
-        args.size.y,
-        times.len(),
-        if times.len() == 1 { "" } else { "s" }
-    );
+    print_plan(&scene, configurations.len(), args, times.len());
     let light_count = scene.lights.len();
     let scene_name = scene.name.clone();
     let triangles = scene.triangle_summary();
     let mut renderer = Renderer::with_shaders(gpu, scene, args.size, shaders)?;
 
+    let (views, failures) = judge_views(&mut renderer, args, &configurations, &times)?;
+    print_references(&views, args.judge);
+    let [images_path, report_path] = write_outputs(
+        &args.out,
+        csv,
+        &csv_path,
+        &ReportInputs {
+            scene: &scene_name,
+            scene_path: &args.scene,
+            triangles,
+            lights: light_count,
+            size: (args.size.x, args.size.y),
+            adapter: &adapter,
+            judge: args.judge,
+            views: &views,
+            failures: &failures,
+        },
+    )?;
+    print_summaries(&views);
+    println!(
+        "wrote {}, {}, {} and the error maps",
+        csv_path.display(),
+        images_path.display(),
+        report_path.display()
+    );
+    check_failures(&failures, configurations.len() * views.len())
+}
+
+/// Prints what the run will do: the scene, the configurations, the resolution and the views.
+fn print_plan(scene: &Scene, configurations: usize, args: &CompareArgs, views: usize) {
+    println!(
+        "scene: {} ({}, {} lights); {} configurations at {}x{}, {} view{}",
+        scene.name,
+        scene.triangle_summary(),
+        scene.lights.len(),
+        configurations,
+        args.size.x,
+        args.size.y,
+        views,
+        if views == 1 { "" } else { "s" }
+    );
+}
+
+/// Traces the reference of each view and judges every configuration against it, showing
+/// progress; returns the judged views and the runs that failed.
+fn judge_views<'a>(
+    renderer: &mut Renderer,
+    args: &CompareArgs,
+    configurations: &'a [Configuration],
+    times: &[Option<f32>],
+) -> anyhow::Result<(Vec<JudgedView>, Vec<Failure<'a>>)> {
+    let light_count = renderer.scene().lights.len();
     let bar = ProgressBar::new((times.len() * (light_count + configurations.len())) as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed}]")
@@ -233,33 +278,21 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let mut views = Vec::new();
     let mut failures = Vec::new();
     for (view, &time) in times.iter().enumerate() {
-        go_to(&mut renderer, time);
+        go_to(renderer, time);
         bar.set_message(format!("view {view}: reference"));
-        let mut reference = match args.judge {
-            Judge::Cpu => SceneReference::compute(&mut renderer, args.samples, |_| bar.inc(1))?,
-            Judge::Gpu => {
-                let traced = crate::gpu_judge::trace_reference(&mut renderer, args.samples)?;
-                bar.inc(light_count as u64);
-                traced
-            }
-        };
-        let mut judged = Vec::new();
-        for config in &configurations {
-            bar.set_message(format!("view {view}: {}", config.label));
-            let id = config.technique.id;
-            match judge_technique(&mut renderer, &reference, id, &config.params) {
-                Ok(j) => judged.push(Judged {
-                    technique: config.label.clone(),
-                    ..j
-                }),
-                Err(e) => failures.push((view, config.label.as_str(), e.to_string())),
-            }
-            bar.inc(1);
-        }
+        let mut reference = trace_reference(renderer, args, &bar)?;
+        let judged = judge_configurations(
+            renderer,
+            &reference,
+            configurations,
+            view,
+            &bar,
+            &mut failures,
+        );
         bar.set_message(format!("view {view}: images"));
         let flip = judged
             .iter()
-            .map(|j| score_image(&renderer, &mut reference, j, args.samples))
+            .map(|j| score_image(renderer, &mut reference, j, args.samples))
             .collect();
         let view = JudgedView {
             view,
@@ -269,45 +302,97 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             judged,
             flip,
         };
-        views.push(judge_view_outputs(view, &renderer, args, times.len() > 1)?);
+        views.push(judge_view_outputs(view, renderer, args, times.len() > 1)?);
     }
     bar.finish_and_clear();
-    for v in &views {
+    Ok((views, failures))
+}
+
+/// Traces the area-light reference of the current view with the chosen judge, advancing
+/// `bar` by one per light.
+fn trace_reference(
+    renderer: &mut Renderer,
+    args: &CompareArgs,
+    bar: &ProgressBar,
+) -> anyhow::Result<SceneReference> {
+    Ok(match args.judge {
+        Judge::Cpu => SceneReference::compute(renderer, args.samples, |_| bar.inc(1))?,
+        Judge::Gpu => {
+            let traced = crate::gpu_judge::trace_reference(renderer, args.samples)?;
+            bar.inc(renderer.scene().lights.len() as u64);
+            traced
+        }
+    })
+}
+
+/// Judges every configuration against the reference of view `view`, advancing `bar` by one
+/// per configuration; the runs that fail go to `failures`.
+fn judge_configurations<'a>(
+    renderer: &mut Renderer,
+    reference: &SceneReference,
+    configurations: &'a [Configuration],
+    view: usize,
+    bar: &ProgressBar,
+    failures: &mut Vec<Failure<'a>>,
+) -> Vec<Judged> {
+    let mut judged = Vec::new();
+    for config in configurations {
+        bar.set_message(format!("view {view}: {}", config.label));
+        let id = config.technique.id;
+        match judge_technique(renderer, reference, id, &config.params) {
+            Ok(j) => judged.push(Judged {
+                technique: config.label.clone(),
+                ..j
+            }),
+            Err(e) => failures.push((view, config.label.as_str(), e.to_string())),
+        }
+        bar.inc(1);
+    }
+    judged
+}
+
+/// Prints how each view's reference was traced.
+fn print_references(views: &[JudgedView], judge: Judge) {
+    for v in views {
         println!(
             "reference{}: {} occluder triangles, {} area samples, traced on the {} in {:.2} s",
             view_label(v, views.len()),
             v.reference.occluder_triangles,
             v.reference.lights.first().map_or(0, |l| l.samples),
-            judge_name(args.judge),
+            judge_name(judge),
             v.reference.seconds
         );
     }
+}
 
-    csv.write_all(results_csv(&scene_name, &views).as_bytes())
+/// Writes `results.csv` (into the already created `csv`), `indirect.csv` when a technique
+/// adds light, `images.csv` and `report.md` into `out`; returns the paths of the images
+/// table and the report.
+fn write_outputs(
+    out: &Path,
+    mut csv: File,
+    csv_path: &Path,
+    r: &ReportInputs<'_>,
+) -> anyhow::Result<[PathBuf; 2]> {
+    csv.write_all(results_csv(r.scene, r.views).as_bytes())
         .with_context(|| format!("cannot write {}", csv_path.display()))?;
-    if let Some(indirect) = indirect_csv(&scene_name, &views) {
-        let path = args.out.join("indirect.csv");
+    if let Some(indirect) = indirect_csv(r.scene, r.views) {
+        let path = out.join("indirect.csv");
         std::fs::write(&path, indirect)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let images_path = args.out.join("images.csv");
-    std::fs::write(&images_path, images_csv(&scene_name, &views))
+    let images_path = out.join("images.csv");
+    std::fs::write(&images_path, images_csv(r.scene, r.views))
         .with_context(|| format!("cannot write {}", images_path.display()))?;
-    let report = report_md(&ReportInputs {
-        scene: &scene_name,
-        scene_path: &args.scene,
-        triangles,
-        lights: light_count,
-        size: (args.size.x, args.size.y),
-        adapter: &adapter,
-        judge: args.judge,
-        views: &views,
-        failures: &failures,
-    });
-    let report_path = args.out.join("report.md");
-    std::fs::write(&report_path, &report)
+    let report_path = out.join("report.md");
+    std::fs::write(&report_path, report_md(r))
         .with_context(|| format!("cannot write {}", report_path.display()))?;
-    for v in &views {
+    Ok([images_path, report_path])
+}
+
+/// Prints each view's summary table and indirect-light scores.
+fn print_summaries(views: &[JudgedView]) {
+    for v in views {
         if views.len() > 1 {
             println!("view {} (time {:.2}):", v.view, v.time.unwrap_or(0.0));
         }
@@ -319,23 +404,17 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             );
         }
     }
-    println!(
-        "wrote {}, {}, {} and the error maps",
-        csv_path.display(),
-        images_path.display(),
-        report_path.display()
-    );
-    if !failures.is_empty() {
-        for (view, id, e) in &failures {
-            eprintln!("{id} failed (view {view}): {e}");
-        }
-        bail!(
-            "{} of {} technique runs failed",
-            failures.len(),
-            configurations.len() * views.len()
-        );
+}
+
+/// Prints the runs that failed, if any, and then fails: `runs` is how many there were.
+fn check_failures(failures: &[Failure<'_>], runs: usize) -> anyhow::Result<()> {
+    if failures.is_empty() {
+        return Ok(());
     }
-    Ok(())
+    for (view, id, e) in failures {
+        eprintln!("{id} failed (view {view}): {e}");
+    }
+    bail!("{} of {runs} technique runs failed", failures.len());
 }
 
 /// `" (view N)"` when there are several views, else nothing.
@@ -763,7 +842,7 @@ struct ReportInputs<'a> {
     judge: Judge,
     views: &'a [JudgedView],
     /// (view, technique, error) of the runs that failed.
-    failures: &'a [(usize, &'a str, String)],
+    failures: &'a [Failure<'a>],
 }
 
 /// One row of the report's metrics table.
@@ -803,7 +882,28 @@ const METRICS_TABLE_HEAD: &str = "| technique | view | light | kind | pixels | f
 fn report_md(r: &ReportInputs<'_>) -> String {
     let mut out = String::new();
     let w = &mut out;
-    let first = r.views.first();
+    summary_md(w, r);
+    metrics_md(w, r.views);
+    final_images_md(w, r.views);
+    if r.views.iter().any(|v| !v.indirect.is_empty()) {
+        indirect_md(w, r.views);
+    }
+    let judged = r
+        .views
+        .first()
+        .map(|v| v.judged.as_slice())
+        .unwrap_or_default();
+    parameters_md(w, judged);
+    pass_timings_md(w, judged);
+    if !r.failures.is_empty() {
+        failures_md(w, r.failures);
+    }
+    out
+}
+
+/// The report's title and its bullet list: scene, resolution, adapter, views,
+/// reference, the casters some techniques treat as opaque, and the warnings.
+fn summary_md(w: &mut String, r: &ReportInputs<'_>) {
     let _ = writeln!(w, "# Shadow Zoo comparison: {}\n", r.scene);
     let _ = writeln!(
         w,
@@ -827,7 +927,7 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             times.join(", ")
         );
     }
-    if let Some(v) = first {
+    if let Some(v) = r.views.first() {
         let seconds: f64 = r.views.iter().map(|v| v.reference.seconds).sum();
         let _ = writeln!(
             w,
@@ -837,15 +937,23 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             judge_name(r.judge),
             seconds
         );
+        opaque_casters_md(w, v);
     }
-    if first.is_some_and(|v| v.reference.lights.iter().any(|l| l.color.is_some())) {
-        let opaque: Vec<String> = first
-            .map(|v| v.judged.as_slice())
-            .unwrap_or_default()
-            .iter()
-            .filter(|j| j.transmittance.iter().all(Option::is_none))
-            .map(|j| format!("`{}`", j.technique))
-            .collect();
+    if let Some(warnings) = warnings_md(r.views) {
+        w.push_str(&warnings);
+    }
+}
+
+/// The bullets naming the techniques that treat translucent or alpha-masked
+/// casters as opaque, judged on the first view.
+fn opaque_casters_md(w: &mut String, first: &JudgedView) {
+    if first.reference.lights.iter().any(|l| l.color.is_some()) {
+        let opaque = technique_list(
+            first
+                .judged
+                .iter()
+                .filter(|j| j.transmittance.iter().all(Option::is_none)),
+        );
         let _ = writeln!(
             w,
             "- Translucent casters: the reference filters light through them by colour; {} treat them as opaque (their visibility is scored against the mean colour that passes)",
@@ -856,12 +964,7 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             }
         );
     }
-    let judged = first.map(|v| v.judged.as_slice()).unwrap_or_default();
-    let masks_opaque: Vec<String> = judged
-        .iter()
-        .filter(|j| j.masks_opaque)
-        .map(|j| format!("`{}`", j.technique))
-        .collect();
+    let masks_opaque = technique_list(first.judged.iter().filter(|j| j.masks_opaque));
     if !masks_opaque.is_empty() {
         let _ = writeln!(
             w,
@@ -869,15 +972,22 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             masks_opaque.join(", ")
         );
     }
-    if let Some(warnings) = warnings_md(r.views) {
-        w.push_str(&warnings);
-    }
+}
+
+/// The techniques' names, each in backticks.
+fn technique_list<'a>(judged: impl Iterator<Item = &'a Judged>) -> Vec<String> {
+    judged.map(|j| format!("`{}`", j.technique)).collect()
+}
+
+/// The visibility metrics of every view, then (with several views) their
+/// worst and mean over the views.
+fn metrics_md(w: &mut String, views: &[JudgedView]) {
     let _ = writeln!(
         w,
         "\nFractions are of the pixels each light reaches. `core` leaves out the one-pixel band around reference shadow boundaries; `mae` and `p95` compare with the area-light reference. Error maps: red = false shadow, blue = false lit, grey = both shadowed.\n"
     );
     let _ = writeln!(w, "{METRICS_TABLE_HEAD}");
-    for v in r.views {
+    for v in views {
         for j in &v.judged {
             for s in &j.scores {
                 metrics_row(
@@ -891,14 +1001,14 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             }
         }
     }
-    if r.views.len() > 1 {
+    if views.len() > 1 {
         let _ = writeln!(
             w,
             "\n## Over the views\n\nPer technique and light, the worst (largest) and the mean of each metric over the {} views.\n",
-            r.views.len()
+            views.len()
         );
         let _ = writeln!(w, "{METRICS_TABLE_HEAD}");
-        for series in per_technique_and_light(r.views) {
+        for series in per_technique_and_light(views) {
             let score = &series.scores[0].0;
             let [(worst, worst_ms), (mean, mean_ms)] = series.worst_and_mean();
             metrics_row(
@@ -912,6 +1022,11 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             metrics_row(w, series.technique, "mean", score, mean.as_ref(), mean_ms);
         }
     }
+}
+
+/// The ꟻLIP table of the final images: one row per technique and view, then
+/// (with several views) each technique's worst and mean.
+fn final_images_md(w: &mut String, views: &[JudgedView]) {
     let _ = writeln!(
         w,
         "\n## Final images\n\nꟻLIP of each technique's final image against the reference image (the reference's area visibility shaded by the same lighting on the CPU, with the one-bounce indirect reference for techniques that add light), at 67 pixels per degree: 0 is identical, 1 the largest difference. Maps `<technique>-flip.png` (`<technique>-view<K>-flip.png` with several views; magma: black none, yellow large); values in `images.csv`.\n"
@@ -919,7 +1034,7 @@ fn report_md(r: &ReportInputs<'_>) -> String {
     let _ = writeln!(w, "| technique | view | flip_mean | flip_p95 |");
     let _ = writeln!(w, "|---|---|---|---|");
     let mut per_technique: Vec<(&str, Vec<(f64, f64)>)> = Vec::new();
-    for v in r.views {
+    for v in views {
         for (j, flip) in v.judged.iter().zip(&v.flip) {
             if let Some(flip) = flip {
                 let _ = writeln!(
@@ -934,7 +1049,7 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             }
         }
     }
-    if r.views.len() > 1 {
+    if views.len() > 1 {
         for (technique, scores) in per_technique {
             let [worst, mean] = worst_and_mean_flip(&scores);
             let _ = writeln!(
@@ -945,24 +1060,29 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             let _ = writeln!(w, "| {technique} | mean | {:.4} | {:.4} |", mean.0, mean.1);
         }
     }
-    if r.views.iter().any(|v| !v.indirect.is_empty()) {
-        let _ = writeln!(
-            w,
-            "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more); the values themselves in `reference-indirect.hdr` and `<technique>-indirect.hdr` (linear Radiance HDR). Leak: the technique's mean indirect light on the surfaces that no directly lit surface sees (the reference is exactly 0 there: no cosine ray found light, and none of the points traced as lit from every light is in view), as a fraction of the reference's mean over every surface; `unlit` is those surfaces' share of the pixels.\n"
-        );
-        let _ = writeln!(w, "| technique | view | indirect_rmse | leak | unlit |");
-        let _ = writeln!(w, "|---|---|---|---|---|");
-        for v in r.views {
-            for score in &v.indirect {
-                let _ = writeln!(
-                    w,
-                    "| {} | {} | {:.4} | {:.4} | {:.3} |",
-                    score.technique, v.view, score.rmse, score.leak.leak, score.leak.unlit_share
-                );
-            }
+}
+
+/// The indirect-light section: each technique's error and leak per view.
+fn indirect_md(w: &mut String, views: &[JudgedView]) {
+    let _ = writeln!(
+        w,
+        "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more); the values themselves in `reference-indirect.hdr` and `<technique>-indirect.hdr` (linear Radiance HDR). Leak: the technique's mean indirect light on the surfaces that no directly lit surface sees (the reference is exactly 0 there: no cosine ray found light, and none of the points traced as lit from every light is in view), as a fraction of the reference's mean over every surface; `unlit` is those surfaces' share of the pixels.\n"
+    );
+    let _ = writeln!(w, "| technique | view | indirect_rmse | leak | unlit |");
+    let _ = writeln!(w, "|---|---|---|---|---|");
+    for v in views {
+        for score in &v.indirect {
+            let _ = writeln!(
+                w,
+                "| {} | {} | {:.4} | {:.4} | {:.3} |",
+                score.technique, v.view, score.rmse, score.leak.leak, score.leak.unlit_share
+            );
         }
     }
-    let judged = first.map(|v| v.judged.as_slice()).unwrap_or_default();
+}
+
+/// Each technique's parameter values.
+fn parameters_md(w: &mut String, judged: &[Judged]) {
     let _ = writeln!(w, "\n## Parameters\n");
     for j in judged {
         let values: Vec<String> = j.params.iter().map(|(k, v)| format!("{k} = {v}")).collect();
@@ -977,6 +1097,10 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             }
         );
     }
+}
+
+/// Each technique's GPU pass timings on the first view.
+fn pass_timings_md(w: &mut String, judged: &[Judged]) {
     let _ = writeln!(
         w,
         "\n## Pass timings ({}, view 0)\n",
@@ -991,11 +1115,12 @@ fn report_md(r: &ReportInputs<'_>) -> String {
             .collect();
         let _ = writeln!(w, "- `{}`: {}", j.technique, passes.join(", "));
     }
-    if !r.failures.is_empty() {
-        let _ = writeln!(w, "\n## Failures\n");
-        for (view, id, e) in r.failures {
-            let _ = writeln!(w, "- `{id}` (view {view}): {e}");
-        }
+}
+
+/// The runs that failed, by view and technique.
+fn failures_md(w: &mut String, failures: &[Failure<'_>]) {
+    let _ = writeln!(w, "\n## Failures\n");
+    for (view, id, e) in failures {
+        let _ = writeln!(w, "- `{id}` (view {view}): {e}");
     }
-    out
 }

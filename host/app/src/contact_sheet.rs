@@ -73,6 +73,22 @@ pub struct Row {
 }
 
 impl Row {
+    /// A row with nothing measured.
+    fn new(id: &str, name: String) -> Row {
+        Row {
+            id: id.to_string(),
+            name,
+            frame_ms: None,
+            technique_ms: None,
+            timings: None,
+            summary: None,
+            unsupported: Vec::new(),
+            masks_opaque: false,
+            failure: None,
+            note: None,
+        }
+    }
+
     fn label_lines(&self) -> Vec<String> {
         let title = if self.note.is_some() {
             self.name.clone()
@@ -166,89 +182,27 @@ pub fn build(
 ) -> anyhow::Result<Sheet> {
     progress("reference");
     let mut reference = SceneReference::compute(renderer, samples, |_| {})?;
-    let background = renderer.read_output();
-    let gbuffer_size = reference.gbuffer.size;
-    let traced = format!(
-        "ray traced in {:.2} s ({} triangles)",
-        reference.seconds, reference.occluder_triangles
-    );
-    let reference_row = |id: &str, name: String| Row {
-        id: id.to_string(),
-        name,
-        frame_ms: None,
-        technique_ms: None,
-        timings: None,
-        summary: None,
-        unsupported: Vec::new(),
-        masks_opaque: false,
-        failure: None,
-        note: Some(traced.clone()),
-    };
-    let mut rows = vec![
-        reference_row("reference (hard)", "Reference: hard shadows".into()),
-        reference_row(
-            "reference (area)",
-            format!(
-                "Reference: area lights, {} samples",
-                reference.lights.first().map_or(0, |l| l.samples)
-            ),
-        ),
-    ];
-    let mut images = {
-        let hard: Vec<&[f32]> = reference.lights.iter().map(|l| l.hard.as_slice()).collect();
-        let area: Vec<&[f32]> = reference.lights.iter().map(|l| l.area.as_slice()).collect();
-        vec![
-            shade_on_cpu(renderer, &reference.gbuffer, &hard, None, &background),
-            shade_on_cpu(renderer, &reference.gbuffer, &area, None, &background),
-        ]
-    };
+    let (mut rows, mut images) = reference_tiles(renderer, &reference);
+    let tile_size = reference.gbuffer.size;
     for (registration, values) in techniques {
         progress(registration.id);
-        match judge_technique(renderer, &reference, registration.id, values) {
+        let (row, image) = match judge_technique(renderer, &reference, registration.id, values) {
             Ok(judged) => {
                 let flip = score_image(renderer, &mut reference, &judged, samples);
-                rows.push(Row {
-                    id: registration.id.to_string(),
-                    name: registration.name.to_string(),
-                    frame_ms: Some(judged.timings.frame_total()),
-                    technique_ms: Some(judged.gpu_ms),
-                    timings: Some(judged.timings.clone()),
-                    summary: Summary::of(&judged).map(|s| Summary {
-                        flip: flip.map(|f| f.mean),
-                        ..s
-                    }),
-                    unsupported: judged
-                        .scores
-                        .iter()
-                        .filter(|s| s.metrics.is_none())
-                        .map(|s| s.light)
-                        .collect(),
-                    masks_opaque: judged.masks_opaque,
-                    failure: None,
-                    note: None,
-                });
-                images.push(judged.image);
+                judged_tile(registration, judged, flip.map(|f| f.mean))
             }
             Err(e) => {
-                rows.push(Row {
-                    id: registration.id.to_string(),
-                    name: registration.name.to_string(),
-                    frame_ms: None,
-                    technique_ms: None,
-                    timings: None,
-                    summary: None,
-                    unsupported: Vec::new(),
-                    masks_opaque: false,
+                let row = Row {
                     failure: Some(e.to_string()),
-                    note: None,
-                });
-                images.push(RgbaImage::from_pixel(
-                    gbuffer_size.x,
-                    gbuffer_size.y,
-                    image::Rgba([60, 20, 20, 255]),
-                ));
+                    ..Row::new(registration.id, registration.name.to_string())
+                };
+                let image =
+                    RgbaImage::from_pixel(tile_size.x, tile_size.y, image::Rgba([60, 20, 20, 255]));
+                (row, image)
             }
-        }
+        };
+        rows.push(row);
+        images.push(image);
     }
     let scene: &Scene = renderer.scene();
     let size = renderer.size();
@@ -263,6 +217,61 @@ pub fn build(
         rows,
         images,
     })
+}
+
+/// The two reference tiles, hard and area visibility shaded on the CPU over the output
+/// `renderer` last rendered, with their rows.
+fn reference_tiles(renderer: &Renderer, reference: &SceneReference) -> (Vec<Row>, Vec<RgbaImage>) {
+    let background = renderer.read_output();
+    let traced = format!(
+        "ray traced in {:.2} s ({} triangles)",
+        reference.seconds, reference.occluder_triangles
+    );
+    let reference_row = |id: &str, name: String| Row {
+        note: Some(traced.clone()),
+        ..Row::new(id, name)
+    };
+    let rows = vec![
+        reference_row("reference (hard)", "Reference: hard shadows".into()),
+        reference_row(
+            "reference (area)",
+            format!(
+                "Reference: area lights, {} samples",
+                reference.lights.first().map_or(0, |l| l.samples)
+            ),
+        ),
+    ];
+    let hard: Vec<&[f32]> = reference.lights.iter().map(|l| l.hard.as_slice()).collect();
+    let area: Vec<&[f32]> = reference.lights.iter().map(|l| l.area.as_slice()).collect();
+    let images = vec![
+        shade_on_cpu(renderer, &reference.gbuffer, &hard, None, &background),
+        shade_on_cpu(renderer, &reference.gbuffer, &area, None, &background),
+    ];
+    (rows, images)
+}
+
+/// A judged technique's tile: its row (with the mean ꟻLIP of its image, if scored) and its
+/// final image.
+fn judged_tile(
+    registration: &TechniqueRegistration,
+    judged: Judged,
+    flip: Option<f64>,
+) -> (Row, RgbaImage) {
+    let row = Row {
+        frame_ms: Some(judged.timings.frame_total()),
+        technique_ms: Some(judged.gpu_ms),
+        timings: Some(judged.timings.clone()),
+        summary: Summary::of(&judged).map(|s| Summary { flip, ..s }),
+        unsupported: judged
+            .scores
+            .iter()
+            .filter(|s| s.metrics.is_none())
+            .map(|s| s.light)
+            .collect(),
+        masks_opaque: judged.masks_opaque,
+        ..Row::new(registration.id, registration.name.to_string())
+    };
+    (row, judged.image)
 }
 
 /// Columns of a sheet with `tiles` tiles: close to square.

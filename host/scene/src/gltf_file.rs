@@ -328,91 +328,16 @@ impl Loader<'_> {
         ) {
             return Ok(None);
         }
-        let invalid = |attribute: &str, message: String| GltfError::Invalid {
-            what: format!("{what}.{attribute}"),
-            message,
+        let attributes = Attributes {
+            primitive,
+            buffers: self.buffers,
+            what,
         };
-        let buffers = self.buffers;
-        let reader = primitive.reader(|b| buffers.get(b.index()).copied());
-
-        let positions_accessor = primitive
-            .get(&gltf::Semantic::Positions)
-            .ok_or_else(|| invalid("attributes", "has no POSITION".into()))?;
-        check_accessor(
-            &positions_accessor,
-            &[DataType::F32],
-            Dimensions::Vec3,
-            buffers,
-        )
-        .map_err(|m| invalid("POSITION", m))?;
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| invalid("POSITION", "cannot be read".into()))?
-            .map(Vec3::from)
-            .collect();
-        if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(invalid("POSITION", format!("vertex {bad} is not finite")));
-        }
+        let positions = attributes.positions()?;
         let count = positions.len();
-
-        let normals = match primitive.get(&gltf::Semantic::Normals) {
-            Some(accessor) if accessor.count() == count => {
-                check_accessor(&accessor, &[DataType::F32], Dimensions::Vec3, buffers)
-                    .map_err(|m| invalid("NORMAL", m))?;
-                let normals: Vec<Vec3> = (reader.read_normals())
-                    .map(|n| n.map(Vec3::from).collect())
-                    .unwrap_or_default();
-                let usable = normals
-                    .iter()
-                    .all(|n| n.is_finite() && n.length_squared() > 1e-12);
-                if usable {
-                    normals.into_iter().map(Vec3::normalize).collect()
-                } else {
-                    Vec::new()
-                }
-            }
-            _ => Vec::new(),
-        };
-
-        let uvs = match primitive.get(&gltf::Semantic::TexCoords(0)) {
-            Some(accessor) if accessor.count() == count => {
-                let types = [DataType::F32, DataType::U8, DataType::U16];
-                check_accessor(&accessor, &types, Dimensions::Vec2, buffers)
-                    .map_err(|m| invalid("TEXCOORD_0", m))?;
-                (reader.read_tex_coords(0))
-                    .map(|t| t.into_f32().map(Vec2::from).collect())
-                    .unwrap_or_default()
-            }
-            _ => Vec::new(),
-        };
-        let uvs = if uvs.len() == count {
-            uvs.into_iter()
-                .map(|t: Vec2| if t.is_finite() { t } else { Vec2::ZERO })
-                .collect()
-        } else {
-            vec![Vec2::ZERO; count]
-        };
-
-        let sequence: Vec<u32> = match primitive.indices() {
-            Some(accessor) => {
-                let types = [DataType::U8, DataType::U16, DataType::U32];
-                check_accessor(&accessor, &types, Dimensions::Scalar, buffers)
-                    .map_err(|m| invalid("indices", m))?;
-                let indices: Vec<u32> = (reader.read_indices())
-                    .map(|i| i.into_u32().collect())
-                    .unwrap_or_default();
-                if let Some(bad) = indices.iter().find(|&&i| i as usize >= count) {
-                    return Err(invalid(
-                        "indices",
-                        format!("index {bad} is out of range of {count} vertices"),
-                    ));
-                }
-                indices
-            }
-            None => (0..count as u32).collect(),
-        };
-        let indices = triangles(mode, &sequence);
-
+        let normals = attributes.normals(count)?;
+        let uvs = attributes.uvs(count)?;
+        let indices = triangles(mode, &attributes.index_sequence(count)?);
         let mut mesh = MeshData {
             positions,
             normals,
@@ -424,6 +349,122 @@ impl Loader<'_> {
             self.report.normals_computed = true;
         }
         Ok(Some(mesh))
+    }
+}
+
+/// Reads and checks the vertex attributes and indices of one primitive.
+struct Attributes<'a, 'p> {
+    primitive: &'a gltf::Primitive<'p>,
+    buffers: &'a [&'a [u8]],
+    /// The primitive, as errors name it.
+    what: &'a str,
+}
+
+impl Attributes<'_, '_> {
+    /// An error in `attribute` of the primitive.
+    fn invalid(&self, attribute: &str, message: String) -> GltfError {
+        GltfError::Invalid {
+            what: format!("{}.{attribute}", self.what),
+            message,
+        }
+    }
+
+    /// Checks the accessor of `attribute` holds `types` in `dimensions`.
+    fn check(
+        &self,
+        accessor: &gltf::Accessor<'_>,
+        types: &[DataType],
+        dimensions: Dimensions,
+        attribute: &str,
+    ) -> Result<(), GltfError> {
+        check_accessor(accessor, types, dimensions, self.buffers)
+            .map_err(|m| self.invalid(attribute, m))
+    }
+
+    /// The positions, which a primitive must have, all finite.
+    fn positions(&self) -> Result<Vec<Vec3>, GltfError> {
+        let accessor = (self.primitive.get(&gltf::Semantic::Positions))
+            .ok_or_else(|| self.invalid("attributes", "has no POSITION".into()))?;
+        self.check(&accessor, &[DataType::F32], Dimensions::Vec3, "POSITION")?;
+        let positions: Vec<Vec3> = (self.primitive)
+            .reader(|b| self.buffers.get(b.index()).copied())
+            .read_positions()
+            .ok_or_else(|| self.invalid("POSITION", "cannot be read".into()))?
+            .map(Vec3::from)
+            .collect();
+        if let Some(bad) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(self.invalid("POSITION", format!("vertex {bad} is not finite")));
+        }
+        Ok(positions)
+    }
+
+    /// The normals, normalized; none when there are not `count` of them or one is unusable.
+    fn normals(&self, count: usize) -> Result<Vec<Vec3>, GltfError> {
+        let Some(accessor) = self.primitive.get(&gltf::Semantic::Normals) else {
+            return Ok(Vec::new());
+        };
+        if accessor.count() != count {
+            return Ok(Vec::new());
+        }
+        self.check(&accessor, &[DataType::F32], Dimensions::Vec3, "NORMAL")?;
+        let normals: Vec<Vec3> = (self.primitive)
+            .reader(|b| self.buffers.get(b.index()).copied())
+            .read_normals()
+            .map(|n| n.map(Vec3::from).collect())
+            .unwrap_or_default();
+        let usable = normals
+            .iter()
+            .all(|n| n.is_finite() && n.length_squared() > 1e-12);
+        Ok(if usable {
+            normals.into_iter().map(Vec3::normalize).collect()
+        } else {
+            Vec::new()
+        })
+    }
+
+    /// The first texture coordinates, `count` of them (zero where missing or not finite).
+    fn uvs(&self, count: usize) -> Result<Vec<Vec2>, GltfError> {
+        let uvs = match self.primitive.get(&gltf::Semantic::TexCoords(0)) {
+            Some(accessor) if accessor.count() == count => {
+                let types = [DataType::F32, DataType::U8, DataType::U16];
+                self.check(&accessor, &types, Dimensions::Vec2, "TEXCOORD_0")?;
+                (self.primitive)
+                    .reader(|b| self.buffers.get(b.index()).copied())
+                    .read_tex_coords(0)
+                    .map(|t| t.into_f32().map(Vec2::from).collect())
+                    .unwrap_or_default()
+            }
+            _ => Vec::new(),
+        };
+        Ok(if uvs.len() == count {
+            uvs.into_iter()
+                .map(|t: Vec2| if t.is_finite() { t } else { Vec2::ZERO })
+                .collect()
+        } else {
+            vec![Vec2::ZERO; count]
+        })
+    }
+
+    /// The vertex sequence the primitive's mode assembles (its indices, each below `count`,
+    /// or every vertex in order).
+    fn index_sequence(&self, count: usize) -> Result<Vec<u32>, GltfError> {
+        let Some(accessor) = self.primitive.indices() else {
+            return Ok((0..count as u32).collect());
+        };
+        let types = [DataType::U8, DataType::U16, DataType::U32];
+        self.check(&accessor, &types, Dimensions::Scalar, "indices")?;
+        let indices: Vec<u32> = (self.primitive)
+            .reader(|b| self.buffers.get(b.index()).copied())
+            .read_indices()
+            .map(|i| i.into_u32().collect())
+            .unwrap_or_default();
+        if let Some(bad) = indices.iter().find(|&&i| i as usize >= count) {
+            return Err(self.invalid(
+                "indices",
+                format!("index {bad} is out of range of {count} vertices"),
+            ));
+        }
+        Ok(indices)
     }
 }
 

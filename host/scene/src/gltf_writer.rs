@@ -110,67 +110,10 @@ impl DocumentSpec {
 
     /// The JSON, and the binary buffer (empty when `embedded` puts it in a data URI).
     fn json_and_binary(&self, embedded: bool) -> (String, Vec<u8>) {
-        let mut bin = Vec::new();
-        let mut views = Vec::new();
-        let mut accessors = Vec::new();
-        let mut add_view = |bin: &mut Vec<u8>, bytes: &[u8]| {
-            while !bin.len().is_multiple_of(4) {
-                bin.push(0);
-            }
-            views.push(format!(
-                r#"{{"buffer":0,"byteOffset":{},"byteLength":{}}}"#,
-                bin.len(),
-                bytes.len()
-            ));
-            bin.extend_from_slice(bytes);
-            views.len() - 1
-        };
-        let mut meshes = Vec::new();
-        for mesh in &self.meshes {
-            let floats = |values: &mut dyn Iterator<Item = f32>| -> Vec<u8> {
-                values.flat_map(f32::to_le_bytes).collect()
-            };
-            let view = add_view(
-                &mut bin,
-                &floats(&mut mesh.positions.iter().flatten().copied()),
-            );
-            let (lo, hi) =
-                mesh.positions
-                    .iter()
-                    .fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), p| {
-                        (
-                            [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
-                            [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
-                        )
-                    });
-            accessors.push(format!(
-                r#"{{"bufferView":{view},"componentType":5126,"count":{},"type":"VEC3","min":{lo:?},"max":{hi:?}}}"#,
-                mesh.positions.len()
-            ));
-            let mut attributes = format!(r#""POSITION":{}"#, accessors.len() - 1);
-            if !mesh.uvs.is_empty() {
-                let view = add_view(&mut bin, &floats(&mut mesh.uvs.iter().flatten().copied()));
-                accessors.push(format!(
-                    r#"{{"bufferView":{view},"componentType":5126,"count":{},"type":"VEC2"}}"#,
-                    mesh.uvs.len()
-                ));
-                write!(attributes, r#","TEXCOORD_0":{}"#, accessors.len() - 1).unwrap();
-            }
-            let indices: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-            let view = add_view(&mut bin, &indices);
-            accessors.push(format!(
-                r#"{{"bufferView":{view},"componentType":5125,"count":{},"type":"SCALAR"}}"#,
-                mesh.indices.len()
-            ));
-            let material = mesh
-                .material
-                .map(|m| format!(r#","material":{m}"#))
-                .unwrap_or_default();
-            meshes.push(format!(
-                r#"{{"primitives":[{{"attributes":{{{attributes}}},"indices":{}{material}}}]}}"#,
-                accessors.len() - 1
-            ));
-        }
+        let mut buffer = BinaryBuffer::default();
+        let meshes: Vec<String> = (self.meshes.iter())
+            .map(|mesh| buffer.add_mesh(mesh))
+            .collect();
         let images: Vec<String> = self
             .images
             .iter()
@@ -178,7 +121,7 @@ impl DocumentSpec {
                 if embedded {
                     format!(r#"{{"uri":"data:image/png;base64,{}"}}"#, base64(png))
                 } else {
-                    let view = add_view(&mut bin, png);
+                    let view = buffer.add_view(png);
                     format!(r#"{{"bufferView":{view},"mimeType":"image/png"}}"#)
                 }
             })
@@ -186,45 +129,13 @@ impl DocumentSpec {
         let textures: Vec<String> = (0..self.images.len())
             .map(|i| format!(r#"{{"source":{i}}}"#))
             .collect();
-        let materials: Vec<String> = self
-            .materials
-            .iter()
-            .map(|m| {
-                let texture = m
-                    .texture
-                    .map(|t| format!(r#","baseColorTexture":{{"index":{t}}}"#))
-                    .unwrap_or_default();
-                format!(
-                    r#"{{"name":"{}","pbrMetallicRoughness":{{"baseColorFactor":{:?},"metallicFactor":{:?},"roughnessFactor":{:?}{texture}}},"alphaMode":"{}","alphaCutoff":{:?},"doubleSided":{}}}"#,
-                    m.name,
-                    m.base_color,
-                    m.metallic,
-                    m.roughness,
-                    m.alpha_mode,
-                    m.alpha_cutoff,
-                    m.double_sided
-                )
-            })
-            .collect();
-        let nodes: Vec<String> = self
-            .nodes
-            .iter()
-            .map(|n| {
-                let mesh = n
-                    .mesh
-                    .map(|m| format!(r#""mesh":{m},"#))
-                    .unwrap_or_default();
-                let children = if n.children.is_empty() {
-                    String::new()
-                } else {
-                    format!(r#","children":{:?}"#, n.children)
-                };
-                format!(
-                    r#"{{{mesh}"translation":{:?},"rotation":{:?},"scale":{:?}{children}}}"#,
-                    n.translation, n.rotation, n.scale
-                )
-            })
-            .collect();
+        let materials: Vec<String> = self.materials.iter().map(material_json).collect();
+        let nodes: Vec<String> = self.nodes.iter().map(node_json).collect();
+        let BinaryBuffer {
+            bin,
+            views,
+            accessors,
+        } = buffer;
         let buffer = if embedded {
             format!(
                 r#"{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}"#,
@@ -252,6 +163,113 @@ impl DocumentSpec {
         );
         (json, if embedded { Vec::new() } else { bin })
     }
+}
+
+/// The file's one binary buffer as it is filled, with the JSON of its views and accessors.
+#[derive(Default)]
+struct BinaryBuffer {
+    bin: Vec<u8>,
+    views: Vec<String>,
+    accessors: Vec<String>,
+}
+
+impl BinaryBuffer {
+    /// Appends `bytes` (4-byte aligned) as a new buffer view; returns its index.
+    fn add_view(&mut self, bytes: &[u8]) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        self.views.push(format!(
+            r#"{{"buffer":0,"byteOffset":{},"byteLength":{}}}"#,
+            self.bin.len(),
+            bytes.len()
+        ));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+
+    /// Adds an accessor's JSON; returns its index.
+    fn add_accessor(&mut self, json: String) -> usize {
+        self.accessors.push(json);
+        self.accessors.len() - 1
+    }
+
+    /// Adds a mesh's positions, texture coordinates (if any) and indices; returns the
+    /// mesh's JSON, one primitive reading them.
+    fn add_mesh(&mut self, mesh: &MeshSpec) -> String {
+        let floats = |values: &mut dyn Iterator<Item = f32>| -> Vec<u8> {
+            values.flat_map(f32::to_le_bytes).collect()
+        };
+        let view = self.add_view(&floats(&mut mesh.positions.iter().flatten().copied()));
+        let (lo, hi) = bounds(&mesh.positions);
+        let positions = self.add_accessor(format!(
+            r#"{{"bufferView":{view},"componentType":5126,"count":{},"type":"VEC3","min":{lo:?},"max":{hi:?}}}"#,
+            mesh.positions.len()
+        ));
+        let mut attributes = format!(r#""POSITION":{positions}"#);
+        if !mesh.uvs.is_empty() {
+            let view = self.add_view(&floats(&mut mesh.uvs.iter().flatten().copied()));
+            let uvs = self.add_accessor(format!(
+                r#"{{"bufferView":{view},"componentType":5126,"count":{},"type":"VEC2"}}"#,
+                mesh.uvs.len()
+            ));
+            write!(attributes, r#","TEXCOORD_0":{uvs}"#).unwrap();
+        }
+        let indices: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+        let view = self.add_view(&indices);
+        let indices = self.add_accessor(format!(
+            r#"{{"bufferView":{view},"componentType":5125,"count":{},"type":"SCALAR"}}"#,
+            mesh.indices.len()
+        ));
+        let material = mesh
+            .material
+            .map(|m| format!(r#","material":{m}"#))
+            .unwrap_or_default();
+        format!(
+            r#"{{"primitives":[{{"attributes":{{{attributes}}},"indices":{indices}{material}}}]}}"#
+        )
+    }
+}
+
+/// The smallest and largest coordinates of `positions`.
+fn bounds(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+    positions
+        .iter()
+        .fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
+                [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
+            )
+        })
+}
+
+/// A material's JSON: metallic-roughness, with its base colour texture if any.
+fn material_json(m: &MaterialSpec) -> String {
+    let texture = m
+        .texture
+        .map(|t| format!(r#","baseColorTexture":{{"index":{t}}}"#))
+        .unwrap_or_default();
+    format!(
+        r#"{{"name":"{}","pbrMetallicRoughness":{{"baseColorFactor":{:?},"metallicFactor":{:?},"roughnessFactor":{:?}{texture}}},"alphaMode":"{}","alphaCutoff":{:?},"doubleSided":{}}}"#,
+        m.name, m.base_color, m.metallic, m.roughness, m.alpha_mode, m.alpha_cutoff, m.double_sided
+    )
+}
+
+/// A node's JSON: its mesh if any, its transform and its children.
+fn node_json(n: &NodeSpec) -> String {
+    let mesh = n
+        .mesh
+        .map(|m| format!(r#""mesh":{m},"#))
+        .unwrap_or_default();
+    let children = if n.children.is_empty() {
+        String::new()
+    } else {
+        format!(r#","children":{:?}"#, n.children)
+    };
+    format!(
+        r#"{{{mesh}"translation":{:?},"rotation":{:?},"scale":{:?}{children}}}"#,
+        n.translation, n.rotation, n.scale
+    )
 }
 
 /// Standard base64 with padding.

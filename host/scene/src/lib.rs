@@ -298,177 +298,27 @@ impl Scene {
         path: &Path,
         base: &Path,
     ) -> Result<Scene, SceneError> {
-        let invalid = |field: String, message: &str| SceneError::Invalid {
-            path: path.to_path_buf(),
-            field,
-            message: message.to_string(),
-        };
-        let camera = build_camera(&desc.camera).map_err(|(f, m)| invalid(f, m))?;
-        check_vec(desc.ambient, "ambient").map_err(|(f, m)| invalid(f, m))?;
-
-        if desc.lights.is_empty() {
-            return Err(invalid("lights".into(), "a scene needs at least one light"));
-        }
-        if desc.lights.len() > MAX_LIGHTS {
-            return Err(invalid(
-                "lights".into(),
-                &format!(
-                    "{} lights given, at most {MAX_LIGHTS} are supported",
-                    desc.lights.len()
-                ),
-            ));
-        }
-        let lights = desc
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(i, l)| build_light(l, &format!("lights[{i}]")))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|(f, m)| invalid(f, &m))?;
-
-        if desc.objects.is_empty() {
-            return Err(invalid(
-                "objects".into(),
-                "a scene needs at least one object",
-            ));
-        }
-        let mut mesh = MeshData::default();
-        let mut objects = Vec::with_capacity(desc.objects.len());
-        let mut receivers = Vec::new();
-        let mut textures = TextureRequests::default();
-        let mut warnings = Vec::new();
-        for (i, object) in desc.objects.iter().enumerate() {
-            let field = format!("objects[{i}]");
-            let (parts, report, file_warnings) = build_mesh(&object.mesh, &field, path, base)?;
-            warnings.extend(
-                file_warnings
-                    .into_iter()
-                    .map(|w| format!("{}: {field}.mesh: {w}", path.display())),
-            );
-            let t = &object.transform;
-            check_transform(t, &format!("{field}.transform")).map_err(|(f, m)| invalid(f, m))?;
-            check_material(object, &field).map_err(|(f, m)| invalid(f, m))?;
-            let placements =
-                instance_placements(object, &field).map_err(|(f, m)| invalid(f, &m))?;
-            let transform = t.matrix();
-            if object.receiver && !object.instances.is_empty() {
-                return Err(invalid(
-                    format!("{field}.instances"),
-                    "receiver planes cannot be instanced",
-                ));
-            }
-            if object.receiver {
-                let MeshDesc::Plane { size, .. } = object.mesh else {
-                    return Err(invalid(
-                        format!("{field}.receiver"),
-                        "only Plane meshes can be receiver planes",
-                    ));
-                };
-                receivers.push(receiver_plane(objects.len(), transform, size));
-            }
-            if report.degenerate_removed > 0 {
-                log::warn!(
-                    "{}: {field}: removed {} degenerate triangles",
-                    path.display(),
-                    report.degenerate_removed
-                );
-            }
-            let name = if object.name.is_empty() {
-                format!("object {i}")
-            } else {
-                object.name.clone()
-            };
-            let own = ObjectMaterial::of(object, base, &mut textures);
-            let folder = mesh_folder(&object.mesh, base);
-            let several = parts.len() > 1;
-            // Part-major order: an instanced part's objects are consecutive, so a pass draws
-            // them in one call.
-            for (local, file_material) in parts {
-                let start = mesh.indices.len();
-                mesh.append(&local.transformed(transform));
-                let material = match file_material {
-                    Some(m) if object.file_materials => {
-                        ObjectMaterial::from_file(&m, &own, &folder, &mut textures)
-                    }
-                    _ => own.clone(),
-                };
-                for (instance, &placement) in placements.iter().enumerate() {
-                    let part = match (several, &material.name) {
-                        (true, Some(part)) => format!("/{part}"),
-                        _ => String::new(),
-                    };
-                    let instance = (!object.instances.is_empty()).then_some(instance);
-                    objects.push(SceneObject {
-                        name: match instance {
-                            Some(k) => format!("{name}[{k}]{part}"),
-                            None => format!("{name}{part}"),
-                        },
-                        transform: placement * transform,
-                        placement,
-                        instance,
-                        bounds: placed_bounds(&mesh, start..mesh.indices.len(), placement),
-                        indices: start..mesh.indices.len(),
-                        color: material.color,
-                        specular: material.specular,
-                        shininess: material.shininess,
-                        casts_shadows: object.casts_shadows,
-                        opacity: material.opacity,
-                        transmission: object.transmission,
-                        albedo_texture: material.albedo_texture,
-                        alpha_mask: material.alpha_mask,
-                        double_sided: material.double_sided,
-                        report,
-                    });
-                }
-            }
-        }
-        if objects.len() > MAX_OBJECTS {
-            return Err(invalid(
-                "objects".into(),
-                &format!(
-                    "{} objects with instances and model parts, at most {MAX_OBJECTS} are supported",
-                    objects.len()
-                ),
-            ));
-        }
-        // Triangles drawn are numbered in 32 bits on the GPU, the largest number meaning none.
-        let drawn: usize = objects.iter().map(|o| o.indices.len() / 3).sum();
-        if drawn >= u32::MAX as usize {
-            return Err(invalid(
-                "objects".into(),
-                &format!(
-                    "{drawn} triangles drawn (instances counted), at most {} are supported",
-                    u32::MAX - 1
-                ),
-            ));
-        }
-        if textures.len() > material::MAX_TEXTURE_LAYERS {
-            return Err(invalid(
-                "objects".into(),
-                &format!(
-                    "{} distinct textures and masks, at most {} are supported",
-                    textures.len(),
-                    material::MAX_TEXTURE_LAYERS
-                ),
-            ));
-        }
+        let camera = build_camera(&desc.camera).map_err(|(f, m)| invalid(path, f, m))?;
+        check_vec(desc.ambient, "ambient").map_err(|(f, m)| invalid(path, f, m))?;
+        let lights = build_lights(&desc.lights).map_err(|(f, m)| invalid(path, f, m))?;
+        let SceneObjects {
+            mesh,
+            objects,
+            receivers,
+            textures,
+            mut warnings,
+        } = SceneObjects::build(&desc.objects, path, base)?;
         let textures = textures.load(&mut warnings);
         for warning in &warnings {
             log::warn!("{warning}");
         }
 
-        validate_paths(&desc.paths, lights.len()).map_err(|(f, m)| invalid(f, &m))?;
+        validate_paths(&desc.paths, lights.len()).map_err(|(f, m)| invalid(path, f, m))?;
 
         let ranges: Vec<_> = objects.iter().map(|o| o.indices.clone()).collect();
         let adjacency = Adjacency::build(&mesh, &ranges);
         Ok(Scene {
-            name: if desc.name.is_empty() {
-                path.file_stem()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_default()
-            } else {
-                desc.name.clone()
-            },
+            name: scene_name(desc, path),
             path: path.to_path_buf(),
             camera,
             ambient: desc.ambient,
@@ -634,6 +484,241 @@ pub fn read_description(path: &Path) -> Result<SceneDescription, SceneError> {
     parse_description(&text, path)
 }
 
+/// A [`SceneError::Invalid`]: `field` of the scene file at `path` is wrong.
+fn invalid(path: &Path, field: String, message: impl Into<String>) -> SceneError {
+    SceneError::Invalid {
+        path: path.to_path_buf(),
+        field,
+        message: message.into(),
+    }
+}
+
+/// The scene's name: the description's, else the file's stem.
+fn scene_name(desc: &SceneDescription, path: &Path) -> String {
+    if desc.name.is_empty() {
+        path.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    } else {
+        desc.name.clone()
+    }
+}
+
+/// Builds the lights, of which a scene needs at least one and at most [`MAX_LIGHTS`].
+fn build_lights(lights: &[LightDesc]) -> Result<Vec<Light>, (String, String)> {
+    if lights.is_empty() {
+        return Err(("lights".into(), "a scene needs at least one light".into()));
+    }
+    if lights.len() > MAX_LIGHTS {
+        return Err((
+            "lights".into(),
+            format!(
+                "{} lights given, at most {MAX_LIGHTS} are supported",
+                lights.len()
+            ),
+        ));
+    }
+    lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| build_light(l, &format!("lights[{i}]")))
+        .collect()
+}
+
+/// A scene's objects as they are built from its description: one [`SceneObject`] per part
+/// and instance, their triangles in one shared mesh.
+#[derive(Default)]
+struct SceneObjects {
+    mesh: MeshData,
+    objects: Vec<SceneObject>,
+    receivers: Vec<ReceiverPlane>,
+    /// The textures and masks the materials ask for, not yet loaded.
+    textures: TextureRequests,
+    warnings: Vec<String>,
+}
+
+/// What every part of one described object shares as it is placed in the scene.
+struct PlacedObject<'a> {
+    desc: &'a ObjectDesc,
+    name: String,
+    transform: Mat4,
+    /// One per instance (the identity when the object is not instanced).
+    placements: Vec<Mat4>,
+    report: MeshReport,
+}
+
+impl SceneObjects {
+    /// Validates and builds the described objects, within the limits of the GPU passes.
+    fn build(descs: &[ObjectDesc], path: &Path, base: &Path) -> Result<Self, SceneError> {
+        if descs.is_empty() {
+            return Err(invalid(
+                path,
+                "objects".into(),
+                "a scene needs at least one object",
+            ));
+        }
+        let mut built = SceneObjects {
+            objects: Vec::with_capacity(descs.len()),
+            ..SceneObjects::default()
+        };
+        for (i, desc) in descs.iter().enumerate() {
+            built.add(i, desc, path, base)?;
+        }
+        built
+            .check_limits()
+            .map_err(|m| invalid(path, "objects".into(), m))?;
+        Ok(built)
+    }
+
+    /// Adds object `i`: each part of its mesh, once per instance, and its receiver plane.
+    fn add(
+        &mut self,
+        i: usize,
+        desc: &ObjectDesc,
+        path: &Path,
+        base: &Path,
+    ) -> Result<(), SceneError> {
+        let field = format!("objects[{i}]");
+        let (parts, report, file_warnings) = build_mesh(&desc.mesh, &field, path, base)?;
+        self.warnings.extend(
+            file_warnings
+                .into_iter()
+                .map(|w| format!("{}: {field}.mesh: {w}", path.display())),
+        );
+        let placements = check_object(desc, &field).map_err(|(f, m)| invalid(path, f, m))?;
+        let transform = desc.transform.matrix();
+        if let (true, MeshDesc::Plane { size, .. }) = (desc.receiver, &desc.mesh) {
+            let object = self.objects.len();
+            self.receivers
+                .push(receiver_plane(object, transform, *size));
+        }
+        if report.degenerate_removed > 0 {
+            log::warn!(
+                "{}: {field}: removed {} degenerate triangles",
+                path.display(),
+                report.degenerate_removed
+            );
+        }
+        let placed = PlacedObject {
+            desc,
+            name: if desc.name.is_empty() {
+                format!("object {i}")
+            } else {
+                desc.name.clone()
+            },
+            transform,
+            placements,
+            report,
+        };
+        let own = ObjectMaterial::of(desc, base, &mut self.textures);
+        let folder = mesh_folder(&desc.mesh, base);
+        let several = parts.len() > 1;
+        // Part-major order: an instanced part's objects are consecutive, so a pass draws
+        // them in one call.
+        for (local, file_material) in parts {
+            let material = match file_material {
+                Some(m) if desc.file_materials => {
+                    ObjectMaterial::from_file(&m, &own, &folder, &mut self.textures)
+                }
+                _ => own.clone(),
+            };
+            let part = match (several, &material.name) {
+                (true, Some(part)) => format!("/{part}"),
+                _ => String::new(),
+            };
+            self.add_part(&placed, &local, &material, &part);
+        }
+        Ok(())
+    }
+
+    /// Appends one part's triangles to the mesh and adds one object per placement, named
+    /// after the object, the instance and (with `part` as `/<name>`) the part.
+    fn add_part(
+        &mut self,
+        placed: &PlacedObject<'_>,
+        local: &MeshData,
+        material: &ObjectMaterial,
+        part: &str,
+    ) {
+        let start = self.mesh.indices.len();
+        self.mesh.append(&local.transformed(placed.transform));
+        let indices = start..self.mesh.indices.len();
+        let name = &placed.name;
+        for (instance, &placement) in placed.placements.iter().enumerate() {
+            let instance = (!placed.desc.instances.is_empty()).then_some(instance);
+            self.objects.push(SceneObject {
+                name: match instance {
+                    Some(k) => format!("{name}[{k}]{part}"),
+                    None => format!("{name}{part}"),
+                },
+                transform: placement * placed.transform,
+                placement,
+                instance,
+                bounds: placed_bounds(&self.mesh, indices.clone(), placement),
+                indices: indices.clone(),
+                color: material.color,
+                specular: material.specular,
+                shininess: material.shininess,
+                casts_shadows: placed.desc.casts_shadows,
+                opacity: material.opacity,
+                transmission: placed.desc.transmission,
+                albedo_texture: material.albedo_texture,
+                alpha_mask: material.alpha_mask,
+                double_sided: material.double_sided,
+                report: placed.report,
+            });
+        }
+    }
+
+    /// Checks the counts the GPU passes bound: objects, triangles drawn and textures.
+    fn check_limits(&self) -> Result<(), String> {
+        if self.objects.len() > MAX_OBJECTS {
+            return Err(format!(
+                "{} objects with instances and model parts, at most {MAX_OBJECTS} are supported",
+                self.objects.len()
+            ));
+        }
+        // Triangles drawn are numbered in 32 bits on the GPU, the largest number meaning none.
+        let drawn: usize = self.objects.iter().map(|o| o.indices.len() / 3).sum();
+        if drawn >= u32::MAX as usize {
+            return Err(format!(
+                "{drawn} triangles drawn (instances counted), at most {} are supported",
+                u32::MAX - 1
+            ));
+        }
+        if self.textures.len() > material::MAX_TEXTURE_LAYERS {
+            return Err(format!(
+                "{} distinct textures and masks, at most {} are supported",
+                self.textures.len(),
+                material::MAX_TEXTURE_LAYERS
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Checks an object's transform, material, instances and receiver flag; returns its
+/// placements.
+fn check_object(object: &ObjectDesc, field: &str) -> Result<Vec<Mat4>, (String, String)> {
+    let lift = |(f, m): FieldError| (f, m.to_string());
+    check_transform(&object.transform, &format!("{field}.transform")).map_err(lift)?;
+    check_material(object, field).map_err(lift)?;
+    let placements = instance_placements(object, field)?;
+    if object.receiver && !object.instances.is_empty() {
+        return Err((
+            format!("{field}.instances"),
+            "receiver planes cannot be instanced".into(),
+        ));
+    }
+    if object.receiver && !matches!(object.mesh, MeshDesc::Plane { .. }) {
+        return Err((
+            format!("{field}.receiver"),
+            "only Plane meshes can be receiver planes".into(),
+        ));
+    }
+    Ok(placements)
+}
+
 /// Bounds of the vertices of `indices` placed by `placement`.
 fn placed_bounds(mesh: &MeshData, indices: Range<usize>, placement: Mat4) -> Option<(Vec3, Vec3)> {
     let points: Vec<Vec3> = (mesh.indices[indices].iter())
@@ -749,31 +834,10 @@ fn build_camera(c: &CameraDesc) -> Result<Camera, FieldError> {
     })
 }
 
+/// Validates and builds one light; `field` (`lights[i]`) names it in errors.
 fn build_light(desc: &LightDesc, field: &str) -> Result<Light, (String, String)> {
-    let err = |sub: &str, message: &str| (format!("{field}.{sub}"), message.to_string());
+    let err = |sub: &str, message: &str| light_error(field, sub, message);
     let lift = |r: Result<(), FieldError>| r.map_err(|(f, m)| (f, m.to_string()));
-    let direction = |d: Vec3| -> Result<Vec3, (String, String)> {
-        lift(check_vec(d, &format!("{field}.direction")))?;
-        d.try_normalize()
-            .ok_or_else(|| err("direction", "must not be zero"))
-    };
-    let color = |c: Vec3, intensity: f32| -> Result<Vec3, (String, String)> {
-        lift(check_vec(c, &format!("{field}.color")))?;
-        if c.min_element() < 0.0 {
-            return Err(err("color", "components must not be negative"));
-        }
-        if !(intensity.is_finite() && intensity >= 0.0) {
-            return Err(err("intensity", "must be a finite number >= 0"));
-        }
-        Ok(c * intensity)
-    };
-    let radius = |r: f32| {
-        if r.is_finite() && r >= 0.0 {
-            Ok(r)
-        } else {
-            Err(err("radius", "must be a finite number >= 0"))
-        }
-    };
     Ok(match *desc {
         LightDesc::Directional {
             direction: d,
@@ -787,8 +851,8 @@ fn build_light(desc: &LightDesc, field: &str) -> Result<Light, (String, String)>
             Light {
                 kind: LightKind::Directional,
                 position: Vec3::ZERO,
-                direction: direction(d)?,
-                radiance: color(c, intensity)?,
+                direction: light_direction(d, field)?,
+                radiance: light_radiance(c, intensity, field)?,
                 range: f32::INFINITY,
                 spot_angle: 0.0,
                 spot_softness: 0.0,
@@ -808,11 +872,11 @@ fn build_light(desc: &LightDesc, field: &str) -> Result<Light, (String, String)>
                 kind: LightKind::Point,
                 position,
                 direction: Vec3::NEG_Y,
-                radiance: color(c, intensity)?,
+                radiance: light_radiance(c, intensity, field)?,
                 range,
                 spot_angle: 0.0,
                 spot_softness: 0.0,
-                radius: radius(r)?,
+                radius: light_radius(r, field)?,
             }
         }
         LightDesc::Spot {
@@ -836,15 +900,56 @@ fn build_light(desc: &LightDesc, field: &str) -> Result<Light, (String, String)>
             Light {
                 kind: LightKind::Spot,
                 position,
-                direction: direction(d)?,
-                radiance: color(c, intensity)?,
+                direction: light_direction(d, field)?,
+                radiance: light_radiance(c, intensity, field)?,
                 range,
                 spot_angle: angle_degrees.to_radians(),
                 spot_softness: softness,
-                radius: radius(r)?,
+                radius: light_radius(r, field)?,
             }
         }
     })
+}
+
+/// A light's error: `field.sub` is wrong.
+fn light_error(field: &str, sub: &str, message: &str) -> (String, String) {
+    (format!("{field}.{sub}"), message.to_string())
+}
+
+/// A light's direction, normalized.
+fn light_direction(d: Vec3, field: &str) -> Result<Vec3, (String, String)> {
+    check_vec(d, &format!("{field}.direction")).map_err(|(f, m)| (f, m.to_string()))?;
+    d.try_normalize()
+        .ok_or_else(|| light_error(field, "direction", "must not be zero"))
+}
+
+/// A light's radiance: its colour scaled by its intensity.
+fn light_radiance(c: Vec3, intensity: f32, field: &str) -> Result<Vec3, (String, String)> {
+    check_vec(c, &format!("{field}.color")).map_err(|(f, m)| (f, m.to_string()))?;
+    if c.min_element() < 0.0 {
+        return Err(light_error(
+            field,
+            "color",
+            "components must not be negative",
+        ));
+    }
+    if !(intensity.is_finite() && intensity >= 0.0) {
+        return Err(light_error(
+            field,
+            "intensity",
+            "must be a finite number >= 0",
+        ));
+    }
+    Ok(c * intensity)
+}
+
+/// A point or spot light's radius.
+fn light_radius(r: f32, field: &str) -> Result<f32, (String, String)> {
+    if r.is_finite() && r >= 0.0 {
+        Ok(r)
+    } else {
+        Err(light_error(field, "radius", "must be a finite number >= 0"))
+    }
 }
 
 /// A mesh's parts (each with its file material, if any), what loading changed, and warnings.
@@ -854,59 +959,76 @@ type BuiltMesh = (
     Vec<String>,
 );
 
+/// Builds an object's mesh: the parts of an OBJ or glTF file, or one generated shape.
 fn build_mesh(
     desc: &MeshDesc,
     field: &str,
     path: &Path,
     base: &Path,
 ) -> Result<BuiltMesh, SceneError> {
-    let invalid = |message: &str| SceneError::Invalid {
+    match desc {
+        MeshDesc::Obj(file) => load_obj_mesh(&base.join(file), field, path),
+        MeshDesc::Gltf(file) => load_gltf_mesh(&base.join(file), field, path),
+        shape => {
+            let mesh = shape_mesh(shape).map_err(|message| SceneError::Invalid {
+                path: path.to_path_buf(),
+                field: format!("{field}.mesh"),
+                message: message.to_string(),
+            })?;
+            Ok((vec![(mesh, None)], MeshReport::default(), Vec::new()))
+        }
+    }
+}
+
+/// Loads the OBJ file `obj`, each part with its MTL material.
+fn load_obj_mesh(obj: &Path, field: &str, path: &Path) -> Result<BuiltMesh, SceneError> {
+    let loaded = mesh::load_obj(obj).map_err(|e| SceneError::Obj {
         path: path.to_path_buf(),
         field: format!("{field}.mesh"),
-        message: message.to_string(),
-    };
+        obj: obj.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let parts = loaded
+        .parts
+        .into_iter()
+        .map(|p| (p.mesh, p.material.map(|m| FileMaterial::Mtl(Box::new(m)))))
+        .collect();
+    Ok((parts, loaded.report, loaded.warnings))
+}
+
+/// Loads the glTF file `gltf`, each part with its material.
+fn load_gltf_mesh(gltf: &Path, field: &str, path: &Path) -> Result<BuiltMesh, SceneError> {
+    let loaded = gltf_file::load_gltf(gltf).map_err(|e| SceneError::Gltf {
+        path: path.to_path_buf(),
+        field: format!("{field}.mesh"),
+        file: gltf.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let parts = loaded
+        .parts
+        .into_iter()
+        .map(|p| (p.mesh, Some(FileMaterial::Gltf(p.material))))
+        .collect();
+    Ok((parts, loaded.report, loaded.warnings))
+}
+
+/// Generates a shape's mesh; the error says which of its sizes or counts is out of range.
+fn shape_mesh(desc: &MeshDesc) -> Result<MeshData, &'static str> {
     let positive = |values: &[f32]| values.iter().all(|v| v.is_finite() && *v > 0.0);
     let count_ok = |n: u32| (3..=4096).contains(&n);
-    let mesh = match *desc {
-        MeshDesc::Obj(ref file) => {
-            let obj = base.join(file);
-            let loaded = mesh::load_obj(&obj).map_err(|e| SceneError::Obj {
-                path: path.to_path_buf(),
-                field: format!("{field}.mesh"),
-                obj,
-                message: e.to_string(),
-            })?;
-            let parts = loaded
-                .parts
-                .into_iter()
-                .map(|p| (p.mesh, p.material.map(|m| FileMaterial::Mtl(Box::new(m)))))
-                .collect();
-            return Ok((parts, loaded.report, loaded.warnings));
-        }
-        MeshDesc::Gltf(ref file) => {
-            let gltf = base.join(file);
-            let loaded = gltf_file::load_gltf(&gltf).map_err(|e| SceneError::Gltf {
-                path: path.to_path_buf(),
-                field: format!("{field}.mesh"),
-                file: gltf,
-                message: e.to_string(),
-            })?;
-            let parts = loaded
-                .parts
-                .into_iter()
-                .map(|p| (p.mesh, Some(FileMaterial::Gltf(p.material))))
-                .collect();
-            return Ok((parts, loaded.report, loaded.warnings));
+    Ok(match *desc {
+        MeshDesc::Obj(_) | MeshDesc::Gltf(_) => {
+            unreachable!("model files are loaded, not generated")
         }
         MeshDesc::Plane { size, subdivisions } => {
             if !positive(&[size]) || !(1..=1024).contains(&subdivisions) {
-                return Err(invalid("Plane needs size > 0 and 1..=1024 subdivisions"));
+                return Err("Plane needs size > 0 and 1..=1024 subdivisions");
             }
             mesh::plane(size, subdivisions)
         }
         MeshDesc::Box { size } => {
             if !positive(&size.to_array()) {
-                return Err(invalid("Box sizes must be finite and > 0"));
+                return Err("Box sizes must be finite and > 0");
             }
             mesh::cuboid(size)
         }
@@ -916,9 +1038,7 @@ fn build_mesh(
             rings,
         } => {
             if !positive(&[radius]) || !count_ok(segments) || !count_ok(rings) {
-                return Err(invalid(
-                    "Sphere needs radius > 0 and 3..=4096 segments and rings",
-                ));
+                return Err("Sphere needs radius > 0 and 3..=4096 segments and rings");
             }
             mesh::sphere(radius, segments, rings)
         }
@@ -928,9 +1048,7 @@ fn build_mesh(
             segments,
         } => {
             if !positive(&[radius, height]) || !count_ok(segments) {
-                return Err(invalid(
-                    "Cylinder needs radius, height > 0 and 3..=4096 segments",
-                ));
+                return Err("Cylinder needs radius, height > 0 and 3..=4096 segments");
             }
             mesh::cylinder(radius, height, segments)
         }
@@ -941,9 +1059,7 @@ fn build_mesh(
             rings,
         } => {
             if !positive(&[major_radius, minor_radius]) || !count_ok(segments) || !count_ok(rings) {
-                return Err(invalid(
-                    "Torus needs radii > 0 and 3..=4096 segments and rings",
-                ));
+                return Err("Torus needs radii > 0 and 3..=4096 segments and rings");
             }
             mesh::torus(major_radius, minor_radius, segments, rings)
         }
@@ -953,14 +1069,11 @@ fn build_mesh(
             segments,
         } => {
             if !positive(&[radius, height]) || !count_ok(segments) {
-                return Err(invalid(
-                    "Cone needs radius, height > 0 and 3..=4096 segments",
-                ));
+                return Err("Cone needs radius, height > 0 and 3..=4096 segments");
             }
             mesh::cone(radius, height, segments)
         }
-    };
-    Ok((vec![(mesh, None)], MeshReport::default(), Vec::new()))
+    })
 }
 
 fn receiver_plane(object: usize, transform: Mat4, size: f32) -> ReceiverPlane {

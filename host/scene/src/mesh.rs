@@ -378,6 +378,46 @@ pub fn load_obj(path: &Path) -> Result<ObjFile, ObjError> {
 /// left out silently). See [`load_obj`].
 pub fn parse_obj(text: &str, library_folder: Option<&Path>) -> Result<ObjFile, ObjError> {
     let polygons_triangulated = prevalidate_obj(text)?;
+    let (models, materials, warnings) = read_obj(text, library_folder)?;
+    let mut parts: Vec<ObjPart> = Vec::new();
+    let mut last_material = None;
+    let mut report = MeshReport {
+        polygons_triangulated,
+        ..MeshReport::default()
+    };
+    for model in &models {
+        let mesh = model_mesh(&model.mesh, &mut report);
+        if mesh.indices.is_empty() {
+            continue;
+        }
+        let id = model.mesh.material_id.filter(|&id| id < materials.len());
+        // Consecutive models of one material (objects and groups) make one part.
+        match parts.last_mut() {
+            Some(last) if last_material == Some(id) => last.mesh.append(&mesh),
+            _ => parts.push(ObjPart {
+                mesh,
+                material: id.map(|id| materials[id].clone()),
+            }),
+        }
+        last_material = Some(id);
+    }
+    if parts.is_empty() {
+        return Err(ObjError::Empty);
+    }
+    Ok(ObjFile {
+        parts,
+        report,
+        warnings,
+    })
+}
+
+/// OBJ text as tobj reads it: its models, its libraries' materials and the warnings about
+/// the libraries left out.
+type ReadObj = (Vec<tobj::Model>, Vec<tobj::Material>, Vec<String>);
+
+/// Reads OBJ text with its material libraries (from `library_folder`; a library that cannot
+/// be read is left out with a warning): its models, materials and warnings.
+fn read_obj(text: &str, library_folder: Option<&Path>) -> Result<ReadObj, ObjError> {
     let mut reader = std::io::Cursor::new(text.as_bytes());
     let warnings = std::cell::RefCell::new(Vec::new());
     let (models, materials) = tobj::load_obj_buf(&mut reader, &tobj::GPU_LOAD_OPTIONS, |library| {
@@ -397,75 +437,50 @@ pub fn parse_obj(text: &str, library_folder: Option<&Path>) -> Result<ObjFile, O
         })
     })
     .map_err(|e| ObjError::Load(e.to_string()))?;
-    let materials = materials.unwrap_or_default();
+    Ok((models, materials.unwrap_or_default(), warnings.into_inner()))
+}
 
-    let mut parts: Vec<ObjPart> = Vec::new();
-    let mut last_material = None;
-    let mut report = MeshReport {
-        polygons_triangulated,
-        ..MeshReport::default()
+/// One model's mesh, with its normals (computed when the file's are missing or unusable)
+/// and without degenerate triangles; `report` counts what was changed.
+fn model_mesh(m: &tobj::Mesh, report: &mut MeshReport) -> MeshData {
+    let positions: Vec<Vec3> = m
+        .positions
+        .chunks_exact(3)
+        .map(|p| Vec3::new(p[0], p[1], p[2]))
+        .collect();
+    // OBJ puts v = 0 at the image's bottom row.
+    let uvs = if m.texcoords.len() / 2 == positions.len() {
+        m.texcoords
+            .chunks_exact(2)
+            .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+            .map(|t| if t.is_finite() { t } else { Vec2::ZERO })
+            .collect()
+    } else {
+        vec![Vec2::ZERO; positions.len()]
     };
-    for model in &models {
-        let m = &model.mesh;
-        let positions: Vec<Vec3> = m
-            .positions
+    let mut mesh = MeshData {
+        normals: Vec::new(),
+        indices: m.indices.clone(),
+        positions,
+        uvs,
+    };
+    let usable_normals = m.normals.len() == m.positions.len()
+        && m.normals.chunks_exact(3).all(|n| {
+            let n = Vec3::new(n[0], n[1], n[2]);
+            n.is_finite() && n.length_squared() > 1e-12
+        });
+    if usable_normals {
+        mesh.normals = m
+            .normals
             .chunks_exact(3)
-            .map(|p| Vec3::new(p[0], p[1], p[2]))
+            .map(|n| Vec3::new(n[0], n[1], n[2]).normalize())
             .collect();
-        // OBJ puts v = 0 at the image's bottom row.
-        let uvs = if m.texcoords.len() / 2 == positions.len() {
-            m.texcoords
-                .chunks_exact(2)
-                .map(|t| Vec2::new(t[0], 1.0 - t[1]))
-                .map(|t| if t.is_finite() { t } else { Vec2::ZERO })
-                .collect()
-        } else {
-            vec![Vec2::ZERO; positions.len()]
-        };
-        let mut mesh = MeshData {
-            normals: Vec::new(),
-            indices: m.indices.clone(),
-            positions,
-            uvs,
-        };
-        let usable_normals = m.normals.len() == m.positions.len()
-            && m.normals.chunks_exact(3).all(|n| {
-                let n = Vec3::new(n[0], n[1], n[2]);
-                n.is_finite() && n.length_squared() > 1e-12
-            });
-        if usable_normals {
-            mesh.normals = m
-                .normals
-                .chunks_exact(3)
-                .map(|n| Vec3::new(n[0], n[1], n[2]).normalize())
-                .collect();
-        } else {
-            mesh.compute_smooth_normals();
-            report.normals_computed = true;
-        }
-        report.degenerate_removed += mesh.remove_degenerate();
-        if mesh.indices.is_empty() {
-            continue;
-        }
-        let id = m.material_id.filter(|&id| id < materials.len());
-        // Consecutive models of one material (objects and groups) make one part.
-        match parts.last_mut() {
-            Some(last) if last_material == Some(id) => last.mesh.append(&mesh),
-            _ => parts.push(ObjPart {
-                mesh,
-                material: id.map(|id| materials[id].clone()),
-            }),
-        }
-        last_material = Some(id);
+    } else {
+        mesh.compute_smooth_normals();
+        report.normals_computed = true;
     }
-    if parts.is_empty() {
-        return Err(ObjError::Empty);
-    }
-    Ok(ObjFile {
-        parts,
-        report,
-        warnings: warnings.into_inner(),
-    })
+    report.degenerate_removed += mesh.remove_degenerate();
+    mesh
 }
 
 /// Checks the colour statements of an MTL library, which its parser requires to hold three
@@ -494,104 +509,35 @@ fn prevalidate_obj(text: &str) -> Result<usize, ObjError> {
     let mut normal_count = 0i64;
     let mut polygons = 0;
     for (line_index, line) in text.lines().enumerate() {
-        let line_no = line_index + 1;
+        let syntax = |(col, message): LineError| ObjError::Syntax {
+            line: line_index + 1,
+            col,
+            message,
+        };
         let mut words = line.split_whitespace();
         let Some(keyword) = words.next() else {
             continue;
         };
-        let column_of = |word: &str| word.as_ptr() as usize - line.as_ptr() as usize + 1;
         match keyword {
             "v" => {
-                let all: Vec<&str> = words.collect();
-                // x y z, then an optional w that divides them (or r g b, which do not).
-                if let [x, y, z, w] = all[..] {
-                    let scaled = [x, y, z].map(|c| {
-                        let (c, w) = (c.parse::<f32>(), w.parse::<f32>());
-                        c.ok().zip(w.ok()).map(|(c, w)| c / w)
-                    });
-                    if !scaled.iter().all(|c| c.is_some_and(f32::is_finite)) {
-                        return Err(ObjError::Syntax {
-                            line: line_no,
-                            col: column_of(w),
-                            message: format!("vertex weight `{w}` gives non-finite coordinates"),
-                        });
-                    }
-                }
-                let coords: Vec<&str> = all.into_iter().take(3).collect();
-                if coords.len() < 3 {
-                    return Err(ObjError::Syntax {
-                        line: line_no,
-                        col: line.len() + 1,
-                        message: "vertex needs three coordinates".into(),
-                    });
-                }
-                for word in coords {
-                    match word.parse::<f32>() {
-                        Ok(v) if v.is_finite() => {}
-                        Ok(_) => {
-                            return Err(ObjError::Syntax {
-                                line: line_no,
-                                col: column_of(word),
-                                message: format!("vertex coordinate `{word}` is not finite"),
-                            });
-                        }
-                        Err(_) => {
-                            return Err(ObjError::Syntax {
-                                line: line_no,
-                                col: column_of(word),
-                                message: format!("`{word}` is not a number"),
-                            });
-                        }
-                    }
-                }
+                check_vertex(line, &words.collect::<Vec<_>>()).map_err(syntax)?;
                 vertex_count += 1;
             }
             // Faces and polylines: tobj reads both with the same index rules.
             "f" | "l" => {
                 let corners: Vec<&str> = words.collect();
                 if keyword == "f" && corners.len() < 3 {
-                    return Err(ObjError::Syntax {
-                        line: line_no,
-                        col: line.len() + 1,
-                        message: "face needs at least three vertices".into(),
-                    });
+                    return Err(syntax((
+                        line.len() + 1,
+                        "face needs at least three vertices".into(),
+                    )));
                 }
                 if keyword == "f" && corners.len() > 3 {
                     polygons += 1;
                 }
                 for corner in corners {
-                    // `v`, `v/vt`, `v//vn` or `v/vt/vn`; each index counts from 1, or back
-                    // from the last one defined when negative.
-                    let mut fields = corner.split('/');
-                    for (kind, defined) in [
-                        ("vertex", vertex_count),
-                        ("texture coordinate", texcoord_count),
-                        ("normal", normal_count),
-                    ] {
-                        let text = fields.next().unwrap_or("");
-                        if text.is_empty() && kind != "vertex" {
-                            continue;
-                        }
-                        let index: i64 = text.parse().map_err(|_| ObjError::Syntax {
-                            line: line_no,
-                            col: column_of(corner),
-                            message: format!("`{corner}` is not a {kind} index"),
-                        })?;
-                        let resolved = if index < 0 {
-                            defined.saturating_add(index).saturating_add(1)
-                        } else {
-                            index
-                        };
-                        if resolved < 1 || resolved > defined {
-                            return Err(ObjError::Syntax {
-                                line: line_no,
-                                col: column_of(corner),
-                                message: format!(
-                                    "{kind} index {index} is out of range (1..={defined} defined so far)"
-                                ),
-                            });
-                        }
-                    }
+                    check_corner(corner, [vertex_count, texcoord_count, normal_count])
+                        .map_err(|message| syntax((column_of(line, corner), message)))?;
                 }
             }
             "vt" => texcoord_count += 1,
@@ -600,6 +546,80 @@ fn prevalidate_obj(text: &str) -> Result<usize, ObjError> {
         }
     }
     Ok(polygons)
+}
+
+/// An error on one line of an OBJ file: its column (from 1) and message.
+type LineError = (usize, String);
+
+/// The column (from 1) of `word`, a slice of `line`.
+fn column_of(line: &str, word: &str) -> usize {
+    word.as_ptr() as usize - line.as_ptr() as usize + 1
+}
+
+/// Checks a `v` line's words (after the keyword): three finite coordinates, and an optional
+/// weight that keeps them finite when it divides them.
+fn check_vertex(line: &str, words: &[&str]) -> Result<(), LineError> {
+    // x y z, then an optional w that divides them (or r g b, which do not).
+    if let [x, y, z, w] = words[..] {
+        let scaled = [x, y, z].map(|c| {
+            let (c, w) = (c.parse::<f32>(), w.parse::<f32>());
+            c.ok().zip(w.ok()).map(|(c, w)| c / w)
+        });
+        if !scaled.iter().all(|c| c.is_some_and(f32::is_finite)) {
+            return Err((
+                column_of(line, w),
+                format!("vertex weight `{w}` gives non-finite coordinates"),
+            ));
+        }
+    }
+    if words.len() < 3 {
+        return Err((line.len() + 1, "vertex needs three coordinates".into()));
+    }
+    for &word in &words[..3] {
+        match word.parse::<f32>() {
+            Ok(v) if v.is_finite() => {}
+            Ok(_) => {
+                return Err((
+                    column_of(line, word),
+                    format!("vertex coordinate `{word}` is not finite"),
+                ));
+            }
+            Err(_) => {
+                return Err((column_of(line, word), format!("`{word}` is not a number")));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks one corner of a face or polyline against the vertices, texture coordinates and
+/// normals `defined` so far: `v`, `v/vt`, `v//vn` or `v/vt/vn`, each index counting from 1,
+/// or back from the last one defined when negative.
+fn check_corner(corner: &str, defined: [i64; 3]) -> Result<(), String> {
+    let mut fields = corner.split('/');
+    for (kind, defined) in ["vertex", "texture coordinate", "normal"]
+        .into_iter()
+        .zip(defined)
+    {
+        let text = fields.next().unwrap_or("");
+        if text.is_empty() && kind != "vertex" {
+            continue;
+        }
+        let index: i64 = text
+            .parse()
+            .map_err(|_| format!("`{corner}` is not a {kind} index"))?;
+        let resolved = if index < 0 {
+            defined.saturating_add(index).saturating_add(1)
+        } else {
+            index
+        };
+        if resolved < 1 || resolved > defined {
+            return Err(format!(
+                "{kind} index {index} is out of range (1..={defined} defined so far)"
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

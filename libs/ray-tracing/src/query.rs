@@ -179,6 +179,10 @@ fn rows(transform: Mat4) -> [f32; 12] {
     [a, b, c].concat().try_into().expect("twelve numbers")
 }
 
+/// A top-level instance: its bottom level (`None`: no casters of its kind, so no instance),
+/// its row-major 3x4 transform, its custom data and its mask.
+type Level = (Option<wgpu::Blas>, [f32; 12], u32, u8);
+
 /// Builds the acceleration structure of `ctx`'s scene (submitted to the queue) and its bind
 /// group, with its size (without the time). Casters drawn once are two instances (blocking,
 /// translucent) at the identity; each unmasked mesh instances share is one bottom level,
@@ -189,37 +193,12 @@ pub(crate) fn upload(
     layout: &wgpu::BindGroupLayout,
 ) -> TechniqueResult<(wgpu::BindGroup, BuildStats)> {
     let casters = Casters::of(ctx.scene);
-    let of_kind = |keep: &dyn Fn(&CasterTriangle) -> bool| -> Vec<&CasterTriangle> {
-        casters.triangles.iter().filter(|c| keep(c)).collect()
-    };
-    let opaque = of_kind(&|c| c.translucent.is_none() && c.mask.is_none());
-    // Masked instances are placed into world space here: their alpha tests would need the
-    // candidate hit's instance data, and reading it in a closest-hit query crashes lavapipe
-    // 25.0.7's shader compiler.
-    let is_masked = |mesh: &SharedMesh| mesh.triangles.iter().any(|t| t.mask.is_some());
-    let placed_masked: Vec<CasterTriangle> = (casters.instances.iter())
-        .filter(|i| is_masked(&casters.meshes[i.mesh]))
-        .flat_map(|i| {
-            (casters.meshes[i.mesh].triangles.iter()).map(|t| CasterTriangle {
-                corners: t.corners.map(|p| i.to_world.transform_point3(p)),
-                mask: t.mask,
-                uv: t.uv,
-                translucent: None,
-            })
-        })
-        .collect();
-    let mut masked = of_kind(&|c| c.mask.is_some());
+    let opaque = of_kind(&casters, |c| c.translucent.is_none() && c.mask.is_none());
+    let placed_masked = placed_masked_triangles(&casters);
+    let mut masked = of_kind(&casters, |c| c.mask.is_some());
     masked.extend(&placed_masked);
     let records = masked_records(&masked);
-    // One geometry per translucent object with triangles: its geometry index is its record's.
-    let (translucent, mut transmittance): (Vec<Geometry>, Vec<Vec3>) =
-        (casters.transmittance.iter().enumerate())
-            .map(|(object, colour)| {
-                let triangles = of_kind(&|c| c.translucent == Some(object as u32));
-                (Geometry::of(&triangles, false), *colour)
-            })
-            .filter(|(geometry, _)| !geometry.corners.is_empty())
-            .unzip();
+    let (translucent, mut transmittance) = translucent_geometries(&casters);
 
     let device = &ctx.gpu.device;
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -250,8 +229,79 @@ pub(crate) fn upload(
             TRANSLUCENT_MASK,
         ),
     ];
-    // Each shared mesh's bottom level, and where its masked records start.
-    // Each other shared mesh's bottom level (opaque, or one translucent geometry).
+    levels.extend(shared_mesh_levels(
+        device,
+        &casters,
+        &mut transmittance,
+        &mut encoder,
+    ));
+    if transmittance.len() >= 1 << 24 {
+        return Err(TechniqueError::Other(format!(
+            "{} translucent objects: ray queries index at most 2^24",
+            transmittance.len()
+        )));
+    }
+    let tlas = top_level(device, &levels, &mut encoder);
+    ctx.gpu.queue.submit([encoder.finish()]);
+
+    let bind_group = query_bind_group(ctx, layout, &tlas, &records, &transmittance);
+    let stats = BuildStats {
+        tracer: Tracer::RayQuery,
+        triangles: casters.traced_count(),
+        hierarchy: None,
+        milliseconds: 0.0,
+    };
+    Ok((bind_group, stats))
+}
+
+/// The casters drawn once (in world space) that `keep` keeps.
+fn of_kind(casters: &Casters, keep: impl Fn(&CasterTriangle) -> bool) -> Vec<&CasterTriangle> {
+    casters.triangles.iter().filter(|c| keep(c)).collect()
+}
+
+/// Whether any of a shared mesh's triangles has an alpha mask.
+fn is_masked(mesh: &SharedMesh) -> bool {
+    mesh.triangles.iter().any(|t| t.mask.is_some())
+}
+
+/// Every instance of the masked shared meshes, placed into world space. Their alpha tests
+/// would need the candidate hit's instance data, and reading it in a closest-hit query
+/// crashes lavapipe 25.0.7's shader compiler.
+fn placed_masked_triangles(casters: &Casters) -> Vec<CasterTriangle> {
+    (casters.instances.iter())
+        .filter(|i| is_masked(&casters.meshes[i.mesh]))
+        .flat_map(|i| {
+            (casters.meshes[i.mesh].triangles.iter()).map(|t| CasterTriangle {
+                corners: t.corners.map(|p| i.to_world.transform_point3(p)),
+                mask: t.mask,
+                uv: t.uv,
+                translucent: None,
+            })
+        })
+        .collect()
+}
+
+/// One geometry per translucent object with triangles drawn once, with its transmittance:
+/// its geometry index is its record's.
+fn translucent_geometries(casters: &Casters) -> (Vec<Geometry>, Vec<Vec3>) {
+    (casters.transmittance.iter().enumerate())
+        .map(|(object, colour)| {
+            let triangles = of_kind(casters, |c| c.translucent == Some(object as u32));
+            (Geometry::of(&triangles, false), *colour)
+        })
+        .filter(|(geometry, _)| !geometry.corners.is_empty())
+        .unzip()
+}
+
+/// Each unmasked shared mesh's bottom level (opaque, or one translucent geometry), placed
+/// by each of its instances; a translucent instance's transmittance is appended to
+/// `transmittance`, its index the instance's custom data.
+fn shared_mesh_levels(
+    device: &wgpu::Device,
+    casters: &Casters,
+    transmittance: &mut Vec<Vec3>,
+    encoder: &mut wgpu::CommandEncoder,
+) -> Vec<Level> {
     let meshes: Vec<Option<wgpu::Blas>> = (casters.meshes.iter())
         .map(|mesh| {
             if is_masked(mesh) {
@@ -259,9 +309,10 @@ pub(crate) fn upload(
             }
             let triangles: Vec<&CasterTriangle> = mesh.triangles.iter().collect();
             let geometry = [Geometry::of(&triangles, !mesh.translucent)];
-            bottom_level(device, "ray tracing shared mesh", &geometry, &mut encoder)
+            bottom_level(device, "ray tracing shared mesh", &geometry, encoder)
         })
         .collect();
+    let mut levels = Vec::new();
     for instance in &casters.instances {
         let Some(blas) = &meshes[instance.mesh] else {
             continue;
@@ -275,13 +326,15 @@ pub(crate) fn upload(
         };
         levels.push((Some(blas.clone()), rows(instance.to_world), custom, mask));
     }
-    if transmittance.len() >= 1 << 24 {
-        return Err(TechniqueError::Other(format!(
-            "{} translucent objects: ray queries index at most 2^24",
-            transmittance.len()
-        )));
-    }
-    // A missing level (no casters of its kind) has no instance.
+    levels
+}
+
+/// The top level over `levels` (those with a bottom level), its build recorded in `encoder`.
+fn top_level(
+    device: &wgpu::Device,
+    levels: &[Level],
+    encoder: &mut wgpu::CommandEncoder,
+) -> wgpu::Tlas {
     let instances: Vec<wgpu::TlasInstance> = (levels.iter())
         .filter_map(|(blas, transform, custom, mask)| {
             Some(wgpu::TlasInstance::new(
@@ -302,20 +355,31 @@ pub(crate) fn upload(
         tlas[index] = Some(instance);
     }
     encoder.build_acceleration_structures([], [&tlas]);
-    ctx.gpu.queue.submit([encoder.finish()]);
+    tlas
+}
 
+/// The ray queries' bind group: the scene's top level, the masked casters' alpha tests,
+/// the material textures and the translucent objects' records.
+fn query_bind_group(
+    ctx: &RenderContext<'_>,
+    layout: &wgpu::BindGroupLayout,
+    tlas: &wgpu::Tlas,
+    masked: &[GpuMaskedTriangle],
+    transmittance: &[Vec3],
+) -> wgpu::BindGroup {
+    let device = &ctx.gpu.device;
     let masked_records = storage_buffer(
         device,
         "ray tracing masked casters' alpha tests",
-        &or_one_zeroed::<GpuMaskedTriangle>(&records),
+        &or_one_zeroed::<GpuMaskedTriangle>(masked),
     );
     let translucent_records = storage_buffer(
         device,
         "ray tracing translucent objects",
-        &gpu_bytes(&crate::translucent_records(&transmittance)),
+        &gpu_bytes(&crate::translucent_records(transmittance)),
     );
     let materials = &ctx.scene_buffers.materials;
-    let bind_group = bind_group(
+    bind_group(
         device,
         "ray tracing bind group (ray queries)",
         layout,
@@ -326,14 +390,7 @@ pub(crate) fn upload(
             wgpu::BindingResource::Sampler(&materials.sampler),
             translucent_records.as_entire_binding(),
         ],
-    );
-    let stats = BuildStats {
-        tracer: Tracer::RayQuery,
-        triangles: casters.traced_count(),
-        hierarchy: None,
-        milliseconds: 0.0,
-    };
-    Ok((bind_group, stats))
+    )
 }
 
 #[cfg(test)]

@@ -176,24 +176,10 @@ pub fn psm_frustum(
     casters: &[Aabb],
     min_near_fraction: f32,
 ) -> Option<PsmFit> {
-    let forward = (camera.target - camera.position).normalize_or(Vec3::NEG_Z);
-    let view = camera.view();
     let slice = slice_corners(camera, aspect, near, far);
     let casters = shadowing_casters(light, &receiver_box(&slice, objects), casters);
-    let nearest = casters
-        .iter()
-        .flat_map(|b| corners(*b))
-        .map(|c| -view.transform_point3(c).z)
-        .fold(near, f32::min);
-    let virtual_near = near.max(min_near_fraction * far).max(-nearest);
-    let slide = (virtual_near - nearest).max(0.0);
-    let virtual_camera = Camera {
-        position: camera.position - forward * slide,
-        target: camera.target - forward * slide,
-        near: virtual_near,
-        far: far + slide,
-        ..*camera
-    };
+    let (virtual_camera, slide) =
+        slid_back_camera(camera, (near, far), &casters, min_near_fraction);
     let post = virtual_camera.projection(aspect) * virtual_camera.view();
     let homogeneous = match light.kind {
         LightKind::Directional => (-light.direction).extend(0.0),
@@ -214,16 +200,7 @@ pub fn psm_frustum(
     // Nearly parallel to the view plane the light's post-perspective position runs off to
     // infinity (and with it the precision of a perspective fit): treat it as directional.
     if l.w.abs() < 1e-3 * scale {
-        // Directional in post-perspective space: an orthographic fit along -l.
-        let travel = -l.xyz() / scale;
-        let pp_view = look_to_mat4(Vec3::ZERO, travel, up_for(travel));
-        let (lo, hi) = bounds_in(pp_view, &receivers);
-        let near_z = blockers
-            .iter()
-            .map(|p| pp_view.transform_point3(*p).z)
-            .fold(hi.z, f32::max);
-        let box_corners = corners((lo, Vec3::new(hi.x, hi.y, near_z)));
-        let to_map = fit_to_map(Mat4::IDENTITY, &box_corners) * pp_view;
+        let to_map = parallel_fit(-l.xyz() / scale, &receivers, &blockers);
         return Some(PsmFit {
             frustum: LightFrustum::warped(world_view, to_map * post),
             slide,
@@ -232,8 +209,64 @@ pub fn psm_frustum(
         });
     }
     let inverted = l.w < 0.0;
-    let eye = l.xyz() / l.w;
-    // A cone from the light's post-perspective position around the receivers.
+    let view_proj = point_fit(l.xyz() / l.w, &receivers, &blockers, inverted)? * post;
+    if lands_on_a_sliver(view_proj, &slice) {
+        return None;
+    }
+    Some(PsmFit {
+        frustum: LightFrustum::warped(world_view, view_proj),
+        slide,
+        inverted,
+        directional: false,
+    })
+}
+
+/// PSM's virtual camera: `camera` slid back along its view direction until every one of
+/// `casters` lies beyond its near plane, which is at least `min_near_fraction` of `far`;
+/// with how far it slid.
+fn slid_back_camera(
+    camera: &Camera,
+    (near, far): (f32, f32),
+    casters: &[Aabb],
+    min_near_fraction: f32,
+) -> (Camera, f32) {
+    let forward = (camera.target - camera.position).normalize_or(Vec3::NEG_Z);
+    let view = camera.view();
+    let nearest = casters
+        .iter()
+        .flat_map(|b| corners(*b))
+        .map(|c| -view.transform_point3(c).z)
+        .fold(near, f32::min);
+    let virtual_near = near.max(min_near_fraction * far).max(-nearest);
+    let slide = (virtual_near - nearest).max(0.0);
+    let virtual_camera = Camera {
+        position: camera.position - forward * slide,
+        target: camera.target - forward * slide,
+        near: virtual_near,
+        far: far + slide,
+        ..*camera
+    };
+    (virtual_camera, slide)
+}
+
+/// The map of a light that is directional in post-perspective space, travelling along
+/// `travel`: an orthographic fit around the `receivers` that reaches back to the
+/// `blockers` (all post-perspective).
+fn parallel_fit(travel: Vec3, receivers: &[Vec3], blockers: &[Vec3]) -> Mat4 {
+    let pp_view = look_to_mat4(Vec3::ZERO, travel, up_for(travel));
+    let (lo, hi) = bounds_in(pp_view, receivers);
+    let near_z = blockers
+        .iter()
+        .map(|p| pp_view.transform_point3(*p).z)
+        .fold(hi.z, f32::max);
+    let box_corners = corners((lo, Vec3::new(hi.x, hi.y, near_z)));
+    fit_to_map(Mat4::IDENTITY, &box_corners) * pp_view
+}
+
+/// The map of a light at `eye` in post-perspective space: a cone around the `receivers`
+/// whose depth range takes in the `blockers` in front of it, with reversed depth when the
+/// light is `inverted` (behind the viewer). `None` when the light lies among the receivers.
+fn point_fit(eye: Vec3, receivers: &[Vec3], blockers: &[Vec3], inverted: bool) -> Option<Mat4> {
     let centre = receivers.iter().copied().sum::<Vec3>() / receivers.len() as f32;
     let radius = receivers
         .iter()
@@ -265,21 +298,17 @@ pub fn psm_frustum(
             * 0.99;
         directx::perspective(2.0 * half_angle, 1.0, near_d, r_far * 1.01)
     };
-    let view_proj = projection * pp_view * post;
-    // Where the light grazes the view's squashed post-perspective box, the view lands on a
-    // sliver of the map: no better than a uniform map, and its depth slopes defeat biasing.
-    // (The map's coordinates are after the perspective division.)
+    Some(projection * pp_view)
+}
+
+/// Whether the view's `slice` lands on a sliver of the map `view_proj` makes, as it does
+/// where the light grazes the view's squashed post-perspective box: no better than a
+/// uniform map, and its depth slopes defeat biasing. (The map's coordinates are after the
+/// perspective division.)
+fn lands_on_a_sliver(view_proj: Mat4, slice: &[Vec3]) -> bool {
     let mapped: Vec<Vec3> = slice.iter().map(|p| view_proj.project_point3(*p)).collect();
     let (lo, hi) = transformed_bounds(Mat4::IDENTITY, &mapped);
-    if (hi.x - lo.x).min(2.0) * (hi.y - lo.y).min(2.0) < 4.0 * MIN_MAP_USE {
-        return None;
-    }
-    Some(PsmFit {
-        frustum: LightFrustum::warped(world_view, view_proj),
-        slide,
-        inverted,
-        directional: false,
-    })
+    (hi.x - lo.x).min(2.0) * (hi.y - lo.y).min(2.0) < 4.0 * MIN_MAP_USE
 }
 
 /// How coarse `frustum`'s map (of `resolution` texels a side) is where the view sees it: the

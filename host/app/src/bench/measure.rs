@@ -4,7 +4,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use zoo_host::gpu::{PassOwner, TimingSource};
+use zoo_host::gpu::{FrameTimings, PassOwner, TimingSource};
 use zoo_host::judge::{Occluders, Surfaces, reference_visibility};
 use zoo_host::judging::surface_points;
 use zoo_host::scene::paths;
@@ -52,6 +52,47 @@ pub fn run_configuration(
     config: &Configuration,
     mut tick: impl FnMut(),
 ) -> anyhow::Result<ConfigResult> {
+    let scene = configured_scene(plan, config)?;
+    // The work: instances counted.
+    let triangles = scene.drawn_triangle_count();
+    let occluders = plan
+        .flicker
+        .then(|| (Occluders::new(&scene), Surfaces::new(&scene)));
+    let mut renderer =
+        Renderer::with_shaders(gpu.clone(), scene.clone(), config.size, shaders.clone())?;
+    renderer.set_technique(config.technique.id, &config.params)?;
+    renderer.set_pipeline_statistics(!plan.cpu_timing);
+    renderer.set_cpu_timing(plan.cpu_timing);
+    renderer.set_reuse_unchanged(plan.reuse_unchanged);
+    let (t0, t1) = paths::duration(&scene.paths);
+    let mut samples = Samples::default();
+    let mut flicker = Flicker::default();
+    for f in 0..plan.warmup + plan.frames {
+        let measured = f.saturating_sub(plan.warmup);
+        let time = if plan.frames > 1 {
+            t0 + (t1 - t0) * measured as f32 / (plan.frames - 1) as f32
+        } else {
+            t0
+        };
+        follow_path(&mut renderer, &scene, plan.path, time);
+        let start = Instant::now();
+        let timings = renderer.render(&View::Final)?;
+        let cpu = start.elapsed().as_secs_f64() * 1e3;
+        tick();
+        if f < plan.warmup {
+            continue;
+        }
+        samples.push(&timings, cpu, renderer.wait_for_counters());
+        if let Some((occluders, surfaces)) = &occluders {
+            flicker.push(frame_visibility(&renderer, occluders, surfaces));
+        }
+    }
+    let flicker = occluders.is_some().then(|| flicker.index());
+    Ok(samples.summarize(config, flicker, triangles))
+}
+
+/// The plan's scene with the configuration's tessellation and number of lights.
+fn configured_scene(plan: &BenchPlan, config: &Configuration) -> anyhow::Result<Scene> {
     let base = plan.scene_path.parent().unwrap_or(Path::new("."));
     let mut description = plan.description.with_tessellation(config.tessellation);
     if let Some(n) = config.lights {
@@ -65,118 +106,140 @@ pub fn run_configuration(
         description.lights.truncate(n);
         description.paths.lights.retain(|path| path.light < n);
     }
-    let scene = Scene::from_description(&description, &plan.scene_path, base)?;
-    // The work: instances counted.
-    let triangles = scene.drawn_triangle_count();
-    let occluders = plan
-        .flicker
-        .then(|| (Occluders::new(&scene), Surfaces::new(&scene)));
-    let mut renderer =
-        Renderer::with_shaders(gpu.clone(), scene.clone(), config.size, shaders.clone())?;
-    renderer.set_technique(config.technique.id, &config.params)?;
-    renderer.set_pipeline_statistics(!plan.cpu_timing);
-    renderer.set_cpu_timing(plan.cpu_timing);
-    renderer.set_reuse_unchanged(plan.reuse_unchanged);
-    let (t0, t1) = paths::duration(&scene.paths);
-    let mut pass_samples: Vec<PassSamples> = Vec::new();
-    let (mut frame_gpu, mut technique_gpu, mut frame_cpu) = (Vec::new(), Vec::new(), Vec::new());
-    let mut timing_source = TimingSource::GpuTimestamps;
-    let mut flicker = Flicker::default();
-    let mut counter_frames: Vec<Vec<(String, f64)>> = Vec::new();
-    for f in 0..plan.warmup + plan.frames {
-        let measured = f.saturating_sub(plan.warmup);
-        let time = if plan.frames > 1 {
-            t0 + (t1 - t0) * measured as f32 / (plan.frames - 1) as f32
-        } else {
-            t0
-        };
-        if matches!(plan.path, PathMode::Camera | PathMode::Both) {
-            renderer.set_camera(paths::camera_at(&scene.camera, &scene.paths.camera, time));
+    Ok(Scene::from_description(
+        &description,
+        &plan.scene_path,
+        base,
+    )?)
+}
+
+/// Moves the camera and (or) the lights, as `mode` says, to where the scene's paths have
+/// them at `time`.
+fn follow_path(renderer: &mut Renderer, scene: &Scene, mode: PathMode, time: f32) {
+    if matches!(mode, PathMode::Camera | PathMode::Both) {
+        renderer.set_camera(paths::camera_at(&scene.camera, &scene.paths.camera, time));
+    }
+    if matches!(mode, PathMode::Light | PathMode::Both) {
+        renderer.set_lights(paths::lights_at(&scene.lights, &scene.paths.lights, time));
+    }
+}
+
+/// The technique's visibility of the frame just rendered beside the reference's hard
+/// visibility of the same surface points, for the flicker index.
+fn frame_visibility(
+    renderer: &Renderer,
+    occluders: &Occluders,
+    surfaces: &Surfaces,
+) -> FrameVisibility {
+    let g = renderer.read_gbuffer();
+    let points = surface_points(&g, surfaces);
+    FrameVisibility {
+        technique: (0..renderer.lights().len())
+            .map(|l| renderer.read_visibility(l))
+            .collect(),
+        reference: renderer
+            .lights()
+            .iter()
+            .map(|light| {
+                let r = reference_visibility(occluders, light, &points, 1);
+                r.contributing
+                    .iter()
+                    .zip(&r.hard)
+                    .map(|(c, h)| c.then_some(*h >= 0.5))
+                    .collect()
+            })
+            .collect(),
+    }
+}
+
+/// The measured frames' samples, gathered frame by frame.
+struct Samples {
+    passes: Vec<PassSamples>,
+    frame_gpu: Vec<f64>,
+    technique_gpu: Vec<f64>,
+    frame_cpu: Vec<f64>,
+    timing_source: TimingSource,
+    /// Each frame's counters.
+    counter_frames: Vec<Vec<(String, f64)>>,
+}
+
+impl Default for Samples {
+    fn default() -> Self {
+        Samples {
+            passes: Vec::new(),
+            frame_gpu: Vec::new(),
+            technique_gpu: Vec::new(),
+            frame_cpu: Vec::new(),
+            timing_source: TimingSource::GpuTimestamps,
+            counter_frames: Vec::new(),
         }
-        if matches!(plan.path, PathMode::Light | PathMode::Both) {
-            renderer.set_lights(paths::lights_at(&scene.lights, &scene.paths.lights, time));
-        }
-        let start = Instant::now();
-        let timings = renderer.render(&View::Final)?;
-        let cpu = start.elapsed().as_secs_f64() * 1e3;
-        tick();
-        if f < plan.warmup {
-            continue;
-        }
-        timing_source = timings.source;
-        frame_gpu.push(timings.frame_total());
-        technique_gpu.push(timings.total(PassOwner::Technique));
-        frame_cpu.push(cpu);
-        counter_frames.push(renderer.wait_for_counters());
+    }
+}
+
+impl Samples {
+    /// Adds one measured frame: its pass timings, CPU time (ms) and counters.
+    fn push(&mut self, timings: &FrameTimings, cpu: f64, counters: Vec<(String, f64)>) {
+        self.timing_source = timings.source;
+        self.frame_gpu.push(timings.frame_total());
+        self.technique_gpu.push(timings.total(PassOwner::Technique));
+        self.frame_cpu.push(cpu);
+        self.counter_frames.push(counters);
         for pass in &timings.passes {
-            let index = match pass_samples.iter().position(|p| p.name == pass.name) {
+            let index = match self.passes.iter().position(|p| p.name == pass.name) {
                 Some(i) => i,
                 None => {
-                    pass_samples.push(PassSamples {
+                    self.passes.push(PassSamples {
                         name: pass.name.clone(),
                         owner: pass.owner,
                         times: Vec::new(),
                         invocations: Vec::new(),
                     });
-                    pass_samples.len() - 1
+                    self.passes.len() - 1
                 }
             };
-            pass_samples[index].times.push(pass.milliseconds);
+            self.passes[index].times.push(pass.milliseconds);
             if let Some(counts) = pass.invocations {
-                pass_samples[index].invocations.push(counts);
+                self.passes[index].invocations.push(counts);
             }
         }
-        if let Some((occluders, surfaces)) = &occluders {
-            let g = renderer.read_gbuffer();
-            let points = surface_points(&g, surfaces);
-            let frame = FrameVisibility {
-                technique: (0..renderer.lights().len())
-                    .map(|l| renderer.read_visibility(l))
-                    .collect(),
-                reference: renderer
-                    .lights()
-                    .iter()
-                    .map(|light| {
-                        let r = reference_visibility(occluders, light, &points, 1);
-                        r.contributing
-                            .iter()
-                            .zip(&r.hard)
-                            .map(|(c, h)| c.then_some(*h >= 0.5))
-                            .collect()
-                    })
-                    .collect(),
-            };
-            flicker.push(frame);
+    }
+
+    /// The configuration's result: the samples summarized.
+    fn summarize(
+        self,
+        config: &Configuration,
+        flicker: Option<f64>,
+        triangles: usize,
+    ) -> ConfigResult {
+        ConfigResult {
+            config: config.clone(),
+            invocations: (self.passes.iter())
+                .map(|p| median_counts(&p.invocations))
+                .collect(),
+            passes: (self.passes.into_iter())
+                .map(|p| (p.name, p.owner, Summary::of(&p.times)))
+                .collect(),
+            frame_gpu: Summary::of(&self.frame_gpu),
+            technique_gpu: Summary::of(&self.technique_gpu),
+            frame_cpu: Summary::of(&self.frame_cpu),
+            counters: self.counter_frames.last().cloned().unwrap_or_default(),
+            varying_counters: varying_counters(&self.counter_frames),
+            flicker,
+            timing_source: self.timing_source,
+            triangles,
         }
     }
-    let flicker = occluders.is_some().then(|| flicker.index());
-    let median_counts = |counts: &[[u64; 3]]| -> Option<[u64; 3]> {
-        (!counts.is_empty()).then(|| {
-            [0, 1, 2].map(|k| {
-                let mut v: Vec<u64> = counts.iter().map(|c| c[k]).collect();
-                v.sort_unstable();
-                v[v.len() / 2]
-            })
+}
+
+/// The median of each of the vertex, fragment and compute invocation counts (`None`
+/// without counts).
+fn median_counts(counts: &[[u64; 3]]) -> Option<[u64; 3]> {
+    (!counts.is_empty()).then(|| {
+        [0, 1, 2].map(|k| {
+            let mut v: Vec<u64> = counts.iter().map(|c| c[k]).collect();
+            v.sort_unstable();
+            v[v.len() / 2]
         })
-    };
-    Ok(ConfigResult {
-        config: config.clone(),
-        invocations: pass_samples
-            .iter()
-            .map(|p| median_counts(&p.invocations))
-            .collect(),
-        passes: pass_samples
-            .into_iter()
-            .map(|p| (p.name, p.owner, Summary::of(&p.times)))
-            .collect(),
-        frame_gpu: Summary::of(&frame_gpu),
-        technique_gpu: Summary::of(&technique_gpu),
-        frame_cpu: Summary::of(&frame_cpu),
-        counters: counter_frames.last().cloned().unwrap_or_default(),
-        varying_counters: varying_counters(&counter_frames),
-        flicker,
-        timing_source,
-        triangles,
     })
 }
 

@@ -58,38 +58,10 @@ pub fn pass_bars(bars: &[Bar], title: &str, path: &Path) -> anyhow::Result<()> {
             .label_style((FONT, 13))
             .draw()
             .map_err(plot_error)?;
-        let mut names: Vec<String> = Vec::new();
-        for bar in bars {
-            for (name, _) in &bar.segments {
-                if !names.contains(name) {
-                    names.push(name.clone());
-                }
-            }
-        }
-        for (n, name) in names.iter().enumerate() {
+        for (n, name) in segment_names(bars).iter().enumerate() {
             let color = Palette99::pick(n).to_rgba();
-            let rects: Vec<Rectangle<(f64, SegmentValue<usize>)>> = bars
-                .iter()
-                .enumerate()
-                .filter_map(|(i, bar)| {
-                    let start: f64 = bar
-                        .segments
-                        .iter()
-                        .take_while(|s| &s.0 != name)
-                        .map(|s| s.1)
-                        .sum();
-                    let value = bar.segments.iter().find(|s| &s.0 == name)?.1;
-                    Some(Rectangle::new(
-                        [
-                            (start, SegmentValue::Exact(i)),
-                            (start + value, SegmentValue::Exact(i + 1)),
-                        ],
-                        color.filled(),
-                    ))
-                })
-                .collect();
             chart
-                .draw_series(rects)
+                .draw_series(segment_rects(bars, name, color))
                 .map_err(plot_error)?
                 .label(name.as_str())
                 .legend(move |(x, y)| {
@@ -107,6 +79,46 @@ pub fn pass_bars(bars: &[Bar], title: &str, path: &Path) -> anyhow::Result<()> {
         root.present().map_err(plot_error)?;
     }
     save(buffer, size, path)
+}
+
+/// The segments' names over all bars, in order of first appearance.
+fn segment_names(bars: &[Bar]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for bar in bars {
+        for (name, _) in &bar.segments {
+            if !names.contains(name) {
+                names.push(name.clone());
+            }
+        }
+    }
+    names
+}
+
+/// The rectangles of segment `name` in each bar that has it, after the segments before it.
+fn segment_rects(
+    bars: &[Bar],
+    name: &str,
+    color: RGBAColor,
+) -> Vec<Rectangle<(f64, SegmentValue<usize>)>> {
+    bars.iter()
+        .enumerate()
+        .filter_map(|(i, bar)| {
+            let start: f64 = bar
+                .segments
+                .iter()
+                .take_while(|s| s.0 != name)
+                .map(|s| s.1)
+                .sum();
+            let value = bar.segments.iter().find(|s| s.0 == name)?.1;
+            Some(Rectangle::new(
+                [
+                    (start, SegmentValue::Exact(i)),
+                    (start + value, SegmentValue::Exact(i + 1)),
+                ],
+                color.filled(),
+            ))
+        })
+        .collect()
 }
 
 /// One line of a sweep plot: a name and (x, y) points.

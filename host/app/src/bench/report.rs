@@ -246,6 +246,28 @@ pub fn bench_md(
 ) -> String {
     let mut out = String::new();
     let w = &mut out;
+    environment_md(w, plans, results, skipped, adapter, suite);
+    frame_times_md(w, results);
+    light_costs_md(w, results);
+    if let Some(s) = suite {
+        seeds_md(w, s, results);
+    }
+    passes_md(w, results);
+    counters_md(w, results);
+    varying_counters_md(w, results);
+    out
+}
+
+/// The title, the suite's description and the bullet list of the environment, the runs and
+/// the configurations skipped.
+fn environment_md(
+    w: &mut String,
+    plans: &[BenchPlan],
+    results: &[ConfigResult],
+    skipped: &[super::Skipped],
+    adapter: &str,
+    suite: Option<&suite::Suite>,
+) {
     let title = suite.map_or("Shadow Zoo benchmark".to_string(), |s| {
         format!("Shadow Zoo benchmark suite `{}`", s.name)
     });
@@ -286,6 +308,10 @@ pub fn bench_md(
             s.configuration, s.reason
         );
     }
+}
+
+/// The main table: each configuration's frame times, ratio to `unshadowed` and flicker.
+fn frame_times_md(w: &mut String, results: &[ConfigResult]) {
     let _ = writeln!(
         w,
         "\nFrame times are GPU pass sums (medians over frames); the ratio is to `unshadowed` with the same run, size and tessellation. The flicker index is the mean fraction of pixels whose visibility flips between consecutive frames where the reference visibility does not change.\n"
@@ -310,35 +336,46 @@ pub fn bench_md(
             r.flicker.map_or("–".into(), |x| format!("{x:.5}")),
         );
     }
+}
+
+/// The cost of each added light, when a run sweeps `scene.lights`.
+fn light_costs_md(w: &mut String, results: &[ConfigResult]) {
     let slopes = per_light_costs(results);
-    if !slopes.is_empty() {
-        let _ = writeln!(
-            w,
-            "\n## Cost per added light\n\nLeast-squares slope of the frame median over the `scene.lights` sweep.\n"
-        );
-        let _ = writeln!(w, "| run | configuration | lights | ms per added light |");
+    if slopes.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        w,
+        "\n## Cost per added light\n\nLeast-squares slope of the frame median over the `scene.lights` sweep.\n"
+    );
+    let _ = writeln!(w, "| run | configuration | lights | ms per added light |");
+    let _ = writeln!(w, "|---|---|---|---|");
+    for (run, label, lights, slope) in slopes {
+        let _ = writeln!(w, "| {run} | {label} | {lights} | {slope:.3} |");
+    }
+}
+
+/// The suite's ratios beside the ones its seeds report, and the seeds' own figures.
+fn seeds_md(w: &mut String, suite: &suite::Suite, results: &[ConfigResult]) {
+    let ratios = suite_ratios(suite, results);
+    if !ratios.is_empty() {
+        let _ = writeln!(w, "\n## This project beside the seeds\n");
+        let _ = writeln!(w, "| ratio | configuration | this project | seed |");
         let _ = writeln!(w, "|---|---|---|---|");
-        for (run, label, lights, slope) in slopes {
-            let _ = writeln!(w, "| {run} | {label} | {lights} | {slope:.3} |");
+        for (label, key, value, seed) in ratios {
+            let _ = writeln!(w, "| {label} | {key} | {value:.2} | {seed} |");
         }
     }
-    if let Some(s) = suite {
-        let ratios = suite_ratios(s, results);
-        if !ratios.is_empty() {
-            let _ = writeln!(w, "\n## This project beside the seeds\n");
-            let _ = writeln!(w, "| ratio | configuration | this project | seed |");
-            let _ = writeln!(w, "|---|---|---|---|");
-            for (label, key, value, seed) in ratios {
-                let _ = writeln!(w, "| {label} | {key} | {value:.2} | {seed} |");
-            }
-        }
-        if !s.seed_figures.is_empty() {
-            let _ = writeln!(w, "\nWhat the seeds report:\n");
-            for f in &s.seed_figures {
-                let _ = writeln!(w, "- {f}");
-            }
+    if !suite.seed_figures.is_empty() {
+        let _ = writeln!(w, "\nWhat the seeds report:\n");
+        for f in &suite.seed_figures {
+            let _ = writeln!(w, "- {f}");
         }
     }
+}
+
+/// Each configuration's pass times, with the shader invocations where they were counted.
+fn passes_md(w: &mut String, results: &[ConfigResult]) {
     let _ = writeln!(
         w,
         "\n## Passes (median / p95 ms; vertex / fragment / compute invocations where counted)\n"
@@ -361,43 +398,52 @@ pub fn bench_md(
             passes.join(", ")
         );
     }
+}
+
+/// The techniques' workload counters on the last frame.
+fn counters_md(w: &mut String, results: &[ConfigResult]) {
     let counted: Vec<&ConfigResult> = results.iter().filter(|r| !r.counters.is_empty()).collect();
-    if !counted.is_empty() {
-        let _ = writeln!(w, "\n## Workload counters (last frame)\n");
-        for r in counted {
-            let values: Vec<String> = r.counters.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    if counted.is_empty() {
+        return;
+    }
+    let _ = writeln!(w, "\n## Workload counters (last frame)\n");
+    for r in counted {
+        let values: Vec<String> = r.counters.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        let _ = writeln!(
+            w,
+            "- {} `{}`: {}",
+            r.config.run,
+            r.config.label(),
+            values.join(", ")
+        );
+    }
+}
+
+/// The counters that change between frames, with their value on every measured frame.
+fn varying_counters_md(w: &mut String, results: &[ConfigResult]) {
+    let varying: Vec<&ConfigResult> = results
+        .iter()
+        .filter(|r| !r.varying_counters.is_empty())
+        .collect();
+    if varying.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        w,
+        "\n## Counters that change between frames (value per measured frame)\n"
+    );
+    for r in varying {
+        for (name, values) in &r.varying_counters {
+            let values: Vec<String> = values.iter().map(|v| v.to_string()).collect();
             let _ = writeln!(
                 w,
-                "- {} `{}`: {}",
+                "- {} `{}` {name}: {}",
                 r.config.run,
                 r.config.label(),
                 values.join(", ")
             );
         }
     }
-    let varying: Vec<&ConfigResult> = results
-        .iter()
-        .filter(|r| !r.varying_counters.is_empty())
-        .collect();
-    if !varying.is_empty() {
-        let _ = writeln!(
-            w,
-            "\n## Counters that change between frames (value per measured frame)\n"
-        );
-        for r in varying {
-            for (name, values) in &r.varying_counters {
-                let values: Vec<String> = values.iter().map(|v| v.to_string()).collect();
-                let _ = writeln!(
-                    w,
-                    "- {} `{}` {name}: {}",
-                    r.config.run,
-                    r.config.label(),
-                    values.join(", ")
-                );
-            }
-        }
-    }
-    out
 }
 
 fn file_name(text: &str) -> String {
@@ -412,84 +458,100 @@ fn file_name(text: &str) -> String {
         .collect()
 }
 
+/// Draws `passes.png` (every configuration's pass times) and one `sweep-<run>-<sweep>.png`
+/// per sweep of each run (frame time against the swept value) into `out`.
 pub(super) fn write_plots(
     plans: &[BenchPlan],
     results: &[ConfigResult],
     out: &Path,
 ) -> anyhow::Result<()> {
-    // One segment per pass family ("Shadow map: light 0 face 2" -> "Shadow map").
-    let bars: Vec<plot::Bar> = results
-        .iter()
-        .map(|r| {
-            let mut segments: Vec<(String, f64)> = Vec::new();
-            for (name, _, s) in &r.passes {
-                let family = name.split(':').next().unwrap_or(name).trim().to_string();
-                match segments.iter_mut().find(|(n, _)| *n == family) {
-                    Some((_, total)) => *total += s.median,
-                    None => segments.push((family, s.median)),
-                }
-            }
-            plot::Bar {
-                label: format!("{}: {}", r.config.run, r.config.label()),
-                segments,
-            }
-        })
-        .collect();
+    let bars: Vec<plot::Bar> = results.iter().map(pass_family_bar).collect();
     plot::pass_bars(&bars, "Per-pass GPU time (median)", &out.join("passes.png"))?;
     for plan in plans {
         for sweep in &plan.sweeps {
-            let x_of = |value: &str| -> Option<f64> {
-                match sweep.key {
-                    SweepKey::Size => parse_size(value).ok().map(|s| (s.x * s.y) as f64),
-                    _ => value.parse().ok(),
-                }
+            let lines = sweep_lines(plan, sweep, results);
+            if lines.is_empty() {
+                continue;
+            }
+            let x_label = match sweep.key {
+                SweepKey::Size => "pixels".to_string(),
+                _ => sweep.name.clone(),
             };
-            let mut lines: Vec<plot::Line> = Vec::new();
-            for r in results.iter().filter(|r| r.config.run == plan.run) {
-                let Some((_, value)) = r.config.swept.iter().find(|(k, _)| *k == sweep.name) else {
-                    continue;
-                };
-                let Some(x) = x_of(value) else { continue };
-                let others: Vec<String> = r
-                    .config
-                    .swept
-                    .iter()
-                    .filter(|(k, _)| *k != sweep.name)
-                    .map(|(k, v)| format!("{k}={v}"))
-                    .collect();
-                let name = if others.is_empty() {
-                    r.config.technique.id.to_string()
-                } else {
-                    format!("{} [{}]", r.config.technique.id, others.join(", "))
-                };
-                match lines.iter_mut().find(|l| l.name == name) {
-                    Some(line) => line.points.push((x, r.frame_gpu.median)),
-                    None => lines.push(plot::Line {
-                        name,
-                        points: vec![(x, r.frame_gpu.median)],
-                    }),
-                }
-            }
-            for line in &mut lines {
-                line.points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            }
-            if !lines.is_empty() {
-                let x_label = match sweep.key {
-                    SweepKey::Size => "pixels".to_string(),
-                    _ => sweep.name.clone(),
-                };
-                plot::sweep_lines(
-                    &lines,
-                    &format!("{}: frame time against {}", plan.run, sweep.name),
-                    &x_label,
-                    &out.join(format!(
-                        "sweep-{}-{}.png",
-                        file_name(&plan.run),
-                        file_name(&sweep.name)
-                    )),
-                )?;
-            }
+            plot::sweep_lines(
+                &lines,
+                &format!("{}: frame time against {}", plan.run, sweep.name),
+                &x_label,
+                &out.join(format!(
+                    "sweep-{}-{}.png",
+                    file_name(&plan.run),
+                    file_name(&sweep.name)
+                )),
+            )?;
         }
     }
     Ok(())
+}
+
+/// One configuration's bar, one segment per pass family ("Shadow map: light 0 face 2" ->
+/// "Shadow map").
+fn pass_family_bar(r: &ConfigResult) -> plot::Bar {
+    let mut segments: Vec<(String, f64)> = Vec::new();
+    for (name, _, s) in &r.passes {
+        let family = name.split(':').next().unwrap_or(name).trim().to_string();
+        match segments.iter_mut().find(|(n, _)| *n == family) {
+            Some((_, total)) => *total += s.median,
+            None => segments.push((family, s.median)),
+        }
+    }
+    plot::Bar {
+        label: format!("{}: {}", r.config.run, r.config.label()),
+        segments,
+    }
+}
+
+/// The frame time against the value of `sweep` in run `plan`: one line per technique and
+/// values of the run's other sweeps, its points in increasing order.
+fn sweep_lines(plan: &BenchPlan, sweep: &Sweep, results: &[ConfigResult]) -> Vec<plot::Line> {
+    let x_of = |value: &str| -> Option<f64> {
+        match sweep.key {
+            SweepKey::Size => parse_size(value).ok().map(|s| (s.x * s.y) as f64),
+            _ => value.parse().ok(),
+        }
+    };
+    let mut lines: Vec<plot::Line> = Vec::new();
+    for r in results.iter().filter(|r| r.config.run == plan.run) {
+        let Some((_, value)) = r.config.swept.iter().find(|(k, _)| *k == sweep.name) else {
+            continue;
+        };
+        let Some(x) = x_of(value) else { continue };
+        let name = sweep_line_name(r, sweep);
+        match lines.iter_mut().find(|l| l.name == name) {
+            Some(line) => line.points.push((x, r.frame_gpu.median)),
+            None => lines.push(plot::Line {
+                name,
+                points: vec![(x, r.frame_gpu.median)],
+            }),
+        }
+    }
+    for line in &mut lines {
+        line.points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    lines
+}
+
+/// The name of a configuration's line in the plot of `sweep`: its technique, with the
+/// values of the other sweeps in brackets.
+fn sweep_line_name(r: &ConfigResult, sweep: &Sweep) -> String {
+    let others: Vec<String> = r
+        .config
+        .swept
+        .iter()
+        .filter(|(k, _)| *k != sweep.name)
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect();
+    if others.is_empty() {
+        r.config.technique.id.to_string()
+    } else {
+        format!("{} [{}]", r.config.technique.id, others.join(", "))
+    }
 }

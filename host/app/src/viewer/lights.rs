@@ -109,14 +109,7 @@ pub fn lights_panel(
     extent: f32,
 ) -> LightEdits {
     let mut edits = LightEdits::default();
-    ui.horizontal_wrapped(|ui| {
-        for (i, light) in lights.iter().enumerate() {
-            let label = format!("{i}: {}", light.kind.name());
-            if ui.selectable_label(*selected == i, label).clicked() {
-                *selected = i;
-            }
-        }
-    });
+    light_list(ui, lights, selected);
     ui.horizontal(|ui| {
         edits.add = ui
             .add_enabled(lights.len() < MAX_LIGHTS, egui::Button::new("Add light"))
@@ -130,7 +123,38 @@ pub fn lights_panel(
     let Some(light) = lights.get_mut(*selected) else {
         return edits;
     };
-    let mut changed = false;
+    let mut changed = kind_edit(ui, light, extent);
+    changed |= radiance_edit(ui, light);
+    if light.kind == LightKind::Directional {
+        changed |= angular_radius_edit(ui, light);
+    } else {
+        changed |= emitter_edit(ui, light, extent);
+    }
+    if light.kind == LightKind::Spot {
+        changed |= spot_edit(ui, light);
+    }
+    if light.kind != LightKind::Point {
+        changed |= direction_edit(ui, light);
+    }
+    ui.label("Drag a light's handle in the view to move it.");
+    edits.changed = changed;
+    edits
+}
+
+/// The lights by index and kind; clicking one selects it.
+fn light_list(ui: &mut egui::Ui, lights: &[Light], selected: &mut usize) {
+    ui.horizontal_wrapped(|ui| {
+        for (i, light) in lights.iter().enumerate() {
+            let label = format!("{i}: {}", light.kind.name());
+            if ui.selectable_label(*selected == i, label).clicked() {
+                *selected = i;
+            }
+        }
+    });
+}
+
+/// The light's kind; returns whether it changed.
+fn kind_edit(ui: &mut egui::Ui, light: &mut Light, extent: f32) -> bool {
     let mut kind = light.kind;
     egui::ComboBox::from_label("kind")
         .selected_text(kind.name())
@@ -139,11 +163,16 @@ pub fn lights_panel(
                 ui.selectable_value(&mut kind, k, k.name());
             }
         });
-    if kind != light.kind {
-        set_kind(light, kind, extent);
-        changed = true;
+    if kind == light.kind {
+        return false;
     }
-    // Colour and intensity are stored together as radiance.
+    set_kind(light, kind, extent);
+    true
+}
+
+/// The light's colour and intensity, stored together as radiance; returns whether either
+/// changed.
+fn radiance_edit(ui: &mut egui::Ui, light: &mut Light) -> bool {
     let intensity = light.radiance.max_element();
     let mut colour = if intensity > 0.0 {
         (light.radiance / intensity).to_array()
@@ -151,6 +180,7 @@ pub fn lights_panel(
         [1.0; 3]
     };
     let mut new_intensity = intensity;
+    let mut changed = false;
     ui.horizontal(|ui| {
         changed |= ui.color_edit_button_rgb(&mut colour).changed();
         ui.label("colour");
@@ -163,65 +193,75 @@ pub fn lights_panel(
         )
         .changed();
     light.radiance = Vec3::from(colour) * new_intensity;
-    if light.kind == LightKind::Directional {
-        let mut degrees = light.radius.to_degrees();
-        changed |= ui
-            .add(egui::Slider::new(&mut degrees, 0.0..=10.0).text("angular radius (°)"))
-            .on_hover_text("Half-angle of the emitter disc, for soft shadows")
-            .changed();
-        light.radius = degrees.to_radians();
-    } else {
-        changed |= ui
-            .add(egui::Slider::new(&mut light.radius, 0.0..=extent * 0.1).text("radius"))
-            .on_hover_text("Emitter radius, for soft shadows")
-            .changed();
-        changed |= ui
-            .add(
-                egui::Slider::new(&mut light.range, 0.05..=extent * 4.0)
-                    .logarithmic(true)
-                    .text("range"),
-            )
-            .changed();
-        ui.horizontal(|ui| {
-            ui.label("position");
-            for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
-                let label = ui.label(name);
-                changed |= ui
-                    .add(egui::DragValue::new(&mut light.position[axis]).speed(0.02))
-                    .labelled_by(label.id)
-                    .changed();
-            }
-        });
-    }
-    if light.kind == LightKind::Spot {
-        let mut degrees = light.spot_angle.to_degrees();
-        changed |= ui
-            .add(egui::Slider::new(&mut degrees, 1.0..=89.0).text("spot angle (°)"))
-            .changed();
-        light.spot_angle = degrees.to_radians();
-        changed |= ui
-            .add(egui::Slider::new(&mut light.spot_softness, 0.0..=1.0).text("spot softness"))
-            .changed();
-    }
-    if light.kind != LightKind::Point {
-        let mut yaw = light.direction.x.atan2(light.direction.z).to_degrees();
-        let mut pitch = light.direction.y.clamp(-1.0, 1.0).asin().to_degrees();
-        let mut turned = ui
-            .add(egui::Slider::new(&mut yaw, -180.0..=180.0).text("direction yaw (°)"))
-            .changed();
-        turned |= ui
-            .add(egui::Slider::new(&mut pitch, -90.0..=90.0).text("direction pitch (°)"))
-            .changed();
-        if turned {
-            let (sy, cy) = yaw.to_radians().sin_cos();
-            let (sp, cp) = pitch.to_radians().sin_cos();
-            light.direction = Vec3::new(sy * cp, sp, cy * cp).normalize();
-            changed = true;
+    changed
+}
+
+/// A directional light's angular radius, in degrees; returns whether it changed.
+fn angular_radius_edit(ui: &mut egui::Ui, light: &mut Light) -> bool {
+    let mut degrees = light.radius.to_degrees();
+    let changed = ui
+        .add(egui::Slider::new(&mut degrees, 0.0..=10.0).text("angular radius (°)"))
+        .on_hover_text("Half-angle of the emitter disc, for soft shadows")
+        .changed();
+    light.radius = degrees.to_radians();
+    changed
+}
+
+/// A point or spot light's emitter radius, range and position; returns whether any changed.
+fn emitter_edit(ui: &mut egui::Ui, light: &mut Light, extent: f32) -> bool {
+    let mut changed = ui
+        .add(egui::Slider::new(&mut light.radius, 0.0..=extent * 0.1).text("radius"))
+        .on_hover_text("Emitter radius, for soft shadows")
+        .changed();
+    changed |= ui
+        .add(
+            egui::Slider::new(&mut light.range, 0.05..=extent * 4.0)
+                .logarithmic(true)
+                .text("range"),
+        )
+        .changed();
+    ui.horizontal(|ui| {
+        ui.label("position");
+        for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
+            let label = ui.label(name);
+            changed |= ui
+                .add(egui::DragValue::new(&mut light.position[axis]).speed(0.02))
+                .labelled_by(label.id)
+                .changed();
         }
+    });
+    changed
+}
+
+/// A spot light's cone angle and softness; returns whether either changed.
+fn spot_edit(ui: &mut egui::Ui, light: &mut Light) -> bool {
+    let mut degrees = light.spot_angle.to_degrees();
+    let mut changed = ui
+        .add(egui::Slider::new(&mut degrees, 1.0..=89.0).text("spot angle (°)"))
+        .changed();
+    light.spot_angle = degrees.to_radians();
+    changed |= ui
+        .add(egui::Slider::new(&mut light.spot_softness, 0.0..=1.0).text("spot softness"))
+        .changed();
+    changed
+}
+
+/// The light's direction as yaw and pitch; returns whether it was turned.
+fn direction_edit(ui: &mut egui::Ui, light: &mut Light) -> bool {
+    let mut yaw = light.direction.x.atan2(light.direction.z).to_degrees();
+    let mut pitch = light.direction.y.clamp(-1.0, 1.0).asin().to_degrees();
+    let mut turned = ui
+        .add(egui::Slider::new(&mut yaw, -180.0..=180.0).text("direction yaw (°)"))
+        .changed();
+    turned |= ui
+        .add(egui::Slider::new(&mut pitch, -90.0..=90.0).text("direction pitch (°)"))
+        .changed();
+    if turned {
+        let (sy, cy) = yaw.to_radians().sin_cos();
+        let (sp, cp) = pitch.to_radians().sin_cos();
+        light.direction = Vec3::new(sy * cp, sp, cy * cp).normalize();
     }
-    ui.label("Drag a light's handle in the view to move it.");
-    edits.changed = changed;
-    edits
+    turned
 }
 
 #[cfg(test)]

@@ -1,9 +1,12 @@
 //! The side and bottom panels: scene, technique and generated parameters, views, lights,
 //! camera, A/B, reference judge, settings and timings.
 
+use std::collections::VecDeque;
+
 use egui_plot::{Bar, BarChart, Line, Plot, PlotPoints};
+use zoo_host::ShadowTechnique;
 use zoo_host::View;
-use zoo_host::gpu::PassOwner;
+use zoo_host::gpu::{PassOwner, PassTiming};
 use zoo_host::params::{ParamKind, ParamValue};
 
 use super::camera::CameraMode;
@@ -392,19 +395,7 @@ Source: {}",
     /// The bottom panel: per-pass times, a rolling frame-time plot, counters and memory, and
     /// whether frames keep unchanged work (off shows every pass's full cost each frame).
     pub fn timing_panel(&mut self, ui: &mut egui::Ui) {
-        let mut reuse = self.renderer.reuse_unchanged();
-        let toggled = ui
-            .checkbox(&mut reuse, "keep unchanged shadow maps")
-            .on_hover_text(
-                "Off: every frame renders every map, so the pass times show its full cost",
-            )
-            .changed();
-        if toggled {
-            self.renderer.set_reuse_unchanged(reuse);
-            if let Some(ab) = &mut self.ab {
-                ab.renderer.set_reuse_unchanged(reuse);
-            }
-        }
+        self.reuse_toggle(ui);
         let Some(timings) = &self.timings else {
             return;
         };
@@ -426,64 +417,100 @@ Source: {}",
             }
         });
         ui.columns(3, |columns| {
-            let families = pass_families(&timings.passes);
-            let bars: Vec<Bar> = families
-                .iter()
-                .enumerate()
-                .map(|(i, f)| Bar::new(-(i as f64), f.milliseconds).name(f.label()))
-                .collect();
-            let labels: Vec<String> = families.iter().map(PassFamily::label).collect();
-            Plot::new("pass times")
-                .height(140.0)
-                .allow_scroll(false)
-                .y_axis_min_width(120.0)
-                .y_axis_formatter(move |mark, _| {
-                    let index = -mark.value;
-                    if (index - index.round()).abs() > 1e-6 || index < 0.0 {
-                        return String::new();
-                    }
-                    labels
-                        .get(index.round() as usize)
-                        .cloned()
-                        .unwrap_or_default()
-                })
-                .show(&mut columns[0], |plot| {
-                    plot.bar_chart(BarChart::new("pass time (ms)", bars).horizontal())
-                });
-            let points: PlotPoints<'_> = self
-                .history
-                .iter()
-                .enumerate()
-                .map(|(i, v)| [i as f64, *v])
-                .collect();
-            Plot::new("frame history")
-                .height(140.0)
-                .allow_scroll(false)
-                .show(&mut columns[1], |plot| {
-                    plot.line(Line::new("frame (ms)", points))
-                });
-            let instance = self.renderer.technique_instance();
-            egui::ScrollArea::vertical()
-                .max_height(140.0)
-                .show(&mut columns[2], |ui| {
-                    for p in &timings.passes {
-                        ui.label(format!("{}: {:.2} ms", p.name, p.milliseconds));
-                    }
-                    for r in instance.resources() {
-                        ui.label(format!(
-                            "{}: {:?} {} {:.1} MiB",
-                            r.name,
-                            r.size,
-                            r.format,
-                            r.bytes as f64 / 1048576.0
-                        ));
-                    }
-                    for (name, value) in instance.counters() {
-                        ui.label(format!("{name}: {value}"));
-                    }
-                });
+            pass_time_plot(&mut columns[0], &timings.passes);
+            frame_history_plot(&mut columns[1], &self.history);
+            pass_and_resource_list(
+                &mut columns[2],
+                &timings.passes,
+                self.renderer.technique_instance(),
+            );
         });
     }
+
+    /// Whether frames keep unchanged shadow maps, for both renderers.
+    fn reuse_toggle(&mut self, ui: &mut egui::Ui) {
+        let mut reuse = self.renderer.reuse_unchanged();
+        let toggled = ui
+            .checkbox(&mut reuse, "keep unchanged shadow maps")
+            .on_hover_text(
+                "Off: every frame renders every map, so the pass times show its full cost",
+            )
+            .changed();
+        if toggled {
+            self.renderer.set_reuse_unchanged(reuse);
+            if let Some(ab) = &mut self.ab {
+                ab.renderer.set_reuse_unchanged(reuse);
+            }
+        }
+    }
+}
+
+/// A bar chart of the frame's pass times, one bar per pass family.
+fn pass_time_plot(ui: &mut egui::Ui, passes: &[PassTiming]) {
+    let families = pass_families(passes);
+    let bars: Vec<Bar> = families
+        .iter()
+        .enumerate()
+        .map(|(i, f)| Bar::new(-(i as f64), f.milliseconds).name(f.label()))
+        .collect();
+    let labels: Vec<String> = families.iter().map(PassFamily::label).collect();
+    Plot::new("pass times")
+        .height(140.0)
+        .allow_scroll(false)
+        .y_axis_min_width(120.0)
+        .y_axis_formatter(move |mark, _| {
+            let index = -mark.value;
+            if (index - index.round()).abs() > 1e-6 || index < 0.0 {
+                return String::new();
+            }
+            labels
+                .get(index.round() as usize)
+                .cloned()
+                .unwrap_or_default()
+        })
+        .show(ui, |plot| {
+            plot.bar_chart(BarChart::new("pass time (ms)", bars).horizontal())
+        });
+}
+
+/// The recent frames' times (ms), oldest first.
+fn frame_history_plot(ui: &mut egui::Ui, history: &VecDeque<f64>) {
+    let points: PlotPoints<'_> = history
+        .iter()
+        .enumerate()
+        .map(|(i, v)| [i as f64, *v])
+        .collect();
+    Plot::new("frame history")
+        .height(140.0)
+        .allow_scroll(false)
+        .show(ui, |plot| plot.line(Line::new("frame (ms)", points)));
+}
+
+/// Every pass's time, then the technique's resources (with their memory) and counters.
+fn pass_and_resource_list(
+    ui: &mut egui::Ui,
+    passes: &[PassTiming],
+    instance: &dyn ShadowTechnique,
+) {
+    egui::ScrollArea::vertical()
+        .max_height(140.0)
+        .show(ui, |ui| {
+            for p in passes {
+                ui.label(format!("{}: {:.2} ms", p.name, p.milliseconds));
+            }
+            for r in instance.resources() {
+                ui.label(format!(
+                    "{}: {:?} {} {:.1} MiB",
+                    r.name,
+                    r.size,
+                    r.format,
+                    r.bytes as f64 / 1048576.0
+                ));
+            }
+            for (name, value) in instance.counters() {
+                ui.label(format!("{name}: {value}"));
+            }
+        });
 }
 
 /// Passes of one family (the part of their names before `:`, e.g. "Shadow map" for

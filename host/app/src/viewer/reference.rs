@@ -204,6 +204,29 @@ impl ReferenceOverlay {
 
     /// The panel: judge button, progress, metrics and overlay controls.
     pub fn panel(&mut self, ui: &mut egui::Ui, renderer: &mut Renderer) -> Option<String> {
+        let error = self.judge_controls(ui, renderer);
+        let stale = self.is_stale(renderer);
+        let Some(result) = &self.result else {
+            return error;
+        };
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut self.visible, "show error map");
+            ui.add(egui::Slider::new(&mut self.opacity, 0.0..=1.0).text("opacity"));
+        });
+        if stale {
+            ui.colored_label(
+                egui::Color32::from_rgb(230, 160, 40),
+                "stale: the view changed since it was judged (map hidden)",
+            );
+        }
+        ui.label(judgement_summary(result));
+        metrics_grid(ui, &result.metrics, &mut self.light);
+        error
+    }
+
+    /// The judge button, the live toggle and the CPU judge's progress; returns why judging
+    /// could not start, if it could not.
+    fn judge_controls(&mut self, ui: &mut egui::Ui, renderer: &mut Renderer) -> Option<String> {
         let mut error = None;
         ui.horizontal(|ui| {
             let button = ui
@@ -232,60 +255,56 @@ impl ReferenceOverlay {
                 );
             }
         });
-        let stale = self.is_stale(renderer);
-        let Some(result) = &self.result else {
-            return error;
-        };
-        ui.horizontal(|ui| {
-            ui.checkbox(&mut self.visible, "show error map");
-            ui.add(egui::Slider::new(&mut self.opacity, 0.0..=1.0).text("opacity"));
-        });
-        if stale {
-            ui.colored_label(
-                egui::Color32::from_rgb(230, 160, 40),
-                "stale: the view changed since it was judged (map hidden)",
-            );
-        }
-        let traced = match result.live_samples {
-            Some(0) => "live on the GPU, hard visibility".to_string(),
-            Some(samples) => format!("live on the GPU, {samples} area rays a pixel"),
-            None => "by the CPU judge".to_string(),
-        };
-        ui.label(format!(
-            "{} · {} triangles traced {traced} in {:.2} s · red false shadow, blue false lit",
-            result.view.technique, result.occluder_triangles, result.seconds
-        ));
-        egui::Grid::new("reference metrics")
-            .striped(true)
-            .show(ui, |ui| {
-                for heading in ["light", "false shadow", "false lit", "core fs/fl", "mae"] {
-                    ui.strong(heading);
-                }
-                ui.end_row();
-                for (i, metrics) in result.metrics.iter().enumerate() {
-                    if ui
-                        .selectable_label(self.light == i, format!("{i}"))
-                        .clicked()
-                    {
-                        self.light = i;
-                    }
-                    match metrics {
-                        Some(m) => {
-                            ui.label(format!("{:.4}", m.false_shadow));
-                            ui.label(format!("{:.4}", m.false_lit));
-                            ui.label(format!(
-                                "{:.4}/{:.4}",
-                                m.false_shadow_core, m.false_lit_core
-                            ));
-                            ui.label(format!("{:.4}", m.mae));
-                        }
-                        None => {
-                            ui.label("not supported");
-                        }
-                    }
-                    ui.end_row();
-                }
-            });
         error
     }
+}
+
+/// One line on a judgement: the technique, what traced the reference and how long it took,
+/// and the error map's colours.
+fn judgement_summary(result: &Judgement) -> String {
+    let traced = match result.live_samples {
+        Some(0) => "live on the GPU, hard visibility".to_string(),
+        Some(samples) => format!("live on the GPU, {samples} area rays a pixel"),
+        None => "by the CPU judge".to_string(),
+    };
+    format!(
+        "{} · {} triangles traced {traced} in {:.2} s · red false shadow, blue false lit",
+        result.view.technique, result.occluder_triangles, result.seconds
+    )
+}
+
+/// Each light's metrics, one row per light; clicking a light's number selects its error
+/// map.
+fn metrics_grid(ui: &mut egui::Ui, metrics: &[Option<Metrics>], selected: &mut usize) {
+    egui::Grid::new("reference metrics")
+        .striped(true)
+        .show(ui, |ui| {
+            for heading in ["light", "false shadow", "false lit", "core fs/fl", "mae"] {
+                ui.strong(heading);
+            }
+            ui.end_row();
+            for (i, metrics) in metrics.iter().enumerate() {
+                if ui
+                    .selectable_label(*selected == i, format!("{i}"))
+                    .clicked()
+                {
+                    *selected = i;
+                }
+                match metrics {
+                    Some(m) => {
+                        ui.label(format!("{:.4}", m.false_shadow));
+                        ui.label(format!("{:.4}", m.false_lit));
+                        ui.label(format!(
+                            "{:.4}/{:.4}",
+                            m.false_shadow_core, m.false_lit_core
+                        ));
+                        ui.label(format!("{:.4}", m.mae));
+                    }
+                    None => {
+                        ui.label("not supported");
+                    }
+                }
+                ui.end_row();
+            }
+        });
 }

@@ -235,36 +235,9 @@ impl TransmittanceTargets {
             usage: VISIBILITY_USAGE | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
-        // Every layer of the white texel: GL binds the whole texture, spare layers included.
-        let white_layers = if in_use {
-            0
-        } else {
-            texture.depth_or_array_layers()
-        };
-        for layer in 0..white_layers {
-            gpu.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d {
-                        x: 0,
-                        y: 0,
-                        z: layer,
-                    },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                &[255; 4],
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4),
-                    rows_per_image: None,
-                },
-                wgpu::Extent3d {
-                    width: 1,
-                    height: 1,
-                    depth_or_array_layers: 1,
-                },
-            );
+        if !in_use {
+            // Every layer of the white texel: GL binds the whole texture, spare layers included.
+            fill_white_texels(gpu, &texture);
         }
         let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some("transmittance slots (array)"),
@@ -273,17 +246,7 @@ impl TransmittanceTargets {
             ..Default::default()
         });
         let slot_views = if in_use {
-            (0..layers)
-                .map(|slot| {
-                    texture.create_view(&wgpu::TextureViewDescriptor {
-                        label: Some(&format!("transmittance slot {slot}")),
-                        dimension: Some(wgpu::TextureViewDimension::D2),
-                        base_array_layer: slot,
-                        array_layer_count: Some(1),
-                        ..Default::default()
-                    })
-                })
-                .collect()
+            slot_views(&texture, layers)
         } else {
             Vec::new()
         };
@@ -314,6 +277,50 @@ impl TransmittanceTargets {
                 && self.texture.height() == size.y
                 && self.slot_views.len() as u32 == slots.slot_count().max(1))
     }
+}
+
+/// Writes white into the one texel of every layer of `texture`.
+fn fill_white_texels(gpu: &GpuContext, texture: &wgpu::Texture) {
+    for layer in 0..texture.depth_or_array_layers() {
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: layer,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            &[255; 4],
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4),
+                rows_per_image: None,
+            },
+            wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+}
+
+/// One 2D view per layer of the transmittance slots, for render attachments.
+fn slot_views(texture: &wgpu::Texture, layers: u32) -> Vec<wgpu::TextureView> {
+    (0..layers)
+        .map(|slot| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some(&format!("transmittance slot {slot}")),
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: slot,
+                array_layer_count: Some(1),
+                ..Default::default()
+            })
+        })
+        .collect()
 }
 
 /// Indirect light (`Rgba16Float`), cleared to zero each frame, for techniques that add light:

@@ -120,6 +120,22 @@ macro_rules! render_context {
     };
 }
 
+/// The technique resource a frame shows: the debug view's, or the overlay's over the final
+/// image (the technique's `debug_view`).
+fn shown_resource<'a>(view: &'a View, overlay: Option<&'a Overlay>) -> Option<&'a str> {
+    match (view, overlay) {
+        (View::Resource(name), _) => Some(name.as_str()),
+        (
+            _,
+            Some(Overlay {
+                view: View::Resource(name),
+                ..
+            }),
+        ) => Some(name.as_str()),
+        _ => None,
+    }
+}
+
 /// Largest accepted output side.
 pub const MAX_OUTPUT_SIDE: u32 = 8192;
 
@@ -487,17 +503,7 @@ impl Renderer {
             return Err(self.fallback_later(error));
         }
         let overlay = overlay.filter(|o| *view == View::Final && o.view != View::Final);
-        let resource = match (view, overlay) {
-            (View::Resource(name), _) => Some(name.as_str()),
-            (
-                _,
-                Some(Overlay {
-                    view: View::Resource(name),
-                    ..
-                }),
-            ) => Some(name.as_str()),
-            _ => None,
-        };
+        let resource = shown_resource(view, overlay);
         self.frame.update(
             &self.gpu,
             &self.camera,
@@ -506,17 +512,7 @@ impl Renderer {
             &self.visibility.slots,
             self.size,
         );
-        let id = self.technique.registration.id;
-        if self.technique.pending != Changes::default() {
-            let changes = self.technique.pending;
-            let ctx = render_context!(self, resource);
-            let active = &mut self.technique;
-            let prepared = guarded(&self.gpu, id, || active.instance.prepare(&ctx, changes));
-            if let Err(e) = prepared {
-                return Err(self.fallback_later(e));
-            }
-            self.technique.pending = Changes::default();
-        }
+        self.prepare_pending(resource)?;
 
         // Views are checked before recording, so a bad one never leaves a recorded frame
         // unsubmitted (readbacks the technique set up for it would never arrive).
@@ -526,23 +522,11 @@ impl Renderer {
         if let Some(overlay) = overlay {
             self.debug_source(&overlay.view)?;
         }
+        let id = self.technique.registration.id;
         let ctx = render_context!(self, resource);
         let mut recorder = PassRecorder::new(&self.gpu, self.timestamps.as_ref())
             .with_statistics(self.statistics.as_ref());
-        self.gbuffer_pass.record(
-            &mut recorder,
-            &self.gbuffer,
-            &self.frame,
-            &self.scene,
-            &self.scene_buffers,
-        );
-        clear_visibility(
-            &mut recorder,
-            &self.gpu.device.limits(),
-            &self.visibility,
-            &self.transmittance,
-            &self.indirect,
-        );
+        self.record_technique_inputs(&mut recorder);
         recorder.set_owner(PassOwner::Technique);
         let active = &mut self.technique;
         let recorded = guarded(&self.gpu, id, || {
@@ -554,30 +538,7 @@ impl Renderer {
             return Err(self.fallback_later(e));
         }
         recorder.set_owner(PassOwner::Host);
-        match view {
-            View::Final => self.lighting.record(
-                &mut recorder,
-                &self.output_view,
-                &self.frame,
-                &self.gbuffer,
-                &self.lighting_inputs,
-            ),
-            other => {
-                let source = self.debug_source(other)?;
-                self.debug
-                    .record(&self.gpu, &mut recorder, &self.output_view, &source, None);
-            }
-        }
-        if let Some(overlay) = overlay {
-            let source = self.debug_source(&overlay.view)?;
-            self.debug.record(
-                &self.gpu,
-                &mut recorder,
-                &self.output_view,
-                &source,
-                Some(overlay.opacity),
-            );
-        }
+        self.record_output(&mut recorder, view, overlay)?;
         let timings = recorder.finish();
         let errors = self.gpu.take_uncaptured_errors();
         if !errors.is_empty() {
@@ -587,6 +548,77 @@ impl Renderer {
             }));
         }
         Ok(timings)
+    }
+
+    /// Prepares the technique for the changes made since its last preparation, if any.
+    fn prepare_pending(&mut self, resource: Option<&str>) -> Result<(), RenderError> {
+        if self.technique.pending == Changes::default() {
+            return Ok(());
+        }
+        let id = self.technique.registration.id;
+        let changes = self.technique.pending;
+        let ctx = render_context!(self, resource);
+        let active = &mut self.technique;
+        let prepared = guarded(&self.gpu, id, || active.instance.prepare(&ctx, changes));
+        if let Err(e) = prepared {
+            return Err(self.fallback_later(e));
+        }
+        self.technique.pending = Changes::default();
+        Ok(())
+    }
+
+    /// Records what the technique reads and writes: the G-buffer pass, and the visibility,
+    /// transmittance and indirect targets cleared.
+    fn record_technique_inputs(&self, recorder: &mut PassRecorder<'_>) {
+        self.gbuffer_pass.record(
+            recorder,
+            &self.gbuffer,
+            &self.frame,
+            &self.scene,
+            &self.scene_buffers,
+        );
+        clear_visibility(
+            recorder,
+            &self.gpu.device.limits(),
+            &self.visibility,
+            &self.transmittance,
+            &self.indirect,
+        );
+    }
+
+    /// Records the output image: the lit final image or a debug view, then the overlay
+    /// blended over it.
+    fn record_output(
+        &self,
+        recorder: &mut PassRecorder<'_>,
+        view: &View,
+        overlay: Option<&Overlay>,
+    ) -> Result<(), RenderError> {
+        match view {
+            View::Final => self.lighting.record(
+                recorder,
+                &self.output_view,
+                &self.frame,
+                &self.gbuffer,
+                &self.lighting_inputs,
+            ),
+            other => {
+                let source = self.debug_source(other)?;
+                self.debug
+                    .record(&self.gpu, recorder, &self.output_view, &source, None);
+            }
+        }
+        if let Some(overlay) = overlay {
+            let source = self.debug_source(&overlay.view)?;
+            self.debug.record(
+                &self.gpu,
+                recorder,
+                &self.output_view,
+                &source,
+                Some(overlay.opacity),
+            );
+        }
+        Ok(())
     }
 
     /// Re-reads the shader library (after files under `shaders/` changed) and rebuilds the host
