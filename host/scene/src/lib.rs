@@ -1018,7 +1018,7 @@ fn shape_mesh(desc: &MeshDesc) -> Result<MeshData, &'static str> {
     let count_ok = |n: u32| (3..=4096).contains(&n);
     Ok(match *desc {
         MeshDesc::Obj(_) | MeshDesc::Gltf(_) => {
-            unreachable!("model files are loaded, not generated")
+            return Err("names a model file, which is loaded rather than generated");
         }
         MeshDesc::Plane { size, subdivisions } => {
             if !positive(&[size]) || !(1..=1024).contains(&subdivisions) {
