@@ -338,6 +338,16 @@ fn compare_judges_views_along_the_paths_and_scores_final_images() {
     ]);
     let all = text(&out);
     assert!(out.status.success(), "{all}");
+    assert_view_rows(&out_dir);
+    assert_final_images(&out_dir);
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(report.contains("## Over the views") && report.contains("| sm-pcf | worst |"));
+    assert!(report.contains("## Final images"), "{report}");
+}
+
+/// results.csv of the three-view compare: a row per view, technique and light, then the
+/// worst and the mean of the views.
+fn assert_view_rows(out_dir: &std::path::Path) {
     let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv
         .lines()
@@ -366,7 +376,11 @@ fn compare_judges_views_along_the_paths_and_scores_final_images() {
         per_view.iter().any(|v| (v - per_view[0]).abs() > 1e-4),
         "the views differ along the path: {per_view:?}"
     );
-    // images.csv: one FLIP score per technique and view, then worst and mean; maps per view.
+}
+
+/// images.csv of the three-view compare: one FLIP score per technique and view, then worst
+/// and mean; maps per view.
+fn assert_final_images(out_dir: &std::path::Path) {
     let images = std::fs::read_to_string(out_dir.join("images.csv")).unwrap();
     let mut lines = images.lines();
     assert_eq!(
@@ -400,10 +414,11 @@ fn compare_judges_views_along_the_paths_and_scores_final_images() {
                 .is_file()
         );
     }
-    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
-    assert!(report.contains("## Over the views") && report.contains("| sm-pcf | worst |"));
-    assert!(report.contains("## Final images"), "{report}");
-    // A scene without paths cannot spread views.
+}
+
+#[test]
+fn compare_cannot_spread_views_over_a_scene_without_paths() {
+    let out_dir = temp_dir("compare-no-paths").join("results");
     let out = shadow_zoo(&[
         "compare",
         "--scene",

@@ -14,6 +14,7 @@ mod warped;
 pub use warped::{LispsmParams, PsmParams};
 
 use zoo_host::glam::Vec4;
+use zoo_host::kit::{NamedTextures, TextureSize, TextureSpec};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::light_space::Projection;
@@ -82,32 +83,22 @@ const SPLITS_VIEW: &str = "splits";
 const DENSITY_VIEW: &str = "texel density";
 const TOP_VIEW: &str = "split frusta (top view)";
 
-/// Screen-sized diagnostics (split colours, texel density) and the top view.
-struct Diagnostics {
-    splits: (wgpu::Texture, wgpu::TextureView),
-    density: (wgpu::Texture, wgpu::TextureView),
-    top_view: (wgpu::Texture, wgpu::TextureView),
-}
-
-impl Diagnostics {
-    fn new(device: &wgpu::Device, size: zoo_host::glam::UVec2) -> Diagnostics {
-        let target = |label| {
-            let usage = wgpu::TextureUsages::empty();
-            zoo_host::gpu::render_target(device, label, size, DIAGNOSTICS_FORMAT, usage)
-        };
-        let top = zoo_host::glam::UVec2::splat(top_view::SIZE);
-        Diagnostics {
-            splits: target("pssm split colours"),
-            density: target("pssm texel density"),
-            top_view: zoo_host::gpu::render_target(
-                device,
-                "pssm split frusta (top view)",
-                top,
-                DIAGNOSTICS_FORMAT,
-                wgpu::TextureUsages::COPY_DST,
-            ),
-        }
-    }
+/// Screen-sized diagnostics (split colours, texel density) and the top view, drawn on the CPU.
+fn diagnostics() -> NamedTextures {
+    let colour = Some(ViewMapping::Color { min: 0.0, max: 1.0 });
+    let top_view = TextureSpec {
+        size: TextureSize::Fixed(zoo_host::glam::UVec2::splat(top_view::SIZE)),
+        usage: wgpu::TextureUsages::COPY_DST,
+        ..TextureSpec::screen_target(TOP_VIEW, DIAGNOSTICS_FORMAT, colour)
+    };
+    NamedTextures::new(
+        "pssm",
+        [
+            TextureSpec::screen_target(SPLITS_VIEW, DIAGNOSTICS_FORMAT, colour),
+            TextureSpec::screen_target(DENSITY_VIEW, DIAGNOSTICS_FORMAT, colour),
+            top_view,
+        ],
+    )
 }
 
 /// Maps and the lookup, built at the first `prepare`.
@@ -115,7 +106,7 @@ struct Gpu {
     maps: ShadowMapSet,
     lookup: LookupPass<PssmLight>,
     filters: MapFilters,
-    diagnostics: Diagnostics,
+    diagnostics: NamedTextures,
 }
 
 impl Gpu {
@@ -138,7 +129,7 @@ impl Gpu {
             lookup: LookupPass::new(ctx, &maps, LOOKUP_PASS, shader)?,
             maps,
             filters: MapFilters::read(ctx.shaders)?,
-            diagnostics: Diagnostics::new(&ctx.gpu.device, ctx.size),
+            diagnostics: diagnostics(),
         })
     }
 }
@@ -213,10 +204,7 @@ impl ShadowTechnique for Pssm {
         if let Some(maps) = gpu.maps.maps() {
             out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
         }
-        let d = &gpu.diagnostics;
-        out.push(ResourceInfo::texture(SPLITS_VIEW, &d.splits.0, true));
-        out.push(ResourceInfo::texture(DENSITY_VIEW, &d.density.0, true));
-        out.push(ResourceInfo::texture(TOP_VIEW, &d.top_view.0, true));
+        out.extend(gpu.diagnostics.resources());
         if let Some(cameras) = gpu.maps.cameras() {
             out.push(ResourceInfo::buffer(
                 "layer cameras",
@@ -231,9 +219,7 @@ impl ShadowTechnique for Pssm {
         self.gpu.prepare(false, || Gpu::new(ctx, &self.params))?;
         let cascades = self.cascades();
         let gpu = self.gpu.get_mut()?;
-        if changes.resolution {
-            gpu.diagnostics = Diagnostics::new(&ctx.gpu.device, ctx.size);
-        }
+        gpu.diagnostics.prepare(ctx);
         let p = &self.params;
         (gpu.maps).prepare_with(ctx, changes, p.map.map_size, p.stabilise, &cascades);
         Ok(())
@@ -262,7 +248,14 @@ impl ShadowTechnique for Pssm {
             let shadowed = !l.frustums.is_empty();
             shadowed.then(|| light_uniform(p, map_filter, l, &distances, debug))
         };
-        let targets = [&d.splits.1, &d.density.1];
+        let (Some(splits), Some(density), Some(top)) = (
+            d.view(SPLITS_VIEW),
+            d.view(DENSITY_VIEW),
+            d.texture(TOP_VIEW),
+        ) else {
+            return Err(TechniqueError::not_prepared());
+        };
+        let targets = [splits, density];
         lookup.record(ctx, recorder, maps, p.debug_light, &targets, uniform)?;
         if ctx.debug_view == Some(TOP_VIEW) {
             let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
@@ -272,7 +265,7 @@ impl ShadowTechnique for Pssm {
                 .into_iter()
                 .collect();
             let pixels = top_view::draw(ctx.camera, aspect, &debug, &distances);
-            write_top_view(ctx.gpu, &d.top_view.0, &pixels);
+            write_top_view(ctx.gpu, top, &pixels);
         }
         Ok(())
     }
@@ -285,19 +278,9 @@ impl ShadowTechnique for Pssm {
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
         let gpu = self.gpu.built()?;
-        let colour = ViewMapping::Color { min: 0.0, max: 1.0 };
-        let image = |view| {
-            Some(DebugImage {
-                view,
-                mapping: colour,
-            })
-        };
         match resource {
-            SPLITS_VIEW => image(&gpu.diagnostics.splits.1),
-            DENSITY_VIEW => image(&gpu.diagnostics.density.1),
-            TOP_VIEW => image(&gpu.diagnostics.top_view.1),
             "shadow maps" => gpu.maps.debug_image(self.params.debug_light),
-            _ => None,
+            _ => gpu.diagnostics.debug_view(resource),
         }
     }
 

@@ -7,7 +7,7 @@
 
 use std::cell::Cell;
 
-use zoo_host::glam::UVec2;
+use zoo_host::kit::{NamedTextures, TextureSpec};
 use zoo_host::params::ParamError;
 use zoo_host::prelude::*;
 use zoo_host::scene::Light;
@@ -218,7 +218,8 @@ struct Gpu {
     maps: ShadowMapSet,
     lookup: LookupPass<WarpedLight>,
     filters: MapFilters,
-    density: (wgpu::Texture, wgpu::TextureView),
+    /// The texel-density view.
+    density: NamedTextures,
     fallbacks: u32,
 }
 
@@ -228,15 +229,10 @@ struct WarpedMaps {
     gpu: LazyGpu<Gpu>,
 }
 
-fn density_target(device: &wgpu::Device, size: UVec2) -> (wgpu::Texture, wgpu::TextureView) {
-    let usage = wgpu::TextureUsages::empty();
-    zoo_host::gpu::render_target(
-        device,
-        "warped texel density",
-        size,
-        DIAGNOSTICS_FORMAT,
-        usage,
-    )
+fn density_target() -> NamedTextures {
+    let colour = Some(ViewMapping::Color { min: 0.0, max: 1.0 });
+    let spec = TextureSpec::screen_target(DENSITY_VIEW, DIAGNOSTICS_FORMAT, colour);
+    NamedTextures::new("warped", [spec])
 }
 
 impl WarpedMaps {
@@ -266,7 +262,7 @@ impl Gpu {
             lookup: LookupPass::new(ctx, &maps, &format!("{} lookup", id.to_uppercase()), shader)?,
             maps,
             filters: MapFilters::read(ctx.shaders)?,
-            density: density_target(&ctx.gpu.device, ctx.size),
+            density: density_target(),
             fallbacks: 0,
         })
     }
@@ -277,7 +273,7 @@ impl ShadowTechnique for WarpedMaps {
         let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
-        let mut out = vec![ResourceInfo::texture(DENSITY_VIEW, &gpu.density.0, true)];
+        let mut out = gpu.density.resources();
         if let Some(maps) = gpu.maps.maps() {
             out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
         }
@@ -309,9 +305,7 @@ impl ShadowTechnique for WarpedMaps {
             fallbacks: Cell::new(0),
         };
         let gpu = self.gpu.get_mut()?;
-        if changes.resolution {
-            gpu.density = density_target(&ctx.gpu.device, ctx.size);
-        }
+        gpu.density.prepare(ctx);
         // Warped maps follow the camera: the set refits them on every change.
         (gpu.maps).prepare_with(ctx, changes, shared.map.map_size, false, &layout);
         if layout.fitted.get() > 0 {
@@ -347,7 +341,8 @@ impl ShadowTechnique for WarpedMaps {
                 normal_offset: s.map.normal_offset,
             })
         };
-        lookup.record(ctx, recorder, maps, s.debug_light, &[&density.1], uniform)
+        let density = (density.view(DENSITY_VIEW)).ok_or_else(TechniqueError::not_prepared)?;
+        lookup.record(ctx, recorder, maps, s.debug_light, &[density], uniform)
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -359,12 +354,8 @@ impl ShadowTechnique for WarpedMaps {
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
         let gpu = self.gpu.built()?;
         match resource {
-            DENSITY_VIEW => Some(DebugImage {
-                view: &gpu.density.1,
-                mapping: ViewMapping::Color { min: 0.0, max: 1.0 },
-            }),
             "shadow maps" => gpu.maps.debug_image(self.params.shared().debug_light),
-            _ => None,
+            _ => gpu.density.debug_view(resource),
         }
     }
 

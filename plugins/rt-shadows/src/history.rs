@@ -2,15 +2,19 @@
 //! floating-point history laid out like the visibility slots (each light's layer and channel),
 //! while nothing moves. The filter pass then resolves the history into the slots.
 
+use zoo_host::kit::{NamedTextures, TextureSize, TextureSpec};
 use zoo_host::prelude::*;
+use zoo_host::technique::ResourceInfo;
 
 /// Format of the history: averages of many frames need more than the slots' eight bits.
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const HISTORY: &str = "soft lights' history";
 
 /// The history and its binding.
 pub struct History {
-    pub texture: wgpu::Texture,
-    layer_views: Vec<wgpu::TextureView>,
+    texture: NamedTextures,
+    /// The slots' size and layers it was made for.
+    made_for: wgpu::Extent3d,
     /// The history as the filter pass reads it.
     pub group: kit::StageBindGroup,
 }
@@ -19,46 +23,35 @@ impl History {
     /// A history shaped like `ctx`'s visibility slots, bound as the `history` of the filter
     /// pass's `stage`.
     pub fn new(ctx: &RenderContext<'_>, stage: &kit::Stage) -> TechniqueResult<History> {
-        let device = &ctx.gpu.device;
-        let size = ctx.visibility.texture.size();
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("rt-shadows history"),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let layer_views = (0..size.depth_or_array_layers)
-            .map(|layer| {
-                texture.create_view(&wgpu::TextureViewDescriptor {
-                    label: Some(&format!("rt-shadows history layer {layer}")),
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("rt-shadows history view"),
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let history = ("history", wgpu::BindingResource::TextureView(&view));
+        let made_for = ctx.visibility.texture.size();
+        let spec = TextureSpec {
+            size: TextureSize::Fixed(glam::UVec2::new(made_for.width, made_for.height)),
+            layers: made_for.depth_or_array_layers,
+            array: true,
+            ..TextureSpec::screen_target(HISTORY, FORMAT, None)
+        };
+        let mut texture = NamedTextures::new("rt-shadows", [spec]);
+        texture.prepare(ctx);
+        let view = texture
+            .view(HISTORY)
+            .ok_or_else(TechniqueError::not_prepared)?;
+        let history = ("history", wgpu::BindingResource::TextureView(view));
         let group = stage.bind(ctx, "rt-shadows history", &[history])?;
         Ok(History {
             texture,
-            layer_views,
+            made_for,
             group,
         })
     }
 
     /// Whether it still has the slots' shape.
     pub fn fits(&self, ctx: &RenderContext<'_>) -> bool {
-        self.texture.size() == ctx.visibility.texture.size()
+        self.made_for == ctx.visibility.texture.size()
+    }
+
+    /// The history, for the memory table.
+    pub fn resources(&self) -> Vec<ResourceInfo> {
+        self.texture.resources()
     }
 }
 
@@ -74,14 +67,16 @@ pub fn accumulation_target() -> wgpu::ColorTargetState {
 }
 
 impl History {
-    /// Where light `light`'s traced visibility accumulates: its layer, kept.
+    /// Where light `light`'s traced visibility accumulates: its layer, kept (none for a light
+    /// beyond the slots it was made for).
     pub fn target(
         &self,
         ctx: &RenderContext<'_>,
         light: usize,
-    ) -> (&wgpu::TextureView, wgpu::LoadOp<wgpu::Color>) {
+    ) -> Option<(&wgpu::TextureView, wgpu::LoadOp<wgpu::Color>)> {
         let (layer, _) = ctx.visibility.slots.slot(light);
-        (&self.layer_views[layer as usize], wgpu::LoadOp::Load)
+        let view = self.texture.layer_view(HISTORY, layer)?;
+        Some((view, wgpu::LoadOp::Load))
     }
 
     /// The blend constant that weighs the new frame by `weight` in light `light`'s channel.

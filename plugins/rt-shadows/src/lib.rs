@@ -193,8 +193,11 @@ impl ShadowTechnique for RtShadows {
         let tracing: &dyn kit::SharedGroup = &tracing;
         (gpu.trace).record_with(ctx, rec, TRACE_PASS, per_light, &[], &[tracing])?;
         if let Some(history) = &gpu.history {
-            let layer =
-                |light: usize| (soft_lights.contains(&light)).then(|| history.target(ctx, light));
+            let layer = |light: usize| {
+                (soft_lights.contains(&light))
+                    .then(|| history.target(ctx, light))
+                    .flatten()
+            };
             let blend = |light| Some(History::blend(ctx, light, new_frame_weight));
             (gpu.accumulation).record(ctx, rec, tracing, per_light, layer, blend)?;
             let own = [&history.group];
@@ -249,8 +252,7 @@ impl ShadowTechnique for RtShadows {
         let Some(gpu) = self.gpu.built() else {
             return Vec::new();
         };
-        let history = (gpu.history.iter())
-            .map(|h| ResourceInfo::texture("soft lights' history", &h.texture, false));
+        let history = (gpu.history.iter()).flat_map(History::resources);
         let blocker = (gpu.blocker.resource()).filter(|_| self.params.blocker_distance);
         history.chain(blocker).collect()
     }

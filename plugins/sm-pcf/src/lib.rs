@@ -17,7 +17,7 @@ mod contact;
 
 use contact::ContactParams;
 
-use zoo_host::glam::UVec2;
+use zoo_host::kit::{NamedTextures, TextureSpec};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::{
@@ -72,18 +72,33 @@ struct Gpu {
     lookup: LookupPass<ShadowLight>,
     filters: MapFilters,
     /// Coverage (r) and receiver minus stored depth in texels (g), for the debug light.
-    diagnostics: (wgpu::Texture, wgpu::TextureView),
+    diagnostics: NamedTextures,
 }
 
-fn diagnostics_target(device: &wgpu::Device, size: UVec2) -> (wgpu::Texture, wgpu::TextureView) {
-    let usage = wgpu::TextureUsages::empty();
-    zoo_host::gpu::render_target(
-        device,
-        "sm-pcf diagnostics",
-        size,
-        DIAGNOSTICS_FORMAT,
-        usage,
-    )
+const DIAGNOSTICS: &str = "diagnostics";
+
+/// The diagnostics target, shown as its coverage and depth-difference channels.
+fn diagnostics_target() -> NamedTextures {
+    let mut spec = TextureSpec::screen_target(DIAGNOSTICS, DIAGNOSTICS_FORMAT, None);
+    spec.aliases = vec![
+        (
+            "coverage",
+            ViewMapping::Channel {
+                channel: 0,
+                min: 0.0,
+                max: 1.0,
+            },
+        ),
+        (
+            "depth difference",
+            ViewMapping::Channel {
+                channel: 1,
+                min: -2.0,
+                max: 2.0,
+            },
+        ),
+    ];
+    NamedTextures::new("sm-pcf", [spec])
 }
 
 impl Gpu {
@@ -106,7 +121,7 @@ impl Gpu {
             lookup: LookupPass::new(ctx, &maps, LOOKUP_PASS, shader)?,
             maps,
             filters: MapFilters::read(ctx.shaders)?,
-            diagnostics: diagnostics_target(&ctx.gpu.device, ctx.size),
+            diagnostics: diagnostics_target(),
         })
     }
 }
@@ -147,15 +162,7 @@ impl ShadowTechnique for ShadowMaps {
         if let Some(maps) = gpu.maps.maps() {
             out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
         }
-        let texture = &gpu.diagnostics.0;
-        out.push(ResourceInfo::texture("diagnostics", texture, false));
-        // Two views of the diagnostics texture (no memory of their own).
-        for view in ["coverage", "depth difference"] {
-            out.push(ResourceInfo {
-                bytes: 0,
-                ..ResourceInfo::texture(view, texture, true)
-            });
-        }
+        out.extend(gpu.diagnostics.resources());
         if let Some(cameras) = gpu.maps.cameras() {
             out.push(ResourceInfo::buffer(
                 "layer cameras",
@@ -181,9 +188,7 @@ impl ShadowTechnique for ShadowMaps {
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
         let gpu = self.gpu.prepare(false, || Gpu::new(ctx, &self.params))?;
-        if changes.resolution {
-            gpu.diagnostics = diagnostics_target(&ctx.gpu.device, ctx.size);
-        }
+        gpu.diagnostics.prepare(ctx);
         // Directional maps follow the camera; spot and point maps follow their lights.
         let p = &self.params;
         gpu.maps.prepare(ctx, changes, p.map.map_size, p.stable_fit);
@@ -203,18 +208,13 @@ impl ShadowTechnique for ShadowMaps {
             diagnostics,
         } = self.gpu.get_mut()?;
         maps.record(ctx, recorder, DEPTH_PASS)?;
+        let diagnostics =
+            (diagnostics.view(DIAGNOSTICS)).ok_or_else(TechniqueError::not_prepared)?;
         let uniform = |l: &LightMaps, debug| {
             let light = &ctx.lights[l.light];
             Some(shadow_light(p, contact, filters, l, light, debug))
         };
-        lookup.record(
-            ctx,
-            recorder,
-            maps,
-            p.debug_light,
-            &[&diagnostics.1],
-            uniform,
-        )
+        lookup.record(ctx, recorder, maps, p.debug_light, &[diagnostics], uniform)
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
@@ -232,17 +232,9 @@ impl ShadowTechnique for ShadowMaps {
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
         let gpu = self.gpu.built()?;
-        let channel = |channel, min, max| {
-            Some(DebugImage {
-                view: &gpu.diagnostics.1,
-                mapping: ViewMapping::Channel { channel, min, max },
-            })
-        };
         match resource {
             "shadow maps" => gpu.maps.debug_image(self.params.debug_light),
-            "coverage" => channel(0, 0.0, 1.0),
-            "depth difference" => channel(1, -2.0, 2.0),
-            _ => None,
+            _ => gpu.diagnostics.debug_view(resource),
         }
     }
 
