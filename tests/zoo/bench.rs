@@ -47,7 +47,13 @@ fn a_tiny_run_writes_well_formed_csv_markdown_and_plots() {
         .unwrap()
         .results;
     assert_eq!(results.len(), 4, "2 techniques x 2 sizes");
+    assert_tiny_csv(&out);
+    assert_tiny_summary_report_and_plots(&out);
+}
 
+/// bench.csv of the tiny run: the header, ordered statistics, three frames, the lighting
+/// pass's invocations, and a row per pass and total.
+fn assert_tiny_csv(out: &std::path::Path) {
     let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -104,7 +110,10 @@ fn a_tiny_run_writes_well_formed_csv_markdown_and_plots() {
     }
     // Planar has one pass per light (3) beyond the host's three; plus three totals each.
     assert_eq!(rows, 2 * (3 + 3) + 2 * (6 + 3), "{csv}");
+}
 
+/// summary.csv (the baseline's ratio 1), bench.md and the plots of the tiny run.
+fn assert_tiny_summary_report_and_plots(out: &std::path::Path) {
     let summary = std::fs::read_to_string(out.join("summary.csv")).unwrap();
     assert_eq!(summary.lines().count(), 5);
     for line in summary.lines().skip(1).filter(|l| l.contains("unshadowed")) {

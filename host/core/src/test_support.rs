@@ -515,3 +515,63 @@ pub fn crowd_scene(
             .unwrap_or_else(|e| panic!("{e}")),
     )
 }
+
+/// A crowd's reference and renderer (see [`crowd_scene`]), for judging one volume technique
+/// with several parameter sets against the one reference.
+pub struct CrowdRun {
+    technique: &'static str,
+    renderer: crate::Renderer,
+    reference: crate::judging::SceneReference,
+}
+
+impl CrowdRun {
+    /// `technique` on `scene` at `size`, and the scene's reference.
+    pub fn new(technique: &'static str, scene: crate::Scene, size: glam::UVec2) -> CrowdRun {
+        let mut renderer = crate::Renderer::new(gpu(), scene, size).unwrap();
+        let samples = crate::judging::DEFAULT_SAMPLES;
+        let reference =
+            crate::judging::SceneReference::compute(&mut renderer, samples, |_| {}).unwrap();
+        CrowdRun {
+            technique,
+            renderer,
+            reference,
+        }
+    }
+
+    /// The technique judged with parameters `params` over its defaults, and the number of
+    /// pieces each light's volumes took (its `light N volume pieces` counters).
+    pub fn judge(&mut self, params: &[(&str, &str)]) -> (crate::judging::Judged, Vec<f64>) {
+        let registration = crate::find_technique(self.technique).unwrap();
+        let schema = (registration.params)();
+        let mut values = crate::params::defaults(&schema);
+        let params: Vec<(String, String)> = (params.iter())
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        crate::params::apply_assignments(&schema, &mut values, &params).unwrap();
+        let (renderer, reference) = (&mut self.renderer, &self.reference);
+        let judged = crate::judging::judge_technique(renderer, reference, self.technique, &values);
+        let judged = judged.unwrap();
+        let counters = self.renderer.technique_instance().counters();
+        let pieces = (0..self.renderer.lights().len())
+            .map(|l| counter(&counters, &format!("light {l} volume pieces")).unwrap())
+            .collect();
+        (judged, pieces)
+    }
+
+    /// Asserts the judge's bounds of an exact method on every light of `judged` (of crowd
+    /// `scene`): core errors at most 0.001, all errors (raster edges) at most `edges`; and
+    /// that nothing was left out (no warnings).
+    pub fn assert_exact(&self, scene: &str, judged: &crate::judging::Judged, edges: f64) {
+        for score in &judged.scores {
+            let m = score.metrics.unwrap();
+            eprintln!("{}, {scene}, {}: {m:?}", self.technique, score.kind.name());
+            assert!(
+                m.false_lit_core + m.false_shadow_core <= 0.001
+                    && m.false_lit + m.false_shadow <= edges,
+                "{scene}, light {}: {m:?}",
+                score.light
+            );
+        }
+        assert!(judged.warnings.is_empty(), "{:?}", judged.warnings);
+    }
+}

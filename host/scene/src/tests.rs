@@ -345,9 +345,14 @@ newmtl leaves
 Kd 1 1 1\nmap_Kd -bm 1 textures\\leaf.png\nmap_d leaf_mask.png
 ";
 
-#[test]
-fn obj_materials_become_object_parts_with_textures_and_masks() {
-    let dir = temp_dir("materials");
+/// A bush of two OBJ parts whose materials come from its MTL library.
+const BUSH_RON: &str = r#"(camera: (position: (0, 0, 5), target: (0, 0, 0)),
+        lights: [Point(position: (0, 3, 3))],
+        objects: [(name: "bush", mesh: Obj("parts.obj"), alpha_cutoff: 0.25)])"#;
+
+/// A folder `name` with the bush's OBJ, MTL library, albedo texture and alpha mask.
+fn material_files(name: &str) -> std::path::PathBuf {
+    let dir = temp_dir(name);
     std::fs::create_dir_all(dir.join("textures")).unwrap();
     std::fs::write(dir.join("parts.obj"), MATERIAL_OBJ).unwrap();
     std::fs::write(dir.join("parts.mtl"), MATERIAL_MTL).unwrap();
@@ -357,10 +362,13 @@ fn obj_materials_become_object_parts_with_textures_and_masks() {
     image::GrayImage::from_fn(16, 16, |x, _| image::Luma([if x < 8 { 255 } else { 0 }]))
         .save(dir.join("leaf_mask.png"))
         .unwrap();
-    let ron = r#"(camera: (position: (0, 0, 5), target: (0, 0, 0)),
-        lights: [Point(position: (0, 3, 3))],
-        objects: [(name: "bush", mesh: Obj("parts.obj"), alpha_cutoff: 0.25)])"#;
-    let scene = Scene::from_ron(ron, &dir.join("bush.ron"), &dir).unwrap();
+    dir
+}
+
+#[test]
+fn obj_materials_become_object_parts_with_textures_and_masks() {
+    let dir = material_files("materials");
+    let scene = Scene::from_ron(BUSH_RON, &dir.join("bush.ron"), &dir).unwrap();
     let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(names, ["bush/painted", "bush/leaves"]);
     let (painted, leaves) = (&scene.objects[0], &scene.objects[1]);
@@ -398,9 +406,13 @@ fn obj_materials_become_object_parts_with_textures_and_masks() {
         scene.mesh.uvs[scene.mesh.indices[leaves.indices.start] as usize].y,
         1.0
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
 
-    // The object's own fields instead of the file's materials.
-    let own = ron.replace(
+#[test]
+fn objects_may_take_their_own_fields_instead_of_the_file_s_materials() {
+    let dir = material_files("own-materials");
+    let own = BUSH_RON.replace(
         "alpha_cutoff: 0.25",
         "file_materials: false, color: (0.1, 0.2, 0.3)",
     );
@@ -413,10 +425,14 @@ fn obj_materials_become_object_parts_with_textures_and_masks() {
     );
     assert!(scene.objects.iter().all(|o| o.alpha_mask.is_none()));
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
 
-    // A missing library: one warning naming it, and the object's own material.
+#[test]
+fn a_missing_material_library_warns_and_keeps_the_object_s_material() {
+    let dir = material_files("missing-library");
     std::fs::remove_file(dir.join("parts.mtl")).unwrap();
-    let scene = Scene::from_ron(ron, &dir.join("bush.ron"), &dir).unwrap();
+    let scene = Scene::from_ron(BUSH_RON, &dir.join("bush.ron"), &dir).unwrap();
     assert_eq!(scene.objects.len(), 1);
     assert_eq!(scene.objects[0].color, Vec3::splat(0.8));
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
