@@ -575,3 +575,34 @@ impl CrowdRun {
         assert!(judged.warnings.is_empty(), "{:?}", judged.warnings);
     }
 }
+
+/// Crowds whose volumes fit one buffer, drawn by volume technique `technique` again in
+/// pieces of a small budget (its `volume_buffer_mib`): a teapot's volume may need about 150
+/// thousand vertices (2.4 MiB), so in pieces of 1 MiB each teapot is cut into stretches of
+/// triangles and of edges; in pieces of 8 MiB, three cows share a piece. Asserts every
+/// light's shadows exact, and the same to the bit as in one piece. Returns early, saying so,
+/// where the shared models are absent.
+pub fn assert_crowds_in_pieces_match_one_piece(technique: &'static str) {
+    use crate::LightKind;
+    let all = [LightKind::Spot, LightKind::Directional, LightKind::Point];
+    for (model, count, lights, mib) in [("teapot", 24, &all[..], "1"), ("cow", 30, &all[..1], "8")]
+    {
+        let Some(scene) = crowd_scene(model, count, lights) else {
+            return;
+        };
+        let name = scene.name.clone();
+        let mut crowd = CrowdRun::new(technique, scene, glam::UVec2::new(192, 192));
+        let (whole, one) = crowd.judge(&[]);
+        let (pieced, several) = crowd.judge(&[("volume_buffer_mib", mib)]);
+        eprintln!("{name}: pieces {one:?}, then {several:?} of {mib} MiB");
+        assert!(one.iter().all(|&n| n == 1.0), "{one:?}");
+        assert!(several.iter().all(|&n| n > 2.0), "{several:?}");
+        crowd.assert_exact(&name, &pieced, 0.02);
+        for light in 0..lights.len() {
+            assert!(
+                whole.visibility[light] == pieced.visibility[light],
+                "{name}, light {light}: pieces change the shadows"
+            );
+        }
+    }
+}

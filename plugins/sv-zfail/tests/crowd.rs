@@ -6,37 +6,15 @@ use zoo_plugin_sv_zfail as _;
 
 use zoo_host::LightKind;
 use zoo_host::glam::UVec2;
-use zoo_host::test_support::{CrowdRun, crowd_scene};
+use zoo_host::test_support::{CrowdRun, assert_crowds_in_pieces_match_one_piece, crowd_scene};
 
 const TECHNIQUE: &str = "sv-zfail";
 
-/// Crowds whose volumes fit one buffer, drawn again in pieces of a small budget: a teapot's
-/// volume may need about 150 thousand vertices (2.4 MiB), so in pieces of 1 MiB each teapot
-/// is cut into stretches of triangles and of edges; in pieces of 8 MiB, three cows share a
-/// piece. Every light's shadows are exact, and the same to the bit as in one piece.
+/// Crowds whose volumes fit one buffer, drawn again in pieces of a small budget: exact, and
+/// the same to the bit as in one piece (see the helper).
 #[test]
 fn crowds_in_pieces_are_exact_and_match_one_piece() {
-    let all = [LightKind::Spot, LightKind::Directional, LightKind::Point];
-    for (model, count, lights, mib) in [("teapot", 24, &all[..], "1"), ("cow", 30, &all[..1], "8")]
-    {
-        let Some(scene) = crowd_scene(model, count, lights) else {
-            return;
-        };
-        let name = scene.name.clone();
-        let mut crowd = CrowdRun::new(TECHNIQUE, scene, UVec2::new(192, 192));
-        let (whole, one) = crowd.judge(&[]);
-        let (pieced, several) = crowd.judge(&[("volume_buffer_mib", mib)]);
-        eprintln!("{name}: pieces {one:?}, then {several:?} of {mib} MiB");
-        assert!(one.iter().all(|&n| n == 1.0), "{one:?}");
-        assert!(several.iter().all(|&n| n > 2.0), "{several:?}");
-        crowd.assert_exact(&name, &pieced, 0.02);
-        for light in 0..lights.len() {
-            assert!(
-                whole.visibility[light] == pieced.visibility[light],
-                "{name}, light {light}: pieces change the shadows"
-            );
-        }
-    }
+    assert_crowds_in_pieces_match_one_piece(TECHNIQUE);
 }
 
 /// Crowds of 150 to 300 fandisks (13 thousand triangles each, 4 million at 300) whose volumes
