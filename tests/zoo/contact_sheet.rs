@@ -12,7 +12,7 @@ use zoo_host::test_support::{gpu, workspace_root};
 
 /// Tile size of the README's contact sheet, which every test here shares (a sheet renders
 /// and judges every technique, most of it at a cost that does not depend on the tile size).
-pub const SHARED_TILE: UVec2 = UVec2::new(320, 240);
+pub const SHARED_TILE: UVec2 = UVec2::new(256, 192);
 /// The README's contact sheet, relative to the workspace root.
 const README_IMAGE: &str = "host/app/docs/contact-sheet.png";
 
