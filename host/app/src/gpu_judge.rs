@@ -98,7 +98,12 @@ pub fn trace_reference(renderer: &mut Renderer, samples: u32) -> anyhow::Result<
         Ok(read_traced(renderer))
     };
     let hard = traced(renderer, 1)?;
-    let area = traced(renderer, samples)?;
+    // One area ray is the hard ray: the same frame, not traced twice.
+    let area = if samples == 1 {
+        hard.clone()
+    } else {
+        traced(renderer, samples)?
+    };
     let seconds = start.elapsed().as_secs_f64();
 
     let coloured = renderer.scene().has_translucent_casters();
