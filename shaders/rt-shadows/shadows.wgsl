@@ -11,7 +11,7 @@
 #import "common/lighting.wgsl"
 #import "common/fullscreen.wgsl"
 #import "ray-tracing/trace.wgsl"
-#import "ray-tracing/origin.wgsl"
+#import "ray-tracing/shadow_ray.wgsl"
 #import "rt-shadows/light.wgsl"
 
 // Two unit vectors perpendicular to unit `w` and to each other.
@@ -58,32 +58,6 @@ fn pixel_rotation(pixel: vec2<u32>) -> vec2<f32> {
 struct Traced {
     visibility: f32,
     transmittance: vec3<f32>,
-}
-
-// Where rays from surface `s` start: off the surface on the camera's side (the G-buffer's
-// normal faces the camera) by the bound on the position's rounding, as the judge's rays
-// start (`ray-tracing/origin.wgsl`). A light behind the surface shadows its own points, which
-// it does not light either; a light grazing it is not taken for one behind by the rounding.
-fn ray_origin(s: Surface) -> vec3<f32> {
-    return rt_gbuffer_ray_origin(s.position, s.normal, camera.position);
-}
-
-// A shadow ray from surface `s`: from `origin` along unit `direction` up to `reach`.
-struct ShadowRay {
-    origin: vec3<f32>,
-    direction: vec3<f32>,
-    reach: f32,
-    // How far along the ray from `origin` it starts (past the rasteriser's error).
-    skipped: f32,
-}
-
-// The ray from `origin` (`ray_origin(s)`) along `direction` up to `reach`, started past the
-// stretch where it could meet its own surface again (`rt_gbuffer_raster_skip`).
-fn shadow_ray(s: Surface, origin: vec3<f32>, direction: vec3<f32>, reach: f32) -> ShadowRay {
-    // A pixel's side at unit distance: the view plane's height over the pixels.
-    let pixel = 2.0 / (camera.proj[1][1] * camera.size.y);
-    let skip = min(rt_gbuffer_raster_skip(s.position, s.normal, camera.position, direction, pixel), reach);
-    return ShadowRay(origin + direction * skip, direction, reach - skip, skip);
 }
 
 // The light's visibility, and its transmittance when `coloured` (white otherwise), from the

@@ -7,6 +7,7 @@
 mod bench;
 mod cli;
 mod contact_sheet;
+mod exact_methods;
 mod filtered_shadow_maps;
 mod foliage;
 mod gl_backend;

@@ -69,6 +69,24 @@ zoo_host::gpu_struct! {
     }
 }
 
+zoo_host::gpu_struct! {
+    "ray-tracing/batch.wgsl" =>
+    /// A run of caster triangles that a per-triangle pass visits
+    /// ([`CasterGeometry::caster_batches`]): triangles `first..first + count` of
+    /// `ray-tracing/trace.wgsl`'s triangles, in world space or placed by instance `instance`
+    /// ([`NO_INSTANCE`] for none), numbered from `start` in the pass's flat numbering.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub struct GpuBatch {
+        pub first: u32,
+        pub count: u32,
+        pub start: u32,
+        pub instance: u32,
+    }
+}
+
+/// [`GpuBatch::instance`] of triangles stored in world space.
+pub const NO_INSTANCE: u32 = u32::MAX;
+
 /// [`GpuInstance::translucent`] of a blocking caster (`RT_NO_OBJECT` in
 /// `ray-tracing/trace.wgsl`).
 pub const NO_OBJECT: u32 = u32::MAX;
@@ -103,6 +121,9 @@ pub struct CasterGeometry {
     pub translucent: Vec<GpuTranslucent>,
     /// The first node of every hierarchy.
     hierarchies: Vec<u32>,
+    /// The triangles of every hierarchy over triangles: its first node, first triangle and
+    /// triangle count.
+    triangle_runs: Vec<(u32, u32, u32)>,
     /// Triangles traced, an instance's each time.
     traced: usize,
 }
@@ -127,6 +148,7 @@ impl CasterGeometry {
             },
             translucent: Vec::new(),
             hierarchies: Vec::new(),
+            triangle_runs: Vec::new(),
             traced: casters.traced_count(),
         };
         geometry.append_hierarchy(&blocking);
@@ -237,6 +259,8 @@ impl CasterGeometry {
             self.texcoords.push(GpuTexcoords { uv: caster.uv });
         }
         self.hierarchies.push(node_base);
+        let count = self.triangles.len() as u32 - triangle_base;
+        self.triangle_runs.push((node_base, triangle_base, count));
         Some(node_base)
     }
 
@@ -253,6 +277,33 @@ impl CasterGeometry {
             }
         }
         deepest
+    }
+
+    /// Every caster triangle as runs a per-triangle pass visits, numbered in one flat
+    /// sequence: the blocking (opaque and masked) ones drawn once, in world space, then the
+    /// translucent ones drawn once, then each instance's shared triangles once per instance
+    /// (not copied).
+    pub fn caster_batches(&self) -> Vec<GpuBatch> {
+        let run = |root: u32| {
+            let found = self.triangle_runs.iter().find(|(node, _, _)| *node == root);
+            found.map(|&(_, first, count)| (first, count))
+        };
+        let drawn_once = [(NO_INSTANCE, 0), (NO_INSTANCE, self.roots.translucent)];
+        let placed = (self.instances.iter().enumerate()).map(|(index, i)| (index as u32, i.root));
+        let mut start = 0;
+        (drawn_once.into_iter().chain(placed))
+            .filter_map(|(instance, root)| {
+                let (first, count) = run(root)?;
+                let batch = GpuBatch {
+                    first,
+                    count,
+                    start,
+                    instance,
+                };
+                start += count;
+                Some(batch)
+            })
+            .collect()
     }
 
     /// Shadow-casting triangles stored (the placeholder of a scene without blocking casters
@@ -294,11 +345,12 @@ pub(crate) fn entries() -> Vec<wgpu::BindGroupLayoutEntry> {
 }
 
 /// Builds and uploads the hierarchy of `ctx`'s scene: its bind group and its size (without
-/// the time); an error when it is deeper than the traversal's stack holds.
+/// the time), and its blocking casters' batches; an error when it is deeper than the
+/// traversal's stack holds.
 pub(crate) fn upload(
     ctx: &RenderContext<'_>,
     layout: &wgpu::BindGroupLayout,
-) -> TechniqueResult<(wgpu::BindGroup, BuildStats)> {
+) -> TechniqueResult<((wgpu::BindGroup, BuildStats), Vec<GpuBatch>)> {
     let geometry = CasterGeometry::of(ctx.scene);
     let depth = geometry.depth();
     if depth >= STACK_SIZE {
@@ -362,7 +414,7 @@ pub(crate) fn upload(
         }),
         milliseconds: 0.0,
     };
-    Ok((bind_group, stats))
+    Ok(((bind_group, stats), geometry.caster_batches()))
 }
 #[cfg(test)]
 mod tests {
@@ -545,6 +597,51 @@ mod tests {
         assert_eq!(objects, [0, 1]);
         assert_eq!(geometry.translucent.len(), 2);
         assert!((2..STACK_SIZE).contains(&geometry.depth()));
+    }
+
+    #[test]
+    fn batches_number_every_traced_triangle_once_and_each_instance_its_own() {
+        let scene = zoo_host::test_support::scene_from_ron(
+            "batches.ron",
+            r#"(camera: (position: (0, 3, 6), target: (0, 0, 0)),
+                lights: [Point(position: (0, 4, 0))],
+                objects: [
+                    (mesh: Plane(size: 10)),
+                    (mesh: Box(size: (1, 1, 1)), opacity: 0.5),
+                    (mesh: Box(size: (1, 1, 1)), instances: [
+                        (translation: (2, 0.5, 0)),
+                        (translation: (-2, 1, 0), scale: (1, 2, 1)),
+                    ]),
+                ])"#,
+        );
+        let geometry = CasterGeometry::of(&scene);
+        let batches = geometry.caster_batches();
+        // The plane and the glass box drawn once, then each box instance.
+        let runs: Vec<(u32, u32)> = batches.iter().map(|b| (b.count, b.instance)).collect();
+        assert_eq!(
+            runs,
+            [(2, NO_INSTANCE), (12, NO_INSTANCE), (12, 0), (12, 1)]
+        );
+        let mut start = 0;
+        for batch in &batches {
+            assert_eq!(batch.start, start, "{batches:?}");
+            assert!((batch.first + batch.count) as usize <= geometry.triangles.len());
+            start += batch.count;
+        }
+        assert_eq!(start as usize, geometry.traced_count());
+        // The instances share their mesh's triangles.
+        assert_eq!(batches[2].first, batches[3].first);
+
+        // A scene of instances only: no stand-in triangle drawn once.
+        let only_instances = zoo_host::test_support::scene_from_ron(
+            "instances-only.ron",
+            r#"(camera: (position: (0, 3, 6), target: (0, 0, 0)),
+                lights: [Point(position: (0, 4, 0))],
+                objects: [(mesh: Box(size: (1, 1, 1)), instances: [(translation: (2, 0.5, 0))])])"#,
+        );
+        let batches = CasterGeometry::of(&only_instances).caster_batches();
+        assert_eq!(batches.len(), 1);
+        assert_eq!((batches[0].count, batches[0].instance), (12, 0));
     }
 
     #[test]

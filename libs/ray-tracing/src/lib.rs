@@ -34,8 +34,8 @@ mod origin;
 mod query;
 
 pub use compute::{
-    CasterGeometry, GpuInstance, GpuNode, GpuRoots, GpuTexcoords, GpuTriangle, NO_OBJECT,
-    STACK_SIZE,
+    CasterGeometry, GpuBatch, GpuInstance, GpuNode, GpuRoots, GpuTexcoords, GpuTriangle,
+    NO_INSTANCE, NO_OBJECT, STACK_SIZE,
 };
 pub use origin::{ERROR_MODULE, RASTER_SUBPIXEL};
 pub use query::GpuMaskedTriangle;
@@ -365,6 +365,10 @@ impl BuildStats {
 pub struct RayTracing {
     pub bind_group: wgpu::BindGroup,
     pub stats: BuildStats,
+    /// The casters as runs of triangles for per-triangle passes
+    /// ([`CasterGeometry::caster_batches`]; the portable traversal's only, empty for ray
+    /// queries).
+    pub batches: Vec<GpuBatch>,
     /// The scene vertex buffer it was built from (a new scene has a new one).
     vertices: wgpu::Buffer,
 }
@@ -379,14 +383,15 @@ impl RayTracing {
         layout: &wgpu::BindGroupLayout,
     ) -> TechniqueResult<RayTracing> {
         let start = std::time::Instant::now();
-        let (bind_group, mut stats) = match tracer {
+        let ((bind_group, mut stats), batches) = match tracer {
             Tracer::Compute => compute::upload(ctx, layout)?,
-            Tracer::RayQuery => query::upload(ctx, layout)?,
+            Tracer::RayQuery => (query::upload(ctx, layout)?, Vec::new()),
         };
         stats.milliseconds = start.elapsed().as_secs_f64() * 1000.0;
         Ok(RayTracing {
             bind_group,
             stats,
+            batches,
             vertices: ctx.scene_buffers.vertices.clone(),
         })
     }

@@ -1,0 +1,93 @@
+//! The buffers of the volume passes for one frame size: the view samples (each pixel's hard
+//! shadow ray), the hierarchy's boxes, the shadowed flags, and the casters' batches, with each
+//! stage's bind group over them.
+
+use zoo_host::gpu::GpuType;
+use zoo_host::kit::{Stage, StageBindGroup};
+use zoo_host::prelude::*;
+use zoo_ray_tracing::GpuBatch;
+
+/// Bytes of one view sample (`ViewSample` in the shader: two `vec4<f32>`).
+const SAMPLE_BYTES: u64 = 32;
+/// Bytes of one node's box (two `vec4<f32>`).
+const NODE_BYTES: u64 = 32;
+/// Depth clusters a tile holds (`CLUSTERS` in the shader).
+pub(crate) const CLUSTERS: u64 = 2;
+/// Children per side of a node, and pixels per side of a tile (`BRANCHING` in the shader).
+pub(crate) const BRANCHING: u32 = 8;
+/// Pixels per side of a node of each level: tiles, then 8x8 tiles twice.
+pub(crate) const LEVEL_SPANS: [u32; 3] = [BRANCHING, BRANCHING.pow(2), BRANCHING.pow(3)];
+
+/// The stages that bind the buffers: samples, the two reductions, triangles and resolve.
+pub type Stages<'a> = (&'a Stage, &'a [Stage; 2], &'a Stage, &'a Stage);
+
+/// The buffers and each stage's bind group over them.
+pub struct ViewSamples {
+    size: zoo_host::glam::UVec2,
+    /// The bind groups of the samples, the two reductions and the triangle stages.
+    pub groups: [StageBindGroup; 4],
+    /// The resolve stage's bind group (the shadowed flags).
+    pub resolve_group: StageBindGroup,
+}
+
+impl ViewSamples {
+    /// Buffers for `ctx`'s frame size and the casters' `batches`, bound for `stages`.
+    pub fn new(
+        ctx: &RenderContext<'_>,
+        (samples, reduce, triangles, resolve): Stages<'_>,
+        batches: &[GpuBatch],
+    ) -> TechniqueResult<ViewSamples> {
+        let size = ctx.size;
+        let pixels = u64::from(size.x) * u64::from(size.y);
+        // Level 0 holds [`CLUSTERS`] nodes a tile.
+        let nodes: u64 = (LEVEL_SPANS.iter().zip([CLUSTERS, 1, 1]))
+            .map(|(span, count)| {
+                count * u64::from(size.x.div_ceil(*span)) * u64::from(size.y.div_ceil(*span))
+            })
+            .sum();
+        let device = &ctx.gpu.device;
+        let storage = |label: &str, bytes: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let view_samples = storage("per-triangle volumes view samples", pixels * SAMPLE_BYTES);
+        let node_bounds = storage("per-triangle volumes node boxes", nodes * NODE_BYTES);
+        let shadowed = storage("per-triangle volumes shadowed", pixels * 4);
+        let batch_bytes = zoo_host::gpu::gpu_bytes(batches);
+        let batch_buffer = storage(
+            "per-triangle volumes caster batches",
+            (batch_bytes.len() as u64).max(GpuBatch::SIZE as u64),
+        );
+        ctx.gpu.queue.write_buffer(&batch_buffer, 0, &batch_bytes);
+        let resources = [
+            ("view_samples", view_samples.as_entire_binding()),
+            ("node_bounds", node_bounds.as_entire_binding()),
+            ("shadowed", shadowed.as_entire_binding()),
+            ("batches", batch_buffer.as_entire_binding()),
+        ];
+        let bind = |stage: &Stage| stage.bind(ctx, "per-triangle volumes buffers", &resources);
+        Ok(ViewSamples {
+            size,
+            groups: [
+                bind(samples)?,
+                bind(&reduce[0])?,
+                bind(&reduce[1])?,
+                bind(triangles)?,
+            ],
+            resolve_group: resolve.bind(
+                ctx,
+                "per-triangle volumes resolve",
+                &[("shadowed", shadowed.as_entire_binding())],
+            )?,
+        })
+    }
+
+    /// Whether they were made for `ctx`'s frame size.
+    pub fn fits(&self, ctx: &RenderContext<'_>) -> bool {
+        self.size == ctx.size
+    }
+}
