@@ -613,12 +613,15 @@ fn render_without_a_technique_writes_the_contact_sheet_and_its_table() {
     let dir = std::env::temp_dir().join(format!("zoo-cli-sheet-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let png = dir.join("sheet.png");
-    // One sun, so each technique renders one map (the default scene's sheet, rendered and
-    // judged in-process, is `contact_sheet`'s).
+    // One sun, so each technique renders one map, and two techniques (the default scene's
+    // sheet of every technique, rendered and judged in-process, is `contact_sheet`'s).
+    let techniques = ["sm-pcf", "rt-shadows"];
     let out = shadow_zoo(&[
         "render",
         "--scene",
         "scenes/skylight-room.ron",
+        "--techniques",
+        &techniques.join(","),
         "--size",
         "96x64",
         "--out",
@@ -636,18 +639,35 @@ fn render_without_a_technique_writes_the_contact_sheet_and_its_table() {
             l.starts_with("reference (")
                 || crate::shipped_techniques()
                     .iter()
-                    .any(|r| l.starts_with(r.id))
+                    .any(|r| l.starts_with(&format!("{} ", r.id)))
         })
         .collect();
-    assert_eq!(
-        table_rows.len(),
-        crate::shipped_techniques().len() + 2,
-        "{all}"
-    );
-    let layout =
-        shadow_zoo::contact_sheet::Layout::new((96, 64), crate::shipped_techniques().len() + 2);
+    assert_eq!(table_rows.len(), techniques.len() + 2, "{all}");
+    for id in techniques {
+        assert!(table_rows.iter().any(|l| l.starts_with(id)), "{id}: {all}");
+    }
+    let layout = shadow_zoo::contact_sheet::Layout::new((96, 64), techniques.len() + 2);
     let image = image::open(&png).unwrap();
     assert_eq!((image.width(), image.height()), layout.size());
+    // An unknown id is named before any work; a sheet of one technique cannot take `--set`
+    // for another.
+    for (list, set, expected) in [
+        ("sm-pcf,nope", "sm-pcf.map_size=512", "nope"),
+        ("sm-pcf", "vsm.map_size=512", "vsm"),
+    ] {
+        let out = shadow_zoo(&[
+            "render",
+            "--techniques",
+            list,
+            "--set",
+            set,
+            "--out",
+            png.to_str().unwrap(),
+        ]);
+        let all = text(&out);
+        assert!(!out.status.success() && all.contains(expected), "{all}");
+        assert!(!all.contains("panicked"), "{all}");
+    }
 }
 
 /// Without a usable adapter the first command prints one clear message with the fix for the

@@ -121,8 +121,11 @@ fn deferred_lighting_matches_cpu_shading_with_64_packed_lights() {
     assert_matches_cpu_shading("many-lights.ron", UVec2::new(128, 96));
 }
 
+/// Every technique at its cheapest renders planar-room lit, never brighter than unshadowed,
+/// with every pass timed, and each of its viewable resources renders without disabling it
+/// (one loop: each technique is set up and renders its first frame once).
 #[test]
-fn every_technique_renders_lit_and_finite() {
+fn every_technique_renders_lit_and_finite_and_shows_its_resources() {
     let scene = load("planar-room.ron");
     let size = UVec2::new(160, 120);
     let mut renderer = Renderer::new(gpu(), scene.clone(), size).unwrap();
@@ -143,6 +146,7 @@ fn every_technique_renders_lit_and_finite() {
 
     // At their cheapest settings: the contact sheet renders and judges every technique's
     // defaults.
+    let mut views_shown = 0;
     for registration in crate::shipped_techniques() {
         let id = registration.id;
         let values = zoo_host::test_support::cheapest_params(&(registration.params)());
@@ -198,7 +202,33 @@ fn every_technique_renders_lit_and_finite() {
             id == "unshadowed" || !recorded.is_empty(),
             "{id} recorded no passes"
         );
+        views_shown += show_every_viewable_resource(&mut renderer);
     }
+    assert!(
+        views_shown >= crate::shipped_techniques().len() - 1,
+        "only {views_shown} debug views"
+    );
+}
+
+/// Renders every viewable resource of the technique set in `renderer` (after a frame), which
+/// must not disable it; returns how many.
+fn show_every_viewable_resource(renderer: &mut Renderer) -> usize {
+    let id = renderer.technique().id;
+    let viewable: Vec<String> = (renderer.technique_instance().resources().into_iter())
+        .filter(|r| r.viewable)
+        .map(|r| r.name)
+        .collect();
+    for name in &viewable {
+        renderer
+            .render(&View::Resource(name.clone()))
+            .unwrap_or_else(|e| panic!("{id}: view `{name}`: {e}"));
+        assert_eq!(
+            renderer.technique().id,
+            id,
+            "`{name}` disabled the technique"
+        );
+    }
+    viewable.len()
 }
 
 #[test]
@@ -250,40 +280,6 @@ fn debug_views_render_and_unknown_views_are_errors() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("not a view of `unshadowed`"), "{err}");
-}
-
-#[test]
-fn every_viewable_resource_of_every_technique_renders() {
-    let scene = load("planar-room.ron");
-    let mut renderer = Renderer::new(gpu(), scene, UVec2::new(96, 64)).unwrap();
-    let mut shown = 0;
-    for registration in crate::shipped_techniques() {
-        let values = zoo_host::test_support::cheapest_params(&(registration.params)());
-        renderer.set_technique(registration.id, &values).unwrap();
-        renderer.render(&View::Final).unwrap();
-        let viewable: Vec<String> = renderer
-            .technique_instance()
-            .resources()
-            .into_iter()
-            .filter(|r| r.viewable)
-            .map(|r| r.name)
-            .collect();
-        for name in viewable {
-            renderer
-                .render(&View::Resource(name.clone()))
-                .unwrap_or_else(|e| panic!("{}: view `{name}`: {e}", registration.id));
-            assert_eq!(
-                renderer.technique().id,
-                registration.id,
-                "`{name}` disabled the technique"
-            );
-            shown += 1;
-        }
-    }
-    assert!(
-        shown >= crate::shipped_techniques().len() - 1,
-        "only {shown} debug views"
-    );
 }
 
 #[test]

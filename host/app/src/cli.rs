@@ -141,9 +141,12 @@ pub struct RenderArgs {
     /// Scene file (RON). Defaults to the built-in planar-room scene.
     #[arg(long)]
     pub scene: Option<PathBuf>,
-    /// Technique id (see `shadow-zoo list`). Without it, a contact sheet of all techniques.
+    /// Technique id (see `shadow-zoo list`). Without it, a contact sheet of `--techniques`.
     #[arg(long)]
     pub technique: Option<String>,
+    /// The contact sheet's techniques: comma-separated ids, or `all`.
+    #[arg(long, default_value = "all", conflicts_with = "technique")]
+    pub techniques: String,
     /// Output size as WIDTHxHEIGHT (of each tile on a contact sheet).
     #[arg(long, default_value = "512x512", value_parser = parse_size)]
     pub size: UVec2,

@@ -109,7 +109,7 @@ fn render_sheet(args: &RenderArgs) -> anyhow::Result<()> {
             args.view
         );
     }
-    let registry = zoo_host::registry();
+    let registry = crate::compare::select_techniques(&args.techniques)?;
     let params = crate::compare::technique_params(&registry, &args.set)?;
     let started = std::time::Instant::now();
     let scene = load_scene(args.scene.as_deref())?;
