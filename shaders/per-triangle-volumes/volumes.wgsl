@@ -327,6 +327,9 @@ fn may_hold(volume: Volume, p: vec3<f32>) -> bool {
 struct Caster {
     index: u32,
     volume: Volume,
+    // Whether the triangle comes within the light's range (a point or spot light's samples
+    // all lie within it, so a triangle beyond it stops no ray).
+    in_range: bool,
     opaque: bool,
     instanced: bool,
     to_local: array<vec4<f32>, 3>,
@@ -375,8 +378,8 @@ fn batch_of(flat: u32) -> GpuBatch {
     return batches[low];
 }
 
-// Workgroups of `cs_triangles` (`TRIANGLE_GROUPS` in the plugin): each takes every
-// `TRIANGLE_GROUPS`-th triangle in turn, enough workgroups to fill a GPU, and few enough that
+// Workgroups of `cs_triangles` (`TRIANGLE_GROUPS` in the plugin): each takes 64 triangles in
+// turn, every `TRIANGLE_GROUPS`-th 64; enough workgroups to fill a GPU, and few enough that
 // starting them costs little on a CPU's.
 const TRIANGLE_GROUPS: u32 = 2048u;
 // Invocations of a `cs_triangles` workgroup: one a child of a node, one a pixel of a tile.
@@ -394,8 +397,26 @@ var<workgroup> middle_count: atomic<u32>;
 // The level-0 clusters of the current middle node that the volume reaches, and their count.
 var<workgroup> cluster_queue: array<u32, 128>;
 var<workgroup> cluster_count: atomic<u32>;
+// The triangles of the workgroup's current 64 that reach the hierarchy, and their count.
+var<workgroup> triangle_queue: array<u32, GROUP>;
+var<workgroup> triangle_count: atomic<u32>;
 // A queue's length, read by one invocation for all.
 var<workgroup> count_shared: u32;
+
+// Whether triangle (a, b, c) in mesh space may come within `range` (in world space) of the
+// light at `light` (in mesh space): its bounding sphere against the range, stretched by the
+// most that world-to-mesh placement `m` can stretch a length (its Frobenius norm bounds that).
+fn within_range(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, light: vec3<f32>, range: f32, m: array<vec4<f32>, 3>) -> bool {
+    let centre = (a + b + c) / 3.0;
+    let radius = sqrt(max(distance_sq(a, centre), max(distance_sq(b, centre), distance_sq(c, centre))));
+    let stretch = sqrt(dot(m[0].xyz, m[0].xyz) + dot(m[1].xyz, m[1].xyz) + dot(m[2].xyz, m[2].xyz));
+    // (With the planes' rounding to spare.)
+    return distance(centre, light) - radius <= range * stretch * 1.001;
+}
+
+fn distance_sq(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    return dot(a - b, a - b);
+}
 
 // Caster triangle number `flat` of the flat list, with its volume from the frame's light.
 fn load_caster(flat: u32) -> Caster {
@@ -423,17 +444,40 @@ fn load_caster(flat: u32) -> Caster {
     }
     let tri = rt_triangles[caster.index];
     caster.volume = volume_of(tri.v0, tri.v0 + tri.e1, tri.v0 + tri.e2, local_light, m);
+    caster.in_range = light.kind == LIGHT_DIRECTIONAL || within_range(tri.v0, tri.v0 + tri.e1, tri.v0 + tri.e2, local_light.xyz, light.range, m);
     // Wholly inside the volume of an opaque triangle, every ray crosses it; a masked one's
     // rays are each tested at their crossing's texture coordinates.
     caster.opaque = tri.mask_layer < 0;
     return caster;
 }
 
-// Each workgroup takes caster triangles in turn, each down the hierarchy: the top nodes one
-// after another, the 64 middle children of a top node the volume reaches one an invocation,
-// then the 8x8 tiles (two clusters each) of each middle node it reaches one an invocation, then
-// each cluster it reaches one pixel an invocation. Nodes wholly inside an opaque triangle's volume are shadowed
-// whole; the samples of the clusters it straddles are tested exactly.
+// Whether `volume` reaches any of the `count` nodes from `first` (is not outside all).
+fn reaches_a_node(volume: Volume, first: u32, count: u32) -> bool {
+    for (var node = first; node < first + count; node++) {
+        if classify(volume, node) != OUTSIDE {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Whether any of the `count` nodes from `first` holds a sample (is not empty).
+fn any_sample(first: u32, count: u32) -> bool {
+    for (var node = first; node < first + count; node++) {
+        if all(node_bounds[2u * node].xyz <= node_bounds[2u * node + 1u].xyz) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Each workgroup takes caster triangles 64 at a time: each invocation drops its triangle if it
+// is out of the light's range or its volume misses every top node, and the rest go down the
+// hierarchy one at a time: the top nodes one after another, the 64 middle children of a top
+// node the volume reaches one an invocation, then the 8x8 tiles (two clusters each) of each
+// middle node it reaches one an invocation, then the pixels of each cluster it reaches, shared
+// out over the invocations. Nodes wholly inside an opaque triangle's volume are shadowed whole;
+// the samples of the clusters it straddles are tested exactly.
 @compute @workgroup_size(64)
 fn cs_triangles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let top = level_size(2u);
@@ -441,91 +485,119 @@ fn cs_triangles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     let bottom = level_size(0u);
     let top_offset = level_offset(2u);
     let middle_offset = level_offset(1u);
-    for (var flat = group.x; flat < ptv_light.triangles; flat += TRIANGLE_GROUPS) {
+    // A light that reaches no sample: nothing to shadow.
+    if lane == 0u {
+        class_shared = u32(any_sample(top_offset, top.x * top.y));
+    }
+    if workgroupUniformLoad(&class_shared) == 0u {
+        return;
+    }
+    for (var first = group.x * GROUP; first < ptv_light.triangles; first += TRIANGLE_GROUPS * GROUP) {
+        // The workgroup's next 64 triangles, one an invocation: those in the light's range
+        // whose volume reaches a top node are queued.
         if lane == 0u {
-            caster_shared = load_caster(flat);
+            atomicStore(&triangle_count, 0u);
         }
-        let caster = workgroupUniformLoad(&caster_shared);
-        for (var t = 0u; t < top.x * top.y; t++) {
-            let tile = vec2<u32>(t % top.x, t / top.x);
+        workgroupBarrier();
+        if first + lane < ptv_light.triangles {
+            let candidate = load_caster(first + lane);
+            if candidate.in_range && reaches_a_node(candidate.volume, top_offset, top.x * top.y) {
+                triangle_queue[atomicAdd(&triangle_count, 1u)] = first + lane;
+            }
+        }
+        workgroupBarrier();
+        if lane == 0u {
+            count_shared = atomicLoad(&triangle_count);
+        }
+        let queued = workgroupUniformLoad(&count_shared);
+        for (var q = 0u; q < queued; q++) {
             if lane == 0u {
-                class_shared = classify(caster.volume, top_offset + t);
+                caster_shared = load_caster(triangle_queue[q]);
             }
-            let top_class = workgroupUniformLoad(&class_shared);
-            if top_class == OUTSIDE {
-                continue;
-            }
-            if top_class == INSIDE && caster.opaque {
-                shadow_region(tile * TOP_SPAN, TOP_SPAN, ANY_CLUSTER, lane);
-                continue;
-            }
-            // The top node's middle children, one an invocation.
-            if lane == 0u {
-                atomicStore(&middle_count, 0u);
-            }
-            workgroupBarrier();
-            let m = tile * BRANCHING + vec2<u32>(lane % BRANCHING, lane / BRANCHING);
-            if all(m < middle) {
-                let node = m.y * middle.x + m.x;
-                let node_class = classify(caster.volume, middle_offset + node);
-                if node_class != OUTSIDE {
-                    let inside = select(0u, WHOLLY_INSIDE, node_class == INSIDE && caster.opaque);
-                    middle_queue[atomicAdd(&middle_count, 1u)] = node | inside;
+            let caster = workgroupUniformLoad(&caster_shared);
+            for (var t = 0u; t < top.x * top.y; t++) {
+                let tile = vec2<u32>(t % top.x, t / top.x);
+                if lane == 0u {
+                    class_shared = classify(caster.volume, top_offset + t);
                 }
-            }
-            workgroupBarrier();
-            if lane == 0u {
-                count_shared = atomicLoad(&middle_count);
-            }
-            let middles = workgroupUniformLoad(&count_shared);
-            for (var i = 0u; i < middles; i++) {
-                let entry = workgroupUniformLoad(&middle_queue[i]);
-                let node = entry & ~WHOLLY_INSIDE;
-                let mid = vec2<u32>(node % middle.x, node / middle.x);
-                if (entry & WHOLLY_INSIDE) != 0u {
-                    shadow_region(mid * MIDDLE_SPAN, MIDDLE_SPAN, ANY_CLUSTER, lane);
+                let top_class = workgroupUniformLoad(&class_shared);
+                if top_class == OUTSIDE {
                     continue;
                 }
-                // The middle node's tiles, one an invocation, both clusters of each.
+                if top_class == INSIDE && caster.opaque {
+                    shadow_region(tile * TOP_SPAN, TOP_SPAN, ANY_CLUSTER, lane);
+                    continue;
+                }
+                // The top node's middle children, one an invocation.
                 if lane == 0u {
-                    atomicStore(&cluster_count, 0u);
+                    atomicStore(&middle_count, 0u);
                 }
                 workgroupBarrier();
-                let b = mid * BRANCHING + vec2<u32>(lane % BRANCHING, lane / BRANCHING);
-                if all(b < bottom) {
-                    for (var c = 0u; c < CLUSTERS; c++) {
-                        let cluster = CLUSTERS * (b.y * bottom.x + b.x) + c;
-                        let node_class = classify(caster.volume, cluster);
-                        if node_class != OUTSIDE {
-                            let inside = select(0u, WHOLLY_INSIDE, node_class == INSIDE && caster.opaque);
-                            cluster_queue[atomicAdd(&cluster_count, 1u)] = cluster | inside;
+                let m = tile * BRANCHING + vec2<u32>(lane % BRANCHING, lane / BRANCHING);
+                if all(m < middle) {
+                    let node = m.y * middle.x + m.x;
+                    let node_class = classify(caster.volume, middle_offset + node);
+                    if node_class != OUTSIDE {
+                        let inside = select(0u, WHOLLY_INSIDE, node_class == INSIDE && caster.opaque);
+                        middle_queue[atomicAdd(&middle_count, 1u)] = node | inside;
+                    }
+                }
+                workgroupBarrier();
+                if lane == 0u {
+                    count_shared = atomicLoad(&middle_count);
+                }
+                let middles = workgroupUniformLoad(&count_shared);
+                for (var i = 0u; i < middles; i++) {
+                    let entry = workgroupUniformLoad(&middle_queue[i]);
+                    let node = entry & ~WHOLLY_INSIDE;
+                    let mid = vec2<u32>(node % middle.x, node / middle.x);
+                    if (entry & WHOLLY_INSIDE) != 0u {
+                        shadow_region(mid * MIDDLE_SPAN, MIDDLE_SPAN, ANY_CLUSTER, lane);
+                        continue;
+                    }
+                    // The middle node's tiles, one an invocation, both clusters of each.
+                    if lane == 0u {
+                        atomicStore(&cluster_count, 0u);
+                    }
+                    workgroupBarrier();
+                    let b = mid * BRANCHING + vec2<u32>(lane % BRANCHING, lane / BRANCHING);
+                    if all(b < bottom) {
+                        for (var c = 0u; c < CLUSTERS; c++) {
+                            let cluster = CLUSTERS * (b.y * bottom.x + b.x) + c;
+                            let node_class = classify(caster.volume, cluster);
+                            if node_class != OUTSIDE {
+                                let inside = select(0u, WHOLLY_INSIDE, node_class == INSIDE && caster.opaque);
+                                cluster_queue[atomicAdd(&cluster_count, 1u)] = cluster | inside;
+                            }
                         }
                     }
-                }
-                workgroupBarrier();
-                if lane == 0u {
-                    count_shared = atomicLoad(&cluster_count);
-                }
-                let clusters = workgroupUniformLoad(&count_shared);
-                // The queued clusters' pixels, shared out over the invocations.
-                for (var k = lane; k < clusters * GROUP; k += GROUP) {
-                    let entry = cluster_queue[k / GROUP];
-                    let cluster = entry & ~WHOLLY_INSIDE;
-                    let tile_index = cluster / CLUSTERS;
-                    let first = vec2<u32>(tile_index % bottom.x, tile_index / bottom.x) * BRANCHING;
-                    let p = first + vec2<u32>(k % BRANCHING, (k % GROUP) / BRANCHING);
-                    if (entry & WHOLLY_INSIDE) != 0u {
-                        shadow_sample(p, cluster % CLUSTERS);
-                    } else {
-                        test_sample(p, cluster % CLUSTERS, caster);
+                    workgroupBarrier();
+                    if lane == 0u {
+                        count_shared = atomicLoad(&cluster_count);
                     }
+                    let clusters = workgroupUniformLoad(&count_shared);
+                    // The queued clusters' pixels, shared out over the invocations.
+                    for (var k = lane; k < clusters * GROUP; k += GROUP) {
+                        let entry = cluster_queue[k / GROUP];
+                        let cluster = entry & ~WHOLLY_INSIDE;
+                        let tile_index = cluster / CLUSTERS;
+                        let corner = vec2<u32>(tile_index % bottom.x, tile_index / bottom.x) * BRANCHING;
+                        let p = corner + vec2<u32>(k % BRANCHING, (k % GROUP) / BRANCHING);
+                        if (entry & WHOLLY_INSIDE) != 0u {
+                            shadow_sample(p, cluster % CLUSTERS);
+                        } else {
+                            test_sample(p, cluster % CLUSTERS, caster);
+                        }
+                    }
+                    // (The queue is refilled for the next middle node.)
+                    workgroupBarrier();
                 }
-                // (The queue is refilled for the next middle node.)
                 workgroupBarrier();
             }
+            // (`caster_shared` is loaded again for the next triangle.)
             workgroupBarrier();
         }
-        // (`caster_shared` is loaded again for the next triangle.)
+        // (The queue is refilled for the next triangles.)
         workgroupBarrier();
     }
 }

@@ -50,8 +50,8 @@ zoo_host::gpu_struct! {
 
 const VOLUMES_SHADER: &str = "per-triangle-volumes/volumes.wgsl";
 const RESOLVE_SHADER: &str = "per-triangle-volumes/resolve.wgsl";
-/// Workgroups of the triangle pass, each taking every `TRIANGLE_GROUPS`-th triangle in turn
-/// (`TRIANGLE_GROUPS` in the shader).
+/// Workgroups of the triangle pass, each taking 64 triangles in turn, every
+/// `TRIANGLE_GROUPS`-th 64 (`TRIANGLE_GROUPS` in the shader).
 const TRIANGLE_GROUPS: u32 = 2048;
 /// Invocations of a triangle pass workgroup (`GROUP` in the shader).
 const GROUP: u32 = 64;
@@ -153,7 +153,7 @@ impl ShadowTechnique for PerTriangleVolumes {
             gpu.reduce[0].dispatch_in(ctx, &mut pass, (&[reduce1], &shared), levels[1])?;
             gpu.reduce[1].dispatch_in(ctx, &mut pass, (&[reduce2], &shared), levels[2])?;
             if triangles > 0 {
-                let extent = [triangles.min(TRIANGLE_GROUPS) * GROUP, 1, 1];
+                let extent = [triangles.div_ceil(GROUP).min(TRIANGLE_GROUPS) * GROUP, 1, 1];
                 gpu.triangles
                     .dispatch_in(ctx, &mut pass, (&[volumes], &shared), extent)?;
             }
