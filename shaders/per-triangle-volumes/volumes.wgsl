@@ -45,6 +45,15 @@ struct ViewSample {
 // 1 where a caster stops the pixel's ray.
 @group(4) @binding(2) var<storage, read_write> shadowed: array<atomic<u32>>;
 @group(4) @binding(3) var<storage, read> batches: array<GpuBatch>;
+// Per light (`COUNTERS` a light): the triangles that went down the hierarchy, the nodes
+// classified, and the samples tested exactly.
+@group(4) @binding(4) var<storage, read_write> counts: array<atomic<u32>>;
+
+// Counters a light in `counts` (`COUNTERS` in the plugin).
+const COUNTERS: u32 = 3u;
+// This invocation's counts, added to `counts` once at its end.
+var<private> nodes_classified: u32;
+var<private> exact_tests: u32;
 
 // Children per side of a node (and pixels per side of a level-0 node).
 const BRANCHING: u32 = 8u;
@@ -118,6 +127,11 @@ fn cs_samples(
     let pixel = id.y * size.x + id.x;
     var sample = ViewSample(vec4<f32>(0.0), vec4<f32>(0.0));
     var depth = vec2<f32>(EMPTY, -EMPTY);
+    if all(id == vec3<u32>(0u)) {
+        for (var k = 0u; k < COUNTERS; k++) {
+            atomicStore(&counts[COUNTERS * ptv_light.light + k], 0u);
+        }
+    }
     if inside {
         atomicStore(&shadowed[pixel], 0u);
         let s = load_surface(vec2<i32>(id.xy));
@@ -244,6 +258,7 @@ const INSIDE: u32 = 2u;
 // rounding): outside one of its planes, inside all four, or straddling (also where the
 // hierarchy is off). Empty nodes are outside.
 fn classify(volume: Volume, node: u32) -> u32 {
+    nodes_classified += 1u;
     let low = node_bounds[2u * node].xyz;
     let high = node_bounds[2u * node + 1u].xyz;
     if any(low > high) {
@@ -358,6 +373,7 @@ fn test_sample(p: vec2<u32>, cluster: u32, caster: Caster) {
         origin = vec3<f32>(dot(m[0], o), dot(m[1], o), dot(m[2], o));
         direction = vec3<f32>(dot(m[0].xyz, direction), dot(m[1].xyz, direction), dot(m[2].xyz, direction));
     }
+    exact_tests += 1u;
     if rt_intersect(caster.index, origin, direction, sample.origin.w).x > 0.0 {
         atomicStore(&shadowed[pixel], 1u);
     }
@@ -510,6 +526,9 @@ fn cs_triangles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
             count_shared = atomicLoad(&triangle_count);
         }
         let queued = workgroupUniformLoad(&count_shared);
+        if lane == 0u {
+            atomicAdd(&counts[COUNTERS * ptv_light.light], queued);
+        }
         for (var q = 0u; q < queued; q++) {
             if lane == 0u {
                 caster_shared = load_caster(triangle_queue[q]);
@@ -599,5 +618,11 @@ fn cs_triangles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
         }
         // (The queue is refilled for the next triangles.)
         workgroupBarrier();
+    }
+    if nodes_classified > 0u {
+        atomicAdd(&counts[COUNTERS * ptv_light.light + 1u], nodes_classified);
+    }
+    if exact_tests > 0u {
+        atomicAdd(&counts[COUNTERS * ptv_light.light + 2u], exact_tests);
     }
 }

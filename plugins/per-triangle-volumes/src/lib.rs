@@ -17,7 +17,10 @@
 //! The casters come from the ray-tracing library's upload: instances share their mesh's
 //! triangles, visited once per instance through its placement.
 
+use std::sync::Mutex;
 use zoo_host::prelude::*;
+
+use zoo_host::gpu::readback::ReadbackRing;
 use zoo_ray_tracing::{GpuBatch, RayTracing, Tracer};
 
 mod samples;
@@ -27,8 +30,9 @@ use samples::ViewSamples;
 zoo_host::technique_params! {
     /// Parameters of per-triangle shadow volumes.
     pub struct PtvParams {
-        /// Cull the hierarchy's nodes by each triangle's volume; off, every triangle tests
-        /// every sample (the same shadows, to measure what the hierarchy saves).
+        /// Cull the hierarchy's nodes by each triangle's volume; off, every triangle in the
+        /// light's range tests every sample (the same shadows, to measure what the hierarchy
+        /// saves).
         hierarchy: bool = true;
     }
 }
@@ -67,6 +71,24 @@ struct Gpu {
     resolve: kit::Stage,
     /// The view samples, the hierarchy and the shadowed flags, for the current frame size.
     buffers: Option<ViewSamples>,
+    /// The lights' counters, read back a frame or two late.
+    stats: Option<Mutex<ReadbackRing>>,
+    device: wgpu::Device,
+}
+
+impl Gpu {
+    /// Each counter summed over the lights, from the newest frame whose counters have arrived
+    /// (none until one has; never waits for the GPU).
+    fn totals(&self) -> Option<[u64; samples::COUNTERS as usize]> {
+        let mut ring = self.stats.as_ref()?.lock().ok()?;
+        let (_, bytes) = ring.latest(&self.device)?;
+        let mut totals = [0u64; samples::COUNTERS as usize];
+        for (i, word) in bytes.chunks_exact(4).enumerate() {
+            let value = u32::from_le_bytes([word[0], word[1], word[2], word[3]]);
+            totals[i % totals.len()] += u64::from(value);
+        }
+        Some(totals)
+    }
 }
 
 impl Gpu {
@@ -93,6 +115,8 @@ impl Gpu {
             tracing: None,
             uniforms,
             buffers: None,
+            stats: None,
+            device: ctx.gpu.device.clone(),
         })
     }
 }
@@ -112,7 +136,11 @@ impl ShadowTechnique for PerTriangleVolumes {
         if gpu.buffers.as_ref().is_none_or(|b| !b.fits(ctx)) {
             let batches = &gpu.tracing.as_ref().map_or(&[][..], |t| &t.batches);
             let stages = (&gpu.samples, &gpu.reduce, &gpu.triangles, &gpu.resolve);
-            gpu.buffers = Some(ViewSamples::new(ctx, stages, batches)?);
+            let buffers = ViewSamples::new(ctx, stages, batches)?;
+            let label = "per-triangle volumes counters";
+            let ring = ReadbackRing::new(&ctx.gpu.device, label, buffers.counts.size(), 3);
+            gpu.stats = Some(Mutex::new(ring));
+            gpu.buffers = Some(buffers);
         }
         Ok(())
     }
@@ -164,6 +192,12 @@ impl ShadowTechnique for PerTriangleVolumes {
                 .set_on(ctx, &mut pass, &[&buffers.resolve_group], &[])?;
             pass.draw(0..3, 0..1);
         }
+        let stats = gpu.stats.as_ref().and_then(|s| s.lock().ok());
+        if let Some(target) = stats.and_then(|mut ring| ring.target().cloned()) {
+            let bytes = buffers.counts.size();
+            rec.encoder()
+                .copy_buffer_to_buffer(&buffers.counts, 0, &target, 0, bytes);
+        }
         Ok(())
     }
 
@@ -172,13 +206,22 @@ impl ShadowTechnique for PerTriangleVolumes {
     }
 
     fn counters(&self) -> Vec<(String, f64)> {
-        let tracing = self.gpu.built().and_then(|g| g.tracing.as_ref());
+        let gpu = self.gpu.built();
+        let tracing = gpu.and_then(|g| g.tracing.as_ref());
         let batches = tracing.map_or(&[][..], |t| &t.batches);
         let triangles = batches.last().map_or(0, |b| b.start + b.count);
-        vec![
+        let mut counters = vec![
             ("caster triangles".to_string(), f64::from(triangles)),
             ("caster batches".to_string(), batches.len() as f64),
-        ]
+        ];
+        if let Some([descended, nodes, tests]) = gpu.and_then(Gpu::totals) {
+            counters.extend([
+                ("triangles down the hierarchy".to_string(), descended as f64),
+                ("nodes classified".to_string(), nodes as f64),
+                ("samples tested exactly".to_string(), tests as f64),
+            ]);
+        }
+        counters
     }
 }
 
@@ -196,14 +239,15 @@ zoo_host::register_technique! {
     source: "Sintorn, Olsson, Assarsson 2011; Sintorn, Kämpe, Olsson, Assarsson 2014",
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
-    // The frame's lights and objects, the casters' five buffers and the samples' four, in
+    // The frame's lights and objects, the casters' five buffers and the samples' five, in
     // compute; a fifth group for the samples beside the frame, G-buffer, per-light and
     // casters' groups.
     required_limits: || wgpu::Limits {
-        max_storage_buffers_per_shader_stage: 11,
+        max_storage_buffers_per_shader_stage: 12,
         max_bind_groups: 5,
         ..wgpu::Limits::downlevel_defaults()
     },
+    required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS,
     params: PtvParams::schema,
     create: create,
 }
@@ -226,6 +270,7 @@ mod tests {
         // No more workgroups than a dispatch takes along one axis.
         let limits = wgpu::Limits::downlevel_defaults();
         assert_eq!(constant("GROUP"), Ok(i64::from(GROUP)));
+        assert_eq!(constant("COUNTERS"), Ok(samples::COUNTERS as i64));
         assert!(TRIANGLE_GROUPS <= limits.max_compute_workgroups_per_dimension);
     }
 }

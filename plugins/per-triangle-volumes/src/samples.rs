@@ -1,6 +1,6 @@
-//! The buffers of the volume passes for one frame size: the view samples (each pixel's hard
-//! shadow ray), the hierarchy's boxes, the shadowed flags, and the casters' batches, with each
-//! stage's bind group over them.
+//! The buffers of the volume passes for one frame size and number of lights: the view samples
+//! (each pixel's hard shadow ray), the hierarchy's boxes, the shadowed flags, the casters'
+//! batches and the counters, with each stage's bind group over them.
 
 use zoo_host::gpu::GpuType;
 use zoo_host::kit::{Stage, StageBindGroup};
@@ -18,12 +18,19 @@ pub(crate) const BRANCHING: u32 = 8;
 /// Pixels per side of a node of each level: tiles, then 8x8 tiles twice.
 pub(crate) const LEVEL_SPANS: [u32; 3] = [BRANCHING, BRANCHING.pow(2), BRANCHING.pow(3)];
 
+/// Counters a light (`COUNTERS` in the shader): triangles down the hierarchy, nodes
+/// classified, samples tested exactly.
+pub(crate) const COUNTERS: u64 = 3;
+
 /// The stages that bind the buffers: samples, the two reductions, triangles and resolve.
 pub type Stages<'a> = (&'a Stage, &'a [Stage; 2], &'a Stage, &'a Stage);
 
 /// The buffers and each stage's bind group over them.
 pub struct ViewSamples {
     size: zoo_host::glam::UVec2,
+    lights: usize,
+    /// Each light's [`COUNTERS`], written by the volume passes.
+    pub counts: wgpu::Buffer,
     /// The bind groups of the samples, the two reductions and the triangle stages.
     pub groups: [StageBindGroup; 4],
     /// The resolve stage's bind group (the shadowed flags).
@@ -50,7 +57,9 @@ impl ViewSamples {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size: bytes.max(16),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             })
         };
@@ -63,7 +72,13 @@ impl ViewSamples {
             (batch_bytes.len() as u64).max(GpuBatch::SIZE as u64),
         );
         ctx.gpu.queue.write_buffer(&batch_buffer, 0, &batch_bytes);
+        let lights = ctx.lights.len();
+        let counts = storage(
+            "per-triangle volumes counters",
+            lights.max(1) as u64 * COUNTERS * 4,
+        );
         let resources = [
+            ("counts", counts.as_entire_binding()),
             ("view_samples", view_samples.as_entire_binding()),
             ("node_bounds", node_bounds.as_entire_binding()),
             ("shadowed", shadowed.as_entire_binding()),
@@ -72,6 +87,7 @@ impl ViewSamples {
         let bind = |stage: &Stage| stage.bind(ctx, "per-triangle volumes buffers", &resources);
         Ok(ViewSamples {
             size,
+            lights,
             groups: [
                 bind(samples)?,
                 bind(&reduce[0])?,
@@ -83,11 +99,12 @@ impl ViewSamples {
                 "per-triangle volumes resolve",
                 &[("shadowed", shadowed.as_entire_binding())],
             )?,
+            counts,
         })
     }
 
-    /// Whether they were made for `ctx`'s frame size.
+    /// Whether they were made for `ctx`'s frame size and number of lights.
     pub fn fits(&self, ctx: &RenderContext<'_>) -> bool {
-        self.size == ctx.size
+        self.size == ctx.size && self.lights == ctx.lights.len()
     }
 }
