@@ -649,8 +649,9 @@ fn render_without_a_technique_writes_the_contact_sheet_and_its_table() {
     let layout = shadow_zoo::contact_sheet::Layout::new((96, 64), techniques.len() + 2);
     let image = image::open(&png).unwrap();
     assert_eq!((image.width(), image.height()), layout.size());
-    // An unknown id is named before any work; a sheet of one technique cannot take `--set`
-    // for another.
+    // An unknown id is named, and nothing written; a sheet of one technique cannot take
+    // `--set` for another.
+    let none = dir.join("none.png");
     for (list, set, expected) in [
         ("sm-pcf,nope", "sm-pcf.map_size=512", "nope"),
         ("sm-pcf", "vsm.map_size=512", "vsm"),
@@ -662,11 +663,11 @@ fn render_without_a_technique_writes_the_contact_sheet_and_its_table() {
             "--set",
             set,
             "--out",
-            png.to_str().unwrap(),
+            none.to_str().unwrap(),
         ]);
         let all = text(&out);
         assert!(!out.status.success() && all.contains(expected), "{all}");
-        assert!(!all.contains("panicked"), "{all}");
+        assert!(!all.contains("panicked") && !none.exists(), "{all}");
     }
 }
 
