@@ -23,9 +23,8 @@
 #import "common/frame.wgsl"
 #import "common/gbuffer.wgsl"
 #import "common/lighting.wgsl"
-#import "ray-tracing/trace.wgsl"
+#import "ray-tracing/casters.wgsl"
 #import "ray-tracing/shadow_ray.wgsl"
-#import "ray-tracing/batch.wgsl"
 #import "per-triangle-volumes/ptv_light.wgsl"
 
 @group(2) @binding(0) var<uniform> ptv_light: PtvLight;
@@ -38,13 +37,13 @@ struct ViewSample {
     direction: vec4<f32>,
 }
 
-@group(4) @binding(0) var<storage, read_write> view_samples: array<ViewSample>;
+// (Binding 0: `caster_batches`, `ray-tracing/casters.wgsl`.)
+@group(4) @binding(1) var<storage, read_write> view_samples: array<ViewSample>;
 // Each node's box (minimum, then maximum), level after level (`level_offset`); level 0 has
 // two nodes a tile, its clusters.
-@group(4) @binding(1) var<storage, read_write> node_bounds: array<vec4<f32>>;
+@group(4) @binding(2) var<storage, read_write> node_bounds: array<vec4<f32>>;
 // 1 where a caster stops the pixel's ray.
-@group(4) @binding(2) var<storage, read_write> shadowed: array<atomic<u32>>;
-@group(4) @binding(3) var<storage, read> batches: array<GpuBatch>;
+@group(4) @binding(3) var<storage, read_write> shadowed: array<atomic<u32>>;
 // Per light (`COUNTERS` a light): the triangles that went down the hierarchy, the nodes
 // classified, and the samples tested exactly.
 @group(4) @binding(4) var<storage, read_write> counts: array<atomic<u32>>;
@@ -60,8 +59,6 @@ const BRANCHING: u32 = 8u;
 // Pixels per side of a level-1 and a level-2 node.
 const MIDDLE_SPAN: u32 = BRANCHING * BRANCHING;
 const TOP_SPAN: u32 = MIDDLE_SPAN * BRANCHING;
-// `zoo_ray_tracing::NO_INSTANCE`.
-const NO_INSTANCE: u32 = 0xffffffffu;
 // An empty box: its minimum above its maximum.
 const EMPTY: f32 = 3.0e38;
 
@@ -337,21 +334,19 @@ fn may_hold(volume: Volume, p: vec3<f32>) -> bool {
     return true;
 }
 
-// The caster triangle a workgroup tests: its index among the traced triangles, its volume,
-// whether it is opaque, and the placement of its instance (rows of world to mesh space).
+// The caster triangle a workgroup tests (its index and placement), its volume and whether it
+// is opaque.
 struct Caster {
-    index: u32,
+    triangle: CasterTriangle,
     volume: Volume,
     // Whether the triangle comes within the light's range (a point or spot light's samples
     // all lie within it, so a triangle beyond it stops no ray).
     in_range: bool,
     opaque: bool,
-    instanced: bool,
-    to_local: array<vec4<f32>, 3>,
 }
 
 // Tests the sample of pixel `p` of `cluster` that may lie in the caster's volume exactly
-// against the caster (its ray into mesh space for an instance).
+// against the caster.
 fn test_sample(p: vec2<u32>, cluster: u32, caster: Caster) {
     let size = frame_size();
     if any(p >= size) {
@@ -365,33 +360,10 @@ fn test_sample(p: vec2<u32>, cluster: u32, caster: Caster) {
     if ptv_light.hierarchy != 0u && !may_hold(caster.volume, sample.origin.xyz) {
         return;
     }
-    var origin = sample.origin.xyz;
-    var direction = sample.direction.xyz;
-    if caster.instanced {
-        let m = caster.to_local;
-        let o = vec4<f32>(origin, 1.0);
-        origin = vec3<f32>(dot(m[0], o), dot(m[1], o), dot(m[2], o));
-        direction = vec3<f32>(dot(m[0].xyz, direction), dot(m[1].xyz, direction), dot(m[2].xyz, direction));
-    }
     exact_tests += 1u;
-    if rt_intersect(caster.index, origin, direction, sample.origin.w).x > 0.0 {
+    if caster_blocks(caster.triangle, sample.origin.xyz, sample.direction.xyz, sample.origin.w) {
         atomicStore(&shadowed[pixel], 1u);
     }
-}
-
-// The batch that holds flat triangle number `flat` (the last whose start is not past it).
-fn batch_of(flat: u32) -> GpuBatch {
-    var low = 0u;
-    var high = ptv_light.batches;
-    while high - low > 1u {
-        let middle = (low + high) / 2u;
-        if batches[middle].start <= flat {
-            low = middle;
-        } else {
-            high = middle;
-        }
-    }
-    return batches[low];
 }
 
 // Workgroups of `cs_triangles` (`TRIANGLE_GROUPS` in the plugin): each takes 64 triangles in
@@ -436,19 +408,9 @@ fn distance_sq(a: vec3<f32>, b: vec3<f32>) -> f32 {
 
 // Caster triangle number `flat` of the flat list, with its volume from the frame's light.
 fn load_caster(flat: u32) -> Caster {
-    let batch = batch_of(flat);
     var caster: Caster;
-    caster.index = batch.first + flat - batch.start;
-    caster.instanced = batch.instance != NO_INSTANCE;
-    caster.to_local = array<vec4<f32>, 3>(
-        vec4<f32>(1.0, 0.0, 0.0, 0.0),
-        vec4<f32>(0.0, 1.0, 0.0, 0.0),
-        vec4<f32>(0.0, 0.0, 1.0, 0.0),
-    );
-    if caster.instanced {
-        caster.to_local = rt_instances[batch.instance].to_local;
-    }
-    let m = caster.to_local;
+    caster.triangle = caster_triangle(flat);
+    let m = caster.triangle.to_local;
     let light = lights[ptv_light.light];
     var local_light: vec4<f32>;
     if light.kind == LIGHT_DIRECTIONAL {
@@ -458,7 +420,7 @@ fn load_caster(flat: u32) -> Caster {
         let o = vec4<f32>(light.position, 1.0);
         local_light = vec4<f32>(dot(m[0], o), dot(m[1], o), dot(m[2], o), 1.0);
     }
-    let tri = rt_triangles[caster.index];
+    let tri = rt_triangles[caster.triangle.index];
     caster.volume = volume_of(tri.v0, tri.v0 + tri.e1, tri.v0 + tri.e2, local_light, m);
     caster.in_range = light.kind == LIGHT_DIRECTIONAL || within_range(tri.v0, tri.v0 + tri.e1, tri.v0 + tri.e2, local_light.xyz, light.range, m);
     // Wholly inside the volume of an opaque triangle, every ray crosses it; a masked one's

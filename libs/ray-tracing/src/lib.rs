@@ -45,6 +45,9 @@ pub const GROUP: u32 = 3;
 
 /// The module a tracing shader imports (the portable traversal).
 pub const TRACE_MODULE: &str = "ray-tracing/trace.wgsl";
+/// The exact per-triangle methods' resolve: a full-screen `fs_resolve` that shadows each pixel
+/// flagged in its `shadowed` buffer (one `u32` a pixel).
+pub const RESOLVE_SHADOWED_SHADER: &str = "ray-tracing/shadowed.wgsl";
 /// The module [`shader_source`] imports instead for hardware ray queries.
 pub const QUERY_MODULE: &str = "ray-tracing/query.wgsl";
 
@@ -396,6 +399,37 @@ impl RayTracing {
         })
     }
 
+    /// The casters' [`Self::batches`] in a storage buffer, for `caster_batches` of
+    /// `ray-tracing/casters.wgsl` (one empty batch when there are none: a binding is never
+    /// empty).
+    pub fn batch_buffer(&self, ctx: &RenderContext<'_>, label: &str) -> wgpu::Buffer {
+        let empty = [GpuBatch {
+            first: 0,
+            count: 0,
+            start: 0,
+            instance: NO_INSTANCE,
+        }];
+        let batches = if self.batches.is_empty() {
+            &empty[..]
+        } else {
+            &self.batches[..]
+        };
+        let bytes = gpu_bytes(batches);
+        let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.len() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.gpu.queue.write_buffer(&buffer, 0, &bytes);
+        buffer
+    }
+
+    /// The number of caster triangles of [`Self::batches`]' flat numbering.
+    pub fn caster_triangles(&self) -> u32 {
+        self.batches.last().map_or(0, |b| b.start + b.count)
+    }
+
     /// Whether it was built for `ctx`'s scene.
     pub fn is_for(&self, ctx: &RenderContext<'_>) -> bool {
         self.vertices == ctx.scene_buffers.vertices
@@ -419,6 +453,13 @@ mod tests {
             .source;
         let constant = |name| wgsl_integer_constant(&source, name);
         assert_eq!(constant("RT_NO_HIERARCHY"), Ok(i64::from(NO_HIERARCHY)));
+        let source = ShaderLibrary::embedded()
+            .compose("ray-tracing/casters.wgsl")
+            .unwrap()
+            .source;
+        let constant = |name| wgsl_integer_constant(&source, name);
+        let no_instance = i64::from(NO_INSTANCE);
+        assert_eq!(constant("CASTER_NO_INSTANCE"), Ok(no_instance));
     }
 
     /// Each traversal's layout has the shader's bindings of group [`GROUP`], in number and

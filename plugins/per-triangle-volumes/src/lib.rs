@@ -21,7 +21,7 @@ use std::sync::Mutex;
 use zoo_host::prelude::*;
 
 use zoo_host::gpu::readback::ReadbackRing;
-use zoo_ray_tracing::{GpuBatch, RayTracing, Tracer};
+use zoo_ray_tracing::{RESOLVE_SHADOWED_SHADER, RayTracing, Tracer};
 
 mod samples;
 
@@ -40,20 +40,18 @@ zoo_host::technique_params! {
 zoo_host::gpu_struct! {
     "per-triangle-volumes/ptv_light.wgsl" =>
     /// The per-light uniform of the volume passes: the light, the frame's size, the flat count
-    /// of caster triangles and of their batches, and whether the hierarchy culls.
+    /// of caster triangles, and whether the hierarchy culls.
     #[derive(Debug, Clone, Copy)]
     pub(crate) struct PtvLight {
         light: u32,
         width: u32,
         height: u32,
         triangles: u32,
-        batches: u32,
         hierarchy: u32,
     }
 }
 
 const VOLUMES_SHADER: &str = "per-triangle-volumes/volumes.wgsl";
-const RESOLVE_SHADER: &str = "per-triangle-volumes/resolve.wgsl";
 /// Workgroups of the triangle pass, each taking 64 triangles in turn, every
 /// `TRIANGLE_GROUPS`-th 64 (`TRIANGLE_GROUPS` in the shader).
 const TRIANGLE_GROUPS: u32 = 2048;
@@ -110,7 +108,7 @@ impl Gpu {
             samples: compute("cs_samples")?,
             reduce: [compute("cs_reduce1")?, compute("cs_reduce2")?],
             triangles: compute("cs_triangles")?,
-            resolve: kit::Stage::fullscreen(RESOLVE_SHADER, "fs_resolve").build(ctx)?,
+            resolve: kit::Stage::fullscreen(RESOLVE_SHADOWED_SHADER, "fs_resolve").build(ctx)?,
             tracing_layout,
             tracing: None,
             uniforms,
@@ -134,9 +132,11 @@ impl ShadowTechnique for PerTriangleVolumes {
             gpu.buffers = None;
         }
         if gpu.buffers.as_ref().is_none_or(|b| !b.fits(ctx)) {
-            let batches = &gpu.tracing.as_ref().map_or(&[][..], |t| &t.batches);
+            let Some(tracing) = &gpu.tracing else {
+                return Ok(());
+            };
             let stages = (&gpu.samples, &gpu.reduce, &gpu.triangles, &gpu.resolve);
-            let buffers = ViewSamples::new(ctx, stages, batches)?;
+            let buffers = ViewSamples::new(ctx, stages, tracing)?;
             let label = "per-triangle volumes counters";
             let ring = ReadbackRing::new(&ctx.gpu.device, label, buffers.counts.size(), 3);
             gpu.stats = Some(Mutex::new(ring));
@@ -151,15 +151,13 @@ impl ShadowTechnique for PerTriangleVolumes {
             return Ok(());
         };
         let size = ctx.size;
-        let batches: &[GpuBatch] = &tracing.batches;
-        let triangles = batches.last().map_or(0, |b| b.start + b.count);
+        let triangles = tracing.caster_triangles();
         let values: Vec<PtvLight> = (0..ctx.lights.len())
             .map(|light| PtvLight {
                 light: light as u32,
                 width: size.x,
                 height: size.y,
                 triangles,
-                batches: batches.len() as u32,
                 hierarchy: u32::from(self.params.hierarchy),
             })
             .collect();
@@ -265,8 +263,6 @@ mod tests {
         assert_eq!(constant("TRIANGLE_GROUPS"), Ok(i64::from(TRIANGLE_GROUPS)));
         assert_eq!(constant("CLUSTERS"), Ok(samples::CLUSTERS as i64));
         assert_eq!(constant("BRANCHING"), Ok(i64::from(samples::BRANCHING)));
-        let no_instance = i64::from(zoo_ray_tracing::NO_INSTANCE);
-        assert_eq!(constant("NO_INSTANCE"), Ok(no_instance));
         // No more workgroups than a dispatch takes along one axis.
         let limits = wgpu::Limits::downlevel_defaults();
         assert_eq!(constant("GROUP"), Ok(i64::from(GROUP)));

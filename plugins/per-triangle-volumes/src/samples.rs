@@ -2,10 +2,9 @@
 //! (each pixel's hard shadow ray), the hierarchy's boxes, the shadowed flags, the casters'
 //! batches and the counters, with each stage's bind group over them.
 
-use zoo_host::gpu::GpuType;
 use zoo_host::kit::{Stage, StageBindGroup};
 use zoo_host::prelude::*;
-use zoo_ray_tracing::GpuBatch;
+use zoo_ray_tracing::RayTracing;
 
 /// Bytes of one view sample (`ViewSample` in the shader: two `vec4<f32>`).
 const SAMPLE_BYTES: u64 = 32;
@@ -38,11 +37,11 @@ pub struct ViewSamples {
 }
 
 impl ViewSamples {
-    /// Buffers for `ctx`'s frame size and the casters' `batches`, bound for `stages`.
+    /// Buffers for `ctx`'s frame size and `tracing`'s casters, bound for `stages`.
     pub fn new(
         ctx: &RenderContext<'_>,
         (samples, reduce, triangles, resolve): Stages<'_>,
-        batches: &[GpuBatch],
+        tracing: &RayTracing,
     ) -> TechniqueResult<ViewSamples> {
         let size = ctx.size;
         let pixels = u64::from(size.x) * u64::from(size.y);
@@ -66,12 +65,7 @@ impl ViewSamples {
         let view_samples = storage("per-triangle volumes view samples", pixels * SAMPLE_BYTES);
         let node_bounds = storage("per-triangle volumes node boxes", nodes * NODE_BYTES);
         let shadowed = storage("per-triangle volumes shadowed", pixels * 4);
-        let batch_bytes = zoo_host::gpu::gpu_bytes(batches);
-        let batch_buffer = storage(
-            "per-triangle volumes caster batches",
-            (batch_bytes.len() as u64).max(GpuBatch::SIZE as u64),
-        );
-        ctx.gpu.queue.write_buffer(&batch_buffer, 0, &batch_bytes);
+        let batches = tracing.batch_buffer(ctx, "per-triangle volumes caster batches");
         let lights = ctx.lights.len();
         let counts = storage(
             "per-triangle volumes counters",
@@ -82,7 +76,7 @@ impl ViewSamples {
             ("view_samples", view_samples.as_entire_binding()),
             ("node_bounds", node_bounds.as_entire_binding()),
             ("shadowed", shadowed.as_entire_binding()),
-            ("batches", batch_buffer.as_entire_binding()),
+            ("caster_batches", batches.as_entire_binding()),
         ];
         let bind = |stage: &Stage| stage.bind(ctx, "per-triangle volumes buffers", &resources);
         Ok(ViewSamples {

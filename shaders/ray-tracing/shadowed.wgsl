@@ -1,10 +1,11 @@
-// Per-triangle shadow volumes, resolve: each pixel a caster shadows gets visibility 0 in the
-// light's slot (which holds 1, lit, until written).
+// The exact per-triangle methods' resolve (per-triangle volumes, frustum-traced shadows): each
+// pixel whose shadow ray a caster stopped gets visibility 0 in the light's slot (which holds 1,
+// lit, until written).
 
 #import "common/frame.wgsl"
 #import "common/fullscreen.wgsl"
 
-// 1 where a caster stops the pixel's ray (`per-triangle-volumes/volumes.wgsl`).
+// 1 where a caster stops the pixel's ray.
 @group(2) @binding(0) var<storage, read> shadowed: array<u32>;
 
 @fragment

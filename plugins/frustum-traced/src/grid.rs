@@ -1,0 +1,141 @@
+//! The buffers of the irregular z-buffer for one frame size, grid resolution and number of
+//! lights: the view samples, the grid (list heads, lengths, links and the queue of large
+//! triangles), the shadowed flags and the per-light state (counters, the planes' bounds), with
+//! each stage's bind group over them.
+
+use zoo_host::glam::UVec2;
+use zoo_host::kit::{Stage, StageBindGroup};
+use zoo_host::prelude::*;
+use zoo_ray_tracing::RayTracing;
+
+/// Bytes of one view sample (`ViewSample` in the shader: two `vec4<f32>`).
+const SAMPLE_BYTES: u64 = 32;
+/// Counters a light (`COUNTERS` in the shader).
+pub(crate) const COUNTERS: u64 = 6;
+/// Views a light has at most: a cube's faces (`MAX_VIEWS` in the shader).
+pub(crate) const MAX_VIEWS: u64 = 6;
+/// Words of a view's bounds (`BOUNDS` in the shader).
+pub(crate) const BOUNDS: u64 = 4;
+/// Entries of the queue of large triangles (`QUEUE_CAPACITY` in the shader).
+pub(crate) const QUEUE_CAPACITY: u64 = 65536;
+
+/// What the buffers were made for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shape {
+    pub size: UVec2,
+    pub grid: u32,
+    pub lights: usize,
+}
+
+impl Shape {
+    /// Words of the grid buffer's heads and lengths (cleared for each light).
+    pub fn list_words(self) -> u64 {
+        2 * MAX_VIEWS * u64::from(self.grid).pow(2)
+    }
+
+    /// Words of the state buffer's counters (cleared each frame).
+    pub fn counter_words(self) -> u64 {
+        self.lights.max(1) as u64 * COUNTERS
+    }
+}
+
+/// The stages that bind the buffers: samples, insertion, the two triangle passes, and the
+/// resolve.
+pub struct Stages<'a> {
+    pub compute: [&'a Stage; 4],
+    pub resolve: &'a Stage,
+}
+
+/// The buffers and each stage's bind group over them.
+pub struct IrregularGrid {
+    pub shape: Shape,
+    /// The grid: heads, lengths, links, queue.
+    pub grid: wgpu::Buffer,
+    /// Each light's counters, then the current light's bounds and queue length.
+    pub state: wgpu::Buffer,
+    /// The bind groups of the compute stages, in [`Stages::compute`]' order.
+    pub groups: [StageBindGroup; 4],
+    /// The resolve stage's bind group (the shadowed flags).
+    pub resolve_group: StageBindGroup,
+    /// The buffers the debug stages bind with their textures.
+    view_samples: wgpu::Buffer,
+}
+
+impl IrregularGrid {
+    /// Buffers of `shape` for `tracing`'s casters, bound for `stages`; an error naming the
+    /// grid when the device cannot bind it.
+    pub fn new(
+        ctx: &RenderContext<'_>,
+        stages: Stages<'_>,
+        tracing: &RayTracing,
+        shape: Shape,
+    ) -> TechniqueResult<IrregularGrid> {
+        let pixels = u64::from(shape.size.x) * u64::from(shape.size.y);
+        let grid_bytes = 4 * (shape.list_words() + pixels + QUEUE_CAPACITY);
+        let limit = ctx.gpu.device.limits().max_storage_buffer_binding_size;
+        if grid_bytes > limit {
+            return Err(TechniqueError::Unavailable {
+                id: "frustum-traced".into(),
+                reason: format!(
+                    "the grid of {0}x{0} texels a face and its lists take {grid_bytes} bytes, \
+                     the device binds at most {limit}; lower `grid`",
+                    shape.grid
+                ),
+            });
+        }
+        let device = &ctx.gpu.device;
+        let storage = |label: &str, bytes: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        };
+        let view_samples = storage("frustum-traced view samples", pixels * SAMPLE_BYTES);
+        let grid = storage("frustum-traced grid", grid_bytes);
+        let shadowed = storage("frustum-traced shadowed", pixels * 4);
+        let state_words = shape.counter_words() + MAX_VIEWS * BOUNDS + 1;
+        let state = storage("frustum-traced state", state_words * 4);
+        let batches = tracing.batch_buffer(ctx, "frustum-traced caster batches");
+        let resources = [
+            ("caster_batches", batches.as_entire_binding()),
+            ("view_samples", view_samples.as_entire_binding()),
+            ("grid", grid.as_entire_binding()),
+            ("shadowed", shadowed.as_entire_binding()),
+            ("state", state.as_entire_binding()),
+        ];
+        let bind = |stage: &Stage| stage.bind(ctx, "frustum-traced buffers", &resources);
+        let [samples, insert, triangles, big] = stages.compute;
+        Ok(IrregularGrid {
+            shape,
+            groups: [bind(samples)?, bind(insert)?, bind(triangles)?, bind(big)?],
+            resolve_group: stages.resolve.bind(
+                ctx,
+                "frustum-traced resolve",
+                &[("shadowed", shadowed.as_entire_binding())],
+            )?,
+            grid,
+            state,
+            view_samples,
+        })
+    }
+
+    /// The bind group of debug stage `stage`, writing into `texture` (bound as `name`).
+    pub fn debug_group(
+        &self,
+        ctx: &RenderContext<'_>,
+        stage: &Stage,
+        (name, texture): (&str, &wgpu::TextureView),
+    ) -> TechniqueResult<StageBindGroup> {
+        let resources = [
+            ("view_samples", self.view_samples.as_entire_binding()),
+            ("grid", self.grid.as_entire_binding()),
+            ("state", self.state.as_entire_binding()),
+            (name, wgpu::BindingResource::TextureView(texture)),
+        ];
+        stage.bind(ctx, "frustum-traced debug view", &resources)
+    }
+}
