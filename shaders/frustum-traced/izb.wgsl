@@ -315,17 +315,40 @@ fn triangle_rect(light: Light, view: u32, corners: array<vec3<f32>, 3>) -> Rect 
         }
         return texel_rect(low, high, extent);
     }
-    // The triangle clipped to the face's pyramid (widened by the rounding), then projected.
+    // The triangle against the face's pyramid (widened by the rounding): skipped where its
+    // corners all lie outside one side, projected as it is where they all lie inside, clipped
+    // to the pyramid where it crosses a side.
+    let wide = 1.0 + 1e-5;
+    let sides = array<vec3<f32>, 4>(
+        vec3<f32>(-1.0, 0.0, wide),
+        vec3<f32>(1.0, 0.0, wide),
+        vec3<f32>(0.0, -1.0, wide),
+        vec3<f32>(0.0, 1.0, wide),
+    );
+    let a = face_frame(view, corners[0] - light.position);
+    let b = face_frame(view, corners[1] - light.position);
+    let c = face_frame(view, corners[2] - light.position);
+    var inside = min(a.z, min(b.z, c.z)) > 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        let side = vec3<f32>(dot(sides[k], a), dot(sides[k], b), dot(sides[k], c));
+        if all(side < vec3<f32>(0.0)) {
+            return NO_RECT;
+        }
+        inside = inside && all(side >= vec3<f32>(0.0));
+    }
+    if inside {
+        low = min(a.xy / a.z, min(b.xy / b.z, c.xy / c.z));
+        high = max(a.xy / a.z, max(b.xy / b.z, c.xy / c.z));
+        return texel_rect(low, high, extent);
+    }
     var polygon: Polygon;
     polygon.count = 3u;
-    for (var k = 0u; k < 3u; k++) {
-        polygon.corners[k] = face_frame(view, corners[k] - light.position);
+    polygon.corners[0] = a;
+    polygon.corners[1] = b;
+    polygon.corners[2] = c;
+    for (var k = 0u; k < 4u; k++) {
+        polygon = clip(polygon, sides[k]);
     }
-    let wide = 1.0 + 1e-5;
-    polygon = clip(polygon, vec3<f32>(-1.0, 0.0, wide));
-    polygon = clip(polygon, vec3<f32>(1.0, 0.0, wide));
-    polygon = clip(polygon, vec3<f32>(0.0, -1.0, wide));
-    polygon = clip(polygon, vec3<f32>(0.0, 1.0, wide));
     if polygon.count == 0u {
         return NO_RECT;
     }

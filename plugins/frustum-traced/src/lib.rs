@@ -34,7 +34,7 @@ zoo_host::technique_params! {
         /// Texels per side of each light plane's grid (a cube face for point and spot lights):
         /// finer grids make shorter lists and more texels per large triangle; the shadows are
         /// the same at any size.
-        grid: u32 = 256, range(16, 1024), step(16);
+        grid: u32 = 128, range(16, 1024), step(16);
         /// Light whose lists the debug views show.
         debug_light: u32 = 0, range(0, 1023), step(1);
     }
