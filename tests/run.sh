@@ -44,4 +44,22 @@ if [ "${1:-}" = --long ]; then
     # `--tests`: the long checks are tests (the doc examples all run in the suite).
     exec cargo test --workspace --locked --no-default-features --tests "$@" -- --ignored
 fi
-exec cargo test --workspace --locked --no-default-features "$@"
+test=(cargo test --workspace --locked --no-default-features)
+if [ "$#" -gt 0 ]; then
+    exec "${test[@]}" "$@"
+fi
+# The suite: built once, then `tests/zoo` beside every other test binary (cargo runs test
+# binaries one after another, and a binary whose last test runs alone leaves a core idle; two
+# streams keep both busy: about a fifth off the suite's running time on two cores).
+"${test[@]}" --no-run
+zoo_log="$(mktemp)"
+"${test[@]}" --test zoo >"$zoo_log" 2>&1 &
+zoo=$!
+status=0
+"${test[@]}" --lib --bins --test '[!z]*' || status=$?
+"${test[@]}" --doc || status=$?
+wait "$zoo" || status=$?
+echo "--- tests/zoo ---"
+cat "$zoo_log"
+rm -f "$zoo_log"
+exit "$status"

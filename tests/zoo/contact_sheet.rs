@@ -10,17 +10,20 @@ use zoo_host::Renderer;
 use zoo_host::judging::DEFAULT_SAMPLES;
 use zoo_host::test_support::{gpu, workspace_root};
 
-/// Tile size of the README's contact sheet, which every test here shares (a sheet renders
-/// and judges every technique, most of it at a cost that does not depend on the tile size).
-pub const SHARED_TILE: UVec2 = UVec2::new(256, 192);
+/// Tile size of the README's contact sheet, which the long checks share (the README's copy
+/// and GL's parity).
+pub const README_TILE: UVec2 = UVec2::new(256, 192);
+/// Tile size of the suite's sheet: a quarter of the README's pixels (the reference's area
+/// samples, the exact and ray-traced techniques pay by the pixel).
+const SUITE_TILE: UVec2 = UVec2::new(128, 96);
 /// The README's contact sheet, relative to the workspace root.
 const README_IMAGE: &str = "host/app/docs/contact-sheet.png";
 
-/// The default scene's sheet at [`SHARED_TILE`] on the test adapter, built once for every test
+/// The default scene's sheet at [`README_TILE`] on the test adapter, built once for every test
 /// that reads it.
-pub fn shared_sheet() -> &'static Sheet {
+pub fn readme_sheet() -> &'static Sheet {
     static SHEET: OnceLock<Sheet> = OnceLock::new();
-    SHEET.get_or_init(|| sheet(gpu(), SHARED_TILE))
+    SHEET.get_or_init(|| sheet(gpu(), README_TILE))
 }
 
 /// The default scene's sheet of every shipped technique available on `gpu`.
@@ -71,7 +74,7 @@ fn differing(a: &image::RgbaImage, b: &image::RgbaImage, threshold: u8) -> f64 {
 
 #[test]
 fn the_sheet_shows_every_technique_beside_a_reference_that_exact_techniques_match() {
-    let sheet = shared_sheet();
+    let sheet = &sheet(gpu(), SUITE_TILE);
     let ids: Vec<&str> = sheet.rows.iter().map(|r| r.id.as_str()).collect();
     assert_eq!(&ids[..2], ["reference (hard)", "reference (area)"]);
     for r in crate::shipped_techniques() {
@@ -83,7 +86,7 @@ fn the_sheet_shows_every_technique_beside_a_reference_that_exact_techniques_matc
     // shaded on the CPU except in the one-pixel band along the reference's shadow edges.
     let hard = &sheet.images[0];
     let volumes = &sheet.images[row("sv-zfail")];
-    let band = edge_band(SHARED_TILE);
+    let band = edge_band(SUITE_TILE);
     let off_edges = hard
         .pixels()
         .zip(volumes.pixels())
@@ -114,13 +117,14 @@ fn the_sheet_shows_every_technique_beside_a_reference_that_exact_techniques_matc
         assert!(table.contains(id), "{id} missing from\n{table}");
     }
     let image = contact_sheet::draw(sheet).unwrap();
-    let layout = Layout::new((SHARED_TILE.x, SHARED_TILE.y), sheet.images.len());
+    let layout = Layout::new((SUITE_TILE.x, SUITE_TILE.y), sheet.images.len());
     assert_eq!(image.dimensions(), layout.size());
 }
 
 /// The README embeds the sheet of the first command (at a smaller tile size). Its tiles must
 /// show what the current code renders; set `UPDATE_README_IMAGES=1` to regenerate it.
 #[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
 fn the_readme_contact_sheet_is_up_to_date() {
     let path: PathBuf = workspace_root().join(README_IMAGE);
     let readme = std::fs::read_to_string(workspace_root().join("README.md")).unwrap();
@@ -128,7 +132,7 @@ fn the_readme_contact_sheet_is_up_to_date() {
         readme.contains(&format!("]({README_IMAGE})")),
         "README.md must embed {README_IMAGE}"
     );
-    let sheet = shared_sheet();
+    let sheet = readme_sheet();
     let fresh = contact_sheet::draw(sheet).unwrap();
     if std::env::var_os("UPDATE_README_IMAGES").is_some() {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
@@ -136,8 +140,8 @@ fn the_readme_contact_sheet_is_up_to_date() {
         eprintln!("wrote {}", path.display());
         return;
     }
-    let regenerate =
-        "regenerate it with `UPDATE_README_IMAGES=1 cargo test --test zoo contact_sheet`";
+    let regenerate = "regenerate it with `UPDATE_README_IMAGES=1 bash tests/run.sh --test zoo \
+                      contact_sheet -- --ignored`";
     let committed = image::open(&path)
         .unwrap_or_else(|e| panic!("{}: {e}; {regenerate}", path.display()))
         .to_rgba8();
@@ -147,12 +151,12 @@ fn the_readme_contact_sheet_is_up_to_date() {
         "{README_IMAGE} has another layout (techniques added or removed?); {regenerate}"
     );
     // Only the tiles are compared: labels hold frame times, which vary from run to run.
-    let layout = Layout::new((SHARED_TILE.x, SHARED_TILE.y), sheet.images.len());
+    let layout = Layout::new((README_TILE.x, README_TILE.y), sheet.images.len());
     let fresh = image::DynamicImage::ImageRgb8(fresh).to_rgba8();
     for (i, row) in sheet.rows.iter().enumerate() {
         let (x, y) = layout.origin(i);
         let crop = |img: &image::RgbaImage| {
-            image::imageops::crop_imm(img, x, y, SHARED_TILE.x, SHARED_TILE.y).to_image()
+            image::imageops::crop_imm(img, x, y, README_TILE.x, README_TILE.y).to_image()
         };
         let off = differing(&crop(&committed), &crop(&fresh), 24);
         assert!(

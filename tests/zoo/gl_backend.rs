@@ -128,11 +128,11 @@ fn compare_backends(gl: &Arc<GpuContext>, scene: Scene, chosen: impl Fn(&str) ->
 #[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
 fn the_default_render_on_gl_matches_vulkan() {
     let Some(gl) = gl() else { return };
-    // The Vulkan sheet is the one the contact-sheet tests share.
-    let tile = crate::contact_sheet::SHARED_TILE;
+    // The Vulkan sheet is the one the README's check shares.
+    let tile = crate::contact_sheet::README_TILE;
     let (a, b) = (
         &crate::contact_sheet::sheet(gl.clone(), tile),
-        crate::contact_sheet::shared_sheet(),
+        crate::contact_sheet::readme_sheet(),
     );
     let ids = |s: &contact_sheet::Sheet| s.rows.iter().map(|r| r.id.clone()).collect::<Vec<_>>();
     assert_eq!(ids(a), ids(b));
