@@ -68,6 +68,7 @@ fn assert_tiny_csv(out: &std::path::Path) {
             "pass",
             "owner",
             "median_ms",
+            "mean_ms",
             "p95_ms",
             "p99_ms",
             "min_ms",
@@ -83,18 +84,20 @@ fn assert_tiny_csv(out: &std::path::Path) {
         // Quoted fields hold no commas here; every row has the header's width.
         let fields: Vec<&str> = line.split(',').collect();
         assert_eq!(fields.len(), header.len(), "{line}");
-        let numbers: Vec<f64> = fields[7..12].iter().map(|v| v.parse().unwrap()).collect();
-        let (median, p95, p99, min, max) =
-            (numbers[0], numbers[1], numbers[2], numbers[3], numbers[4]);
+        let numbers: Vec<f64> = fields[7..13].iter().map(|v| v.parse().unwrap()).collect();
+        let [median, mean, p95, p99, min, max] = numbers[..] else {
+            unreachable!()
+        };
         assert!(
             min <= median && median <= max && p95 <= p99 && p99 <= max,
             "{line}"
         );
-        assert_eq!(fields[12], "3");
+        assert!(min <= mean && mean <= max, "{line}");
+        assert_eq!(fields[13], "3");
         // The lighting pass shades every pixel once; invocations count whole 2x2 quads, so
         // helper lanes along the triangle's edge add a few percent.
-        if fields[5] == "\"Lighting\"" && !fields[14].is_empty() {
-            let fragments: u64 = fields[14].parse().unwrap();
+        if fields[5] == "\"Lighting\"" && !fields[15].is_empty() {
+            let fragments: u64 = fields[15].parse().unwrap();
             let pixels: u64 = if fields[3] == "96x96" {
                 96 * 96
             } else {
@@ -104,7 +107,7 @@ fn assert_tiny_csv(out: &std::path::Path) {
                 fragments >= pixels && fragments <= pixels * 11 / 10,
                 "{line}"
             );
-            assert_eq!(fields[13], "3", "a full-screen triangle: {line}");
+            assert_eq!(fields[14], "3", "a full-screen triangle: {line}");
         }
         rows += 1;
     }

@@ -30,7 +30,7 @@ pub(super) fn ratio_to_baseline(results: &[ConfigResult], r: &ConfigResult) -> O
 /// `bench.csv`: one row per configuration and pass (plus frame and technique totals).
 pub fn bench_csv(results: &[ConfigResult]) -> String {
     let mut out = String::from(
-        "run,configuration,technique,size,tessellation,pass,owner,median_ms,p95_ms,p99_ms,min_ms,max_ms,frames,vertex_invocations,fragment_invocations,compute_invocations\n",
+        "run,configuration,technique,size,tessellation,pass,owner,median_ms,mean_ms,p95_ms,p99_ms,min_ms,max_ms,frames,vertex_invocations,fragment_invocations,compute_invocations\n",
     );
     for r in results {
         let c = &r.config;
@@ -59,7 +59,7 @@ pub fn bench_csv(results: &[ConfigResult]) -> String {
             let counts = counts.map_or(",,".to_string(), |[v, f, c]| format!("{v},{f},{c}"));
             let _ = writeln!(
                 out,
-                "{},\"{}\",{},{}x{},{},\"{}\",{},{:.4},{:.4},{:.4},{:.4},{:.4},{},{counts}",
+                "{},\"{}\",{},{}x{},{},\"{}\",{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{},{counts}",
                 c.run,
                 c.label().replace('"', "'"),
                 c.technique.id,
@@ -69,6 +69,7 @@ pub fn bench_csv(results: &[ConfigResult]) -> String {
                 name.replace('"', "'"),
                 owner,
                 s.median,
+                s.mean,
                 s.p95,
                 s.p99,
                 s.min,
@@ -126,25 +127,51 @@ fn today() -> String {
     format!("{year:04}-{month:02}-{day:02}")
 }
 
-/// Median of a measure for a result: `frame`, `technique`, or the passes starting with a prefix.
-fn measure(r: &ConfigResult, passes: &str) -> f64 {
-    match passes {
+/// A result's measure (see [`suite::Measure::passes`]): the median time of the frame, of the
+/// technique or of the passes starting with a prefix; a counter's mean over the measured frames;
+/// or the passes' median invocations of one kind. `None` where it was not measured (a counter
+/// the technique lacks, invocations on a device without pipeline statistics).
+fn measure(r: &ConfigResult, passes: &str) -> Option<f64> {
+    if let Some(name) = passes.strip_prefix("counter:") {
+        return counter_mean(r, name);
+    }
+    for (kind, index) in [("vertices:", 0), ("fragments:", 1), ("compute:", 2)] {
+        if let Some(prefix) = passes.strip_prefix(kind) {
+            let counts: Option<Vec<u64>> = (r.passes.iter().zip(&r.invocations))
+                .filter(|((name, _, _), _)| name.starts_with(prefix))
+                .map(|(_, counts)| counts.map(|c| c[index]))
+                .collect();
+            return counts
+                .filter(|c| !c.is_empty())
+                .map(|c| c.iter().sum::<u64>() as f64);
+        }
+    }
+    Some(match passes {
         "frame" => r.frame_gpu.median,
         "technique" => r.technique_gpu.median,
-        prefix => r
-            .passes
-            .iter()
+        prefix => (r.passes.iter())
             .filter(|(n, _, _)| n.starts_with(prefix))
             .map(|(_, _, s)| s.median)
             .sum(),
+    })
+}
+
+/// Counter `name`'s mean over the measured frames (its one value where it did not change).
+fn counter_mean(r: &ConfigResult, name: &str) -> Option<f64> {
+    match r.varying_counters.iter().find(|(n, _)| n == name) {
+        Some((_, values)) => Some(values.iter().sum::<f64>() / values.len().max(1) as f64),
+        None => (r.counters.iter())
+            .find(|(n, _)| n == name)
+            .map(|(_, value)| *value),
     }
 }
 
-/// Suite ratios: (label, configuration key, value, seed figure) for every matching pair.
+/// Suite ratios: (label, configuration key, value, seed figure) for every matching pair; the
+/// value is `None` where a measure was not taken on this device.
 pub fn suite_ratios(
     s: &suite::Suite,
     results: &[ConfigResult],
-) -> Vec<(String, String, f64, String)> {
+) -> Vec<(String, String, Option<f64>, String)> {
     let mut out = Vec::new();
     for ratio in &s.ratios {
         let (n, d) = (&ratio.numerator, &ratio.denominator);
@@ -165,7 +192,7 @@ pub fn suite_ratios(
             });
             if let Some(den) = den {
                 let bottom = measure(den, &d.passes);
-                if bottom > 0.0 {
+                if bottom.is_none_or(|b| b > 0.0) {
                     let key = format!(
                         "{}x{}, tessellation {}{}",
                         num.config.size.x,
@@ -180,7 +207,7 @@ pub fn suite_ratios(
                     out.push((
                         ratio.label.clone(),
                         key,
-                        measure(num, &n.passes) / bottom,
+                        measure(num, &n.passes).zip(bottom).map(|(top, b)| top / b),
                         ratio.seed.clone(),
                     ));
                 }
@@ -318,17 +345,18 @@ fn frame_times_md(w: &mut String, results: &[ConfigResult]) {
     );
     let _ = writeln!(
         w,
-        "| run | configuration | triangles | frame median (ms) | p95 | technique median (ms) | CPU frame (ms) | × unshadowed | flicker |"
+        "| run | configuration | triangles | frame median (ms) | mean | p95 | technique median (ms) | CPU frame (ms) | × unshadowed | flicker |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|");
     for r in results {
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} |",
+            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} |",
             r.config.run,
             r.config.label(),
             r.triangles,
             r.frame_gpu.median,
+            r.frame_gpu.mean,
             r.frame_gpu.p95,
             r.technique_gpu.median,
             r.frame_cpu.median,
@@ -363,7 +391,8 @@ fn seeds_md(w: &mut String, suite: &suite::Suite, results: &[ConfigResult]) {
         let _ = writeln!(w, "| ratio | configuration | this project | seed |");
         let _ = writeln!(w, "|---|---|---|---|");
         for (label, key, value, seed) in ratios {
-            let _ = writeln!(w, "| {label} | {key} | {value:.2} | {seed} |");
+            let value = value.map_or("not measured on this device".into(), |v| format!("{v:.2}"));
+            let _ = writeln!(w, "| {label} | {key} | {value} | {seed} |");
         }
     }
     if !suite.seed_figures.is_empty() {
@@ -553,5 +582,113 @@ fn sweep_line_name(r: &ConfigResult, sweep: &Sweep) -> String {
         r.config.technique.id.to_string()
     } else {
         format!("{} [{}]", r.config.technique.id, others.join(", "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bench::stats::Summary;
+    use zoo_host::gpu::TimingSource;
+
+    /// A result of run `run` for `unshadowed` with `passes` (name, median ms, invocations) and
+    /// counters, some varying over three frames.
+    fn result(
+        run: &str,
+        passes: &[(&str, f64, Option<[u64; 3]>)],
+        counters: &[(&str, f64)],
+        varying: &[(&str, [f64; 3])],
+    ) -> ConfigResult {
+        let technique = zoo_host::find_technique("unshadowed").unwrap();
+        let summary = |ms: f64| Summary::of(&[ms]);
+        let total: f64 = passes.iter().map(|p| p.1).sum();
+        ConfigResult {
+            config: Configuration {
+                run: run.into(),
+                technique,
+                params: zoo_host::params::defaults(&(technique.params)()),
+                swept: Vec::new(),
+                size: zoo_host::glam::UVec2::new(64, 64),
+                tessellation: 1.0,
+                lights: None,
+            },
+            passes: (passes.iter())
+                .map(|(name, ms, _)| (name.to_string(), PassOwner::Technique, summary(*ms)))
+                .collect(),
+            invocations: passes.iter().map(|p| p.2).collect(),
+            frame_gpu: summary(total),
+            technique_gpu: summary(total),
+            frame_cpu: summary(total),
+            counters: (counters.iter())
+                .map(|(name, value)| (name.to_string(), *value))
+                .collect(),
+            varying_counters: (varying.iter())
+                .map(|(name, values)| (name.to_string(), values.to_vec()))
+                .collect(),
+            flicker: None,
+            timing_source: TimingSource::GpuTimestamps,
+            triangles: 0,
+        }
+    }
+
+    #[test]
+    fn measures_are_times_counters_and_invocations() {
+        let r = result(
+            "a",
+            &[
+                ("Volumes: light 0", 2.0, Some([3, 100, 0])),
+                ("Volumes: light 1", 4.0, Some([5, 300, 0])),
+                ("Lighting", 1.0, None),
+            ],
+            &[("pages", 7.0), ("drawn", 6.0)],
+            &[("drawn", [2.0, 4.0, 6.0])],
+        );
+        assert_eq!(measure(&r, "frame"), Some(7.0));
+        assert_eq!(measure(&r, "Volumes"), Some(6.0));
+        assert_eq!(measure(&r, "fragments:Volumes"), Some(400.0));
+        assert_eq!(measure(&r, "vertices:Volumes"), Some(8.0));
+        // Invocations a device did not count, or no pass of that name: not measured.
+        assert_eq!(measure(&r, "fragments:Lighting"), None);
+        assert_eq!(measure(&r, "fragments:Shadow"), None);
+        // A counter that changed is averaged over the frames; one that did not is its value.
+        assert_eq!(measure(&r, "counter:drawn"), Some(4.0));
+        assert_eq!(measure(&r, "counter:pages"), Some(7.0));
+        assert_eq!(measure(&r, "counter:absent"), None);
+    }
+
+    #[test]
+    fn ratios_divide_any_measure_and_name_what_was_not_measured() {
+        let suite: suite::Suite = ron::from_str(
+            r#"(name: "t", description: "", runs: [], ratios: [
+                (label: "fragments", numerator: (run: "a", technique: "unshadowed",
+                    passes: "fragments:Volumes"), denominator: (run: "b",
+                    technique: "unshadowed", passes: "fragments:Volumes"), seed: "8-30x"),
+                (label: "share", numerator: (run: "a", technique: "unshadowed",
+                    passes: "Volumes"), denominator: (run: "a", technique: "unshadowed"),
+                    seed: "> 88 %"),
+                (label: "unmeasured", numerator: (run: "a", technique: "unshadowed",
+                    passes: "fragments:Lighting"), denominator: (run: "b",
+                    technique: "unshadowed"), seed: "-"),
+            ])"#,
+        )
+        .unwrap();
+        let a = result(
+            "a",
+            &[("Volumes", 3.0, Some([0, 50, 0])), ("Lighting", 1.0, None)],
+            &[],
+            &[],
+        );
+        let b = result("b", &[("Volumes", 6.0, Some([0, 1000, 0]))], &[], &[]);
+        let ratios = suite_ratios(&suite, &[a, b]);
+        let values: Vec<(&str, Option<f64>)> =
+            ratios.iter().map(|(l, _, v, _)| (l.as_str(), *v)).collect();
+        assert_eq!(
+            values,
+            [
+                ("fragments", Some(0.05)),
+                ("share", Some(0.75)),
+                ("unmeasured", None)
+            ]
+        );
     }
 }

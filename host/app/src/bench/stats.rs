@@ -4,6 +4,7 @@
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Summary {
     pub median: f64,
+    pub mean: f64,
     pub p95: f64,
     pub p99: f64,
     pub min: f64,
@@ -28,6 +29,7 @@ impl Summary {
         };
         Summary {
             median,
+            mean: sorted.iter().sum::<f64>() / n as f64,
             p95: zoo_host::judge::percentile(&sorted, 0.95),
             p99: zoo_host::judge::percentile(&sorted, 0.99),
             min: sorted[0],

@@ -60,7 +60,11 @@ fn default_warmup() -> u32 {
 pub struct Measure {
     pub run: String,
     pub technique: String,
-    /// `frame`, `technique` (its passes), or a pass-name prefix.
+    /// What is measured: median times of the `frame`, the `technique` (its passes) or the
+    /// passes whose names start with a prefix (over `frame` of the same technique: the passes'
+    /// share of the frame); `counter:NAME`, the counter's mean over the measured frames; or
+    /// `vertices:PREFIX`, `fragments:PREFIX`, `compute:PREFIX`, the median shader invocations
+    /// of those passes (where the device counts them).
     #[serde(default = "default_measure")]
     pub passes: String,
 }
