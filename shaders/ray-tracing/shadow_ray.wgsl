@@ -23,9 +23,12 @@ struct ShadowRay {
     skipped: f32,
 }
 
-// The ray from `origin` (`ray_origin(s)`) along `direction` up to `reach`, started past the
-// stretch where it could meet its own surface again (`rt_gbuffer_raster_skip`).
-fn shadow_ray(s: Surface, origin: vec3<f32>, direction: vec3<f32>, reach: f32) -> ShadowRay {
+// The ray from `origin` (`ray_origin(s)`) along `direction` toward a light `distance` away,
+// started past the stretch where it could meet its own surface again
+// (`rt_gbuffer_raster_skip`) and ended short of the light by the distance's rounding, as the
+// judge's rays end (`RT_TO_LIGHT`): a caster through the light's point does not stop it.
+fn shadow_ray(s: Surface, origin: vec3<f32>, direction: vec3<f32>, distance: f32) -> ShadowRay {
+    let reach = distance * RT_TO_LIGHT;
     // A pixel's side at unit distance: the view plane's height over the pixels.
     let pixel = 2.0 / (camera.proj[1][1] * camera.size.y);
     let skip = min(rt_gbuffer_raster_skip(s.position, s.normal, camera.position, direction, pixel), reach);

@@ -56,8 +56,8 @@ fn agrees_off_edges(scene: &str, id: &str, exact: &JudgeRun, rays: &JudgeRun) {
 
 /// Scenes that stress an exact method's numbers, each at unit scale with every light kind:
 /// casters 1e-4 above their receiver, triangles edge-on to the light (fins along the sun's
-/// direction, a point light in a fin's plane) and lights inside a caster's bounds (a point light
-/// at a torus' centre, a spot light under a lattice of boxes it sits among).
+/// direction, a point light in a fin's plane) and lights inside a caster's bounds (a point
+/// light at a torus' centre, a spot light under a lattice of boxes it sits among).
 const STRESS_SCENES: [(&str, &str); 3] = [
     (
         "hairline",
@@ -128,9 +128,9 @@ const STRESS_SCENES: [(&str, &str); 3] = [
 ];
 
 /// Core error (false shadow and false lit off the shadow edges) at most 0.0005 for every light
-/// of every [`STRESS_SCENES`] scene, for each per-triangle method.
+/// of every [`STRESS_SCENES`] scene, for each per-triangle method and rt-shadows' one ray.
 #[test]
-fn per_triangle_methods_stay_exact_under_stress() {
+fn exact_methods_stay_exact_under_stress() {
     let base = zoo_host::test_support::scene_path("contact.ron");
     for (name, text) in STRESS_SCENES {
         let path = std::path::Path::new(name);
@@ -139,7 +139,39 @@ fn per_triangle_methods_stay_exact_under_stress() {
         for id in PER_TRIANGLE {
             assert_core_within(&judge_scene(scene.clone(), id, &[], SIZE), id, 0.0005);
         }
+        let one_ray = [("rays_per_pixel", "1")];
+        let rays = judge_scene(scene.clone(), "rt-shadows", &one_ray, SIZE);
+        assert_core_within(&rays, "rt-shadows", 0.0005);
     }
+}
+
+/// A point light on a caster's edge (a lamp on a wall's plane): the rays end short of the light
+/// by the distance's rounding, as the judge's do, so the caster through the light's point does
+/// not stop them (measured before rays ended there: core error 0.10 for rt-shadows, 0.027 for
+/// frustum-traced, 0.0094 for per-triangle-volumes). What is left is the rounding of rays that
+/// graze the caster's plane at the light, where the triangle test's distance error grows as one
+/// over the sine of the angle (measured 0.0005 to 0.0008): held to 0.002.
+#[test]
+fn a_light_on_a_casters_edge_is_not_shadowed_by_it() {
+    let text = (STRESS_SCENES[1].1)
+        .replace(
+            "Point(position: (0.0, 1.5, 0.3)",
+            "Point(position: (0.0, 1.2, 0.3)",
+        )
+        .replace("name: \"edge-on\"", "name: \"light-on-an-edge\"");
+    let base = zoo_host::test_support::scene_path("contact.ron");
+    let path = std::path::Path::new("light-on-an-edge");
+    let mut scene = Scene::from_ron(&text, path, base.parent().unwrap()).unwrap();
+    scene
+        .lights
+        .retain(|l| l.kind == zoo_host::LightKind::Point);
+    assert_eq!(scene.lights.len(), 1);
+    for id in PER_TRIANGLE {
+        assert_core_within(&judge_scene(scene.clone(), id, &[], SIZE), id, 0.002);
+    }
+    let one_ray = [("rays_per_pixel", "1")];
+    let rays = judge_scene(scene, "rt-shadows", &one_ray, SIZE);
+    assert_core_within(&rays, "rt-shadows", 0.002);
 }
 
 /// Asserts that every light of `run` (technique `id`) has a core error at most `bound`.

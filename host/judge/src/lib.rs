@@ -27,6 +27,7 @@ pub use metrics::{ErrorClass, Metrics, edge_band, error_class, percentile};
 pub use occluders::Occluders;
 pub use placed::placed_box;
 pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, reference_visibility};
+pub use robust::SHADOW_RAY_TO_LIGHT;
 pub use sampling::{concentric_disk, stratified_disk};
 pub use surfaces::{
     GBUFFER_POSITION_ERROR, SurfaceHit, SurfacePoint, Surfaces, reconstruction_error,

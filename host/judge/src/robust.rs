@@ -30,10 +30,15 @@ pub(crate) fn offset_along(p: Vec3, n: Vec3, distance: f32) -> Vec3 {
     out
 }
 
-/// The length of a shadow ray to a light `distance` away: all of it but the rounding of the
-/// distance itself (lights have no geometry, so nothing at the light is missed).
+/// The fraction of the distance to a light that a shadow ray covers: all of it but the
+/// distance's own rounding, so a caster through the light's point (a lamp on a wall's plane)
+/// does not stop rays that reach the light (lights have no geometry: nothing at the light is
+/// missed). The GPU's shadow rays end at the same fraction (`ray-tracing/shadow_ray.wgsl`).
+pub const SHADOW_RAY_TO_LIGHT: f32 = 1.0 - gamma(4);
+
+/// The length of a shadow ray to a light `distance` away ([`SHADOW_RAY_TO_LIGHT`] of it).
 pub(crate) fn to_light(distance: f32) -> f32 {
-    distance * (1.0 - gamma(4))
+    distance * SHADOW_RAY_TO_LIGHT
 }
 
 /// The distance a ray origin must keep from the plane of triangle `corners` so that the

@@ -4,7 +4,7 @@
 //! once, here and in the judge; this module registers them as the generated shader module
 //! [`ERROR_MODULE`].
 
-use zoo_host::judge::GBUFFER_POSITION_ERROR;
+use zoo_host::judge::{GBUFFER_POSITION_ERROR, SHADOW_RAY_TO_LIGHT};
 
 /// How far the rasteriser may move a drawn surface off its plane, as a fraction of a pixel's
 /// footprint at its distance: its snapping of vertices to a sub-pixel grid of 8 bits
@@ -12,17 +12,19 @@ use zoo_host::judge::GBUFFER_POSITION_ERROR;
 pub const RASTER_SUBPIXEL: f32 = 1.0 / 256.0;
 
 /// The generated module holding `RT_GBUFFER_POSITION_ERROR`, the judge's
-/// [`GBUFFER_POSITION_ERROR`], and `RT_RASTER_SUBPIXEL`, [`RASTER_SUBPIXEL`].
+/// [`GBUFFER_POSITION_ERROR`], `RT_RASTER_SUBPIXEL`, [`RASTER_SUBPIXEL`], and `RT_TO_LIGHT`,
+/// the judge's [`SHADOW_RAY_TO_LIGHT`].
 pub const ERROR_MODULE: &str = "ray-tracing/gbuffer_error.wgsl";
 
 /// The text of [`ERROR_MODULE`]: the factors as WGSL literals that parse back to the same
 /// `f32`s (Rust's shortest round-trip form).
 fn error_module() -> String {
     format!(
-        "// Generated from `zoo_judge::GBUFFER_POSITION_ERROR` and `RASTER_SUBPIXEL`\n\
-         // (libs/ray-tracing/src/origin.rs).\n\
+        "// Generated from `zoo_judge::GBUFFER_POSITION_ERROR`, `RASTER_SUBPIXEL` and\n\
+         // `zoo_judge::SHADOW_RAY_TO_LIGHT` (libs/ray-tracing/src/origin.rs).\n\
          const RT_GBUFFER_POSITION_ERROR: f32 = {GBUFFER_POSITION_ERROR:?};\n\
-         const RT_RASTER_SUBPIXEL: f32 = {RASTER_SUBPIXEL:?};\n"
+         const RT_RASTER_SUBPIXEL: f32 = {RASTER_SUBPIXEL:?};\n\
+         const RT_TO_LIGHT: f32 = {SHADOW_RAY_TO_LIGHT:?};\n"
     )
 }
 
@@ -38,15 +40,22 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_generated_constant_is_the_judges_value() {
+    fn the_generated_constants_are_the_judges_values() {
         let text = zoo_host::ShaderLibrary::embedded()
-            .compose("ray-tracing/origin.wgsl")
+            .compose("ray-tracing/shadow_ray.wgsl")
             .unwrap()
             .source;
-        let line = (text.lines())
-            .find_map(|l| l.strip_prefix("const RT_GBUFFER_POSITION_ERROR: f32 = "))
-            .expect("the origin module imports the generated constant");
-        let value: f32 = line.trim_end_matches(';').parse().unwrap();
-        assert_eq!(value.to_bits(), GBUFFER_POSITION_ERROR.to_bits());
+        let constant = |name: &str| -> f32 {
+            let prefix = format!("const {name}: f32 = ");
+            let line = (text.lines())
+                .find_map(|l| l.strip_prefix(prefix.as_str()))
+                .unwrap_or_else(|| panic!("the shadow rays import {name}"));
+            line.trim_end_matches(';').parse().unwrap()
+        };
+        let position_error = constant("RT_GBUFFER_POSITION_ERROR");
+        assert_eq!(position_error.to_bits(), GBUFFER_POSITION_ERROR.to_bits());
+        let to_light = constant("RT_TO_LIGHT");
+        assert_eq!(to_light.to_bits(), SHADOW_RAY_TO_LIGHT.to_bits());
+        assert!(to_light < 1.0);
     }
 }
