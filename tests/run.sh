@@ -50,16 +50,26 @@ if [ "$#" -gt 0 ]; then
 fi
 # The suite: built once, then `tests/zoo` beside every other test binary (cargo runs test
 # binaries one after another, and a binary whose last test runs alone leaves a core idle; two
-# streams keep both busy: about a fifth off the suite's running time on two cores).
+# streams keep both busy: about a fifth off the suite's running time on two cores). `[!z]*`
+# names every integration test but `zoo` (no other test target's name starts with z).
 "${test[@]}" --no-run
 zoo_log="$(mktemp)"
+echo "tests/zoo runs beside the other tests; its output follows theirs (live in $zoo_log)"
 "${test[@]}" --test zoo >"$zoo_log" 2>&1 &
 zoo=$!
+# On any exit (an interrupt too), the zoo stream stops with the script: its test binary, then
+# cargo.
+stop_zoo() {
+    if command -v pkill >/dev/null; then pkill -P "$zoo" 2>/dev/null || true; fi
+    kill "$zoo" 2>/dev/null || true
+    rm -f "$zoo_log"
+}
+trap stop_zoo EXIT
+trap 'exit 130' INT TERM
 status=0
 "${test[@]}" --lib --bins --test '[!z]*' || status=$?
 "${test[@]}" --doc || status=$?
 wait "$zoo" || status=$?
 echo "--- tests/zoo ---"
 cat "$zoo_log"
-rm -f "$zoo_log"
 exit "$status"

@@ -5,8 +5,9 @@
 //    light (`ray-tracing/shadow_ray.wgsl`, as rt-shadows and the judge send it), and where the
 //    ray meets the light's image plane: for the sun one plane across its direction, for point
 //    and spot lights the six faces of a cube around the light (a ray to the light's centre is
-//    one point of a face). The samples' extent on each plane is fitted (`view_bounds`), so the
-//    grid covers what the camera sees, not the scene.
+//    one point of a face). The samples' extent on each plane is fitted as they are placed
+//    (atomic minima and maxima, read by `view_bounds`), so the grid covers what the camera sees,
+//    not the scene.
 // 2. `cs_insert`: each sample joins the list of its grid texel (a head per texel, a link per
 //    sample): the irregular z-buffer, whose texels hold the exact points the eye sees.
 // 3. `cs_triangles`: every caster triangle is rasterised conservatively on each plane: the
@@ -207,8 +208,9 @@ fn cs_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     var sample = ViewSample(vec4<f32>(0.0), vec4<f32>(0.0));
     let s = load_surface(vec2<i32>(id.xy));
     let light = lights[ft_light.light];
-    if s.valid && light_falloff(light, s.position) > 0.0 {
-        let ray = hard_shadow_ray(s, light);
+    let ray = hard_shadow_ray(s, light);
+    // (A surface at a point light's centre has no direction to it: no sample.)
+    if s.valid && light_falloff(light, s.position) > 0.0 && ray.reach > 0.0 {
         let at = plane_position(light, ray.origin);
         let view = u32(at.z);
         sample = ViewSample(vec4<f32>(ray.origin, ray.reach), vec4<f32>(ray.direction, f32(1u + view)));
@@ -272,9 +274,9 @@ fn texel_rect(low: vec2<f32>, high: vec2<f32>, extent: Extent) -> Rect {
     return Rect(vec2<i32>(max(a, vec2<f32>(0.0))), vec2<i32>(min(b, vec2<f32>(last))));
 }
 
-// A polygon of up to 9 corners (a triangle clipped by four planes).
+// A polygon of up to 7 corners (a triangle clipped by four planes, each adding at most one).
 struct Polygon {
-    corners: array<vec3<f32>, 9>,
+    corners: array<vec3<f32>, 7>,
     count: u32,
 }
 
@@ -410,7 +412,7 @@ fn light_views(light: Light) -> u32 {
 
 // Each invocation takes caster triangles in turn: on each view, a small rectangle of texels
 // is walked here and a large one queued.
-@compute @workgroup_size(64)
+@compute @workgroup_size(GROUP)
 fn cs_triangles(@builtin(global_invocation_id) id: vec3<u32>) {
     let light = lights[ft_light.light];
     let views = light_views(light);
@@ -438,7 +440,7 @@ fn cs_triangles(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Each workgroup takes queued large triangles in turn, its invocations sharing the texels.
-@compute @workgroup_size(64)
+@compute @workgroup_size(GROUP)
 fn cs_big_triangles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let light = lights[ft_light.light];
     let queued = min(atomicLoad(&state[queue_length_index()]), QUEUE_CAPACITY);
@@ -483,7 +485,11 @@ fn cs_samples_per_texel(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= g || id.y >= MAX_VIEWS * g {
         return;
     }
-    let texel = (id.y % g) * g + id.x;
-    let length = atomicLoad(&grid[length_index(id.y / g, texel)]);
+    let view = id.y / g;
+    var length = 0u;
+    // (The lists of views the light lacks are not cleared for it.)
+    if view < light_views(lights[ft_light.light]) {
+        length = atomicLoad(&grid[length_index(view, (id.y % g) * g + id.x)]);
+    }
     textureStore(samples_per_texel, id.xy, vec4<u32>(length));
 }

@@ -5,8 +5,8 @@
 // with the traversal's own triangle test (`rt_intersect`), so the methods stop exactly the rays
 // that rt-shadows and the judge see stopped.
 //
-// A stage importing it binds `caster_batches` in its own group (the plugin's buffer from
-// `zoo_ray_tracing::RayTracing::batch_buffer`).
+// A stage importing it binds `caster_batches` at group 4, binding 0 (the plugin's buffer from
+// `zoo_ray_tracing::RayTracing::batch_buffer`), keeping that binding free in its own group.
 
 #import "ray-tracing/trace.wgsl"
 #import "ray-tracing/batch.wgsl"

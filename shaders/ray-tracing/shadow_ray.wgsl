@@ -42,6 +42,6 @@ fn hard_shadow_ray(s: Surface, light: Light) -> ShadowRay {
     if light.kind == LIGHT_DIRECTIONAL {
         return shadow_ray(s, origin, normalize(light_vector(light, s.position)), 3.0e38);
     }
-    let reach = distance(light.position, origin);
-    return shadow_ray(s, origin, (light.position - origin) / reach, reach);
+    let to_light = distance(light.position, origin);
+    return shadow_ray(s, origin, (light.position - origin) / to_light, to_light);
 }

@@ -89,18 +89,18 @@ fn trace(pixel: vec2<i32>, coloured: bool) -> Traced {
             offset = concentric_disk(fract(rotation + r2(rt_light.frame * rays + i)));
         }
         var direction: vec3<f32>;
-        var reach: f32;
+        var to_light: f32;
         if light.kind == LIGHT_DIRECTIONAL {
             direction = normalize(toward + tan(light.radius) * (disk * offset));
-            reach = 3.0e38;
+            to_light = 3.0e38;
         } else {
             let target_point = light.position + light.radius * (disk * offset);
-            reach = distance(target_point, origin);
-            direction = (target_point - origin) / reach;
+            to_light = distance(target_point, origin);
+            direction = (target_point - origin) / to_light;
         }
         let weight = max(dot(s.normal, direction), 0.0);
         total += weight;
-        let ray = shadow_ray(s, origin, direction, reach);
+        let ray = shadow_ray(s, origin, direction, to_light);
         if !rt_occluded(ray.origin, direction, ray.reach) {
             var colour = vec3<f32>(1.0);
             if coloured {
@@ -162,11 +162,11 @@ fn fs_blocker_distance(in: FullscreenOut) -> @location(0) vec4<f32> {
         discard;
     }
     let origin = ray_origin(s);
-    var reach = 3.0e38;
+    var to_light = 3.0e38;
     if light.kind != LIGHT_DIRECTIONAL {
-        reach = distance(light.position, origin);
+        to_light = distance(light.position, origin);
     }
-    let ray = shadow_ray(s, origin, normalize(toward), reach);
+    let ray = shadow_ray(s, origin, normalize(toward), to_light);
     let hit = rt_closest(ray.origin, ray.direction, ray.reach);
     if !hit.found {
         discard;

@@ -121,7 +121,7 @@ fn the_sheet_shows_every_technique_beside_a_reference_that_exact_techniques_matc
     assert_eq!(image.dimensions(), layout.size());
 }
 
-/// The README embeds the sheet of the first command (at a smaller tile size). Its tiles must
+/// The README embeds the sheet of the first command (at [`README_TILE`]). Its tiles must
 /// show what the current code renders; set `UPDATE_README_IMAGES=1` to regenerate it.
 #[test]
 #[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]

@@ -131,11 +131,8 @@ const STRESS_SCENES: [(&str, &str); 3] = [
 /// of every [`STRESS_SCENES`] scene, for each per-triangle method and rt-shadows' one ray.
 #[test]
 fn exact_methods_stay_exact_under_stress() {
-    let base = zoo_host::test_support::scene_path("contact.ron");
     for (name, text) in STRESS_SCENES {
-        let path = std::path::Path::new(name);
-        let scene =
-            Scene::from_ron(text, path, base.parent().unwrap()).unwrap_or_else(|e| panic!("{e}"));
+        let scene = stress_scene(name, text);
         for id in PER_TRIANGLE {
             assert_core_within(&judge_scene(scene.clone(), id, &[], SIZE), id, 0.0005);
         }
@@ -174,6 +171,13 @@ fn a_light_on_a_casters_edge_is_not_shadowed_by_it() {
     assert_core_within(&rays, "rt-shadows", 0.002);
 }
 
+/// Scene `name` from RON `text` (relative paths from `scenes/`).
+fn stress_scene(name: &str, text: &str) -> Scene {
+    let base = zoo_host::test_support::scene_path("contact.ron");
+    let base = base.parent().unwrap();
+    Scene::from_ron(text, std::path::Path::new(name), base).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Asserts that every light of `run` (technique `id`) has a core error at most `bound`.
 fn assert_core_within(run: &JudgeRun, id: &str, bound: f64) {
     for (light, score) in run.judged.scores.iter().enumerate() {
@@ -205,9 +209,7 @@ fn per_triangle_methods_stay_exact_over_a_million_triangles() {
          color: (0.8, 0.6, 0.3), transform: (translation: (-1.2, 0.4, 0.8))),
     ],
 )"#;
-    let base = zoo_host::test_support::scene_path("contact.ron");
-    let path = std::path::Path::new("million");
-    let scene = Scene::from_ron(text, path, base.parent().unwrap()).unwrap();
+    let scene = stress_scene("million", text);
     eprintln!("million: {} triangles", scene.triangle_count());
     assert!(scene.triangle_count() >= 1_000_000);
     for id in PER_TRIANGLE {

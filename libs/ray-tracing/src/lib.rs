@@ -45,11 +45,11 @@ pub const GROUP: u32 = 3;
 
 /// The module a tracing shader imports (the portable traversal).
 pub const TRACE_MODULE: &str = "ray-tracing/trace.wgsl";
+/// The module [`shader_source`] imports instead for hardware ray queries.
+pub const QUERY_MODULE: &str = "ray-tracing/query.wgsl";
 /// The exact per-triangle methods' resolve: a full-screen `fs_resolve` that shadows each pixel
 /// flagged in its `shadowed` buffer (one `u32` a pixel).
 pub const RESOLVE_SHADOWED_SHADER: &str = "ray-tracing/shadowed.wgsl";
-/// The module [`shader_source`] imports instead for hardware ray queries.
-pub const QUERY_MODULE: &str = "ray-tracing/query.wgsl";
 
 /// Stages that may trace rays.
 const STAGES: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);

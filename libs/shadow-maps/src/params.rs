@@ -9,10 +9,14 @@ zoo_host::technique_params! {
     pub struct MapParams {
         /// Shadow-map resolution in texels per side (clamped to the device and memory budget).
         map_size: u32 = 2048, range(256, 8192), step(256);
-        /// Slope-scaled depth bias of the depth pass (times the polygon's depth slope).
+        /// Slope-scaled depth bias of the depth pass (times the polygon's depth slope). Too
+        /// little shows shadow acne (each texel keeps one depth for a patch of a sloped surface,
+        /// which then shadows itself in stripes); too much detaches shadows from their casters
+        /// (peter-panning).
         slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1), flags(rebuild);
         /// Normal offset: lookups move off the surface by this many shadow-map texels
-        /// (measured at the receiver).
+        /// (measured at the receiver). None, with no slope bias, shows shadow acne on every lit
+        /// surface; too much moves lookups past thin casters' contact (peter-panning).
         normal_offset: f32 = 1.5, range(0.0, 8.0), step(0.1);
     }
 }

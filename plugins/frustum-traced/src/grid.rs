@@ -28,9 +28,22 @@ pub struct Shape {
 }
 
 impl Shape {
-    /// Words of the grid buffer's heads and lengths (cleared for each light).
+    /// Words of the grid buffer's heads and lengths.
     pub fn list_words(self) -> u64 {
-        2 * MAX_VIEWS * u64::from(self.grid).pow(2)
+        2 * MAX_VIEWS * self.view_words()
+    }
+
+    /// Words of one view's heads (or lengths).
+    pub fn view_words(self) -> u64 {
+        u64::from(self.grid).pow(2)
+    }
+
+    /// The byte ranges of the grid buffer that `views` views' heads and lengths take (cleared
+    /// for each light: the sun has one view, point and spot lights six).
+    pub fn list_ranges(self, views: u64) -> [std::ops::Range<u64>; 2] {
+        let view_bytes = 4 * self.view_words();
+        let lengths = MAX_VIEWS * view_bytes;
+        [0..views * view_bytes, lengths..lengths + views * view_bytes]
     }
 
     /// Words of the state buffer's counters (cleared each frame).
@@ -57,7 +70,7 @@ pub struct IrregularGrid {
     pub groups: [StageBindGroup; 4],
     /// The resolve stage's bind group (the shadowed flags).
     pub resolve_group: StageBindGroup,
-    /// The buffers the debug stages bind with their textures.
+    /// The view samples (which the debug stages bind with the grid and the state).
     view_samples: wgpu::Buffer,
 }
 
@@ -72,14 +85,25 @@ impl IrregularGrid {
     ) -> TechniqueResult<IrregularGrid> {
         let pixels = u64::from(shape.size.x) * u64::from(shape.size.y);
         let grid_bytes = 4 * (shape.list_words() + pixels + QUEUE_CAPACITY);
+        let sample_bytes = pixels * SAMPLE_BYTES;
         let limit = ctx.gpu.device.limits().max_storage_buffer_binding_size;
-        if grid_bytes > limit {
+        let (size, grid) = (shape.size, shape.grid);
+        let too_large = [
+            (
+                grid_bytes,
+                format!("the grid of {grid}x{grid} texels a face and its lists"),
+            ),
+            (
+                sample_bytes,
+                format!("the view samples of {}x{} pixels", size.x, size.y),
+            ),
+        ];
+        if let Some((bytes, what)) = too_large.into_iter().find(|(bytes, _)| *bytes > limit) {
             return Err(TechniqueError::Unavailable {
                 id: "frustum-traced".into(),
                 reason: format!(
-                    "the grid of {0}x{0} texels a face and its lists take {grid_bytes} bytes, \
-                     the device binds at most {limit}; lower `grid`",
-                    shape.grid
+                    "{what} take {bytes} bytes, the device binds at most {limit}; lower `grid` \
+                     or the resolution"
                 ),
             });
         }
@@ -94,7 +118,7 @@ impl IrregularGrid {
                 mapped_at_creation: false,
             })
         };
-        let view_samples = storage("frustum-traced view samples", pixels * SAMPLE_BYTES);
+        let view_samples = storage("frustum-traced view samples", sample_bytes);
         let grid = storage("frustum-traced grid", grid_bytes);
         let shadowed = storage("frustum-traced shadowed", pixels * 4);
         let state_words = shape.counter_words() + MAX_VIEWS * BOUNDS + 1;

@@ -1,6 +1,6 @@
 //! Frustum-traced shadows over an irregular z-buffer (Wyman, Hoetzlein and Lefohn, I3D 2015;
-//! TVCG 2016): exact hard shadows from any triangle soup, computed per light in four compute
-//! steps (`shaders/frustum-traced/izb.wgsl`):
+//! TVCG 2016): exact hard shadows from any triangle soup, computed per light in three compute
+//! steps and a resolve (`shaders/frustum-traced/izb.wgsl`):
 //!
 //! 1. each pixel's view sample (its hard shadow ray to the light, the judge's and rt-shadows'
 //!    ray) placed on the light's image plane: one plane across the sun's direction, six cube
@@ -70,8 +70,9 @@ const LIST_LENGTH_VIEW: &str = "list length";
 const SAMPLES_PER_TEXEL_VIEW: &str = "samples per texel";
 const COUNT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
-/// The debug textures for grids of `grid` texels a side.
-fn debug_specs(grid: u32) -> [TextureSpec; 2] {
+/// The debug textures for grids of `grid` texels a side, on a device whose textures are at most
+/// `max_texture` texels a side.
+fn debug_specs(grid: u32, max_texture: u32) -> [TextureSpec; 2] {
     let spec = |name, size| TextureSpec {
         name,
         size,
@@ -82,7 +83,9 @@ fn debug_specs(grid: u32) -> [TextureSpec; 2] {
         view: Some(ViewMapping::Integer),
         aliases: Vec::new(),
     };
-    let planes = zoo_host::glam::UVec2::new(grid, grid * grid::MAX_VIEWS as u32);
+    // (Cut to the device's largest texture: a finer grid's last faces are not shown.)
+    let planes = zoo_host::glam::UVec2::new(grid, grid * grid::MAX_VIEWS as u32)
+        .min(zoo_host::glam::UVec2::splat(max_texture));
     [
         spec(LIST_LENGTH_VIEW, TextureSize::SCREEN),
         spec(SAMPLES_PER_TEXEL_VIEW, TextureSize::Fixed(planes)),
@@ -222,19 +225,19 @@ impl ShadowTechnique for FrustumTraced {
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
         let gpu = self.gpu.prepare(false, || Gpu::new(ctx))?;
-        if changes.scene || gpu.tracing.as_ref().is_none_or(|t| !t.is_for(ctx)) {
-            gpu.tracing = Some(RayTracing::new(ctx, Tracer::Compute, &gpu.tracing_layout)?);
-            gpu.buffers = None;
-        }
+        let tracing = match &mut gpu.tracing {
+            Some(tracing) if !changes.scene && tracing.is_for(ctx) => tracing,
+            slot => {
+                gpu.buffers = None;
+                slot.insert(RayTracing::new(ctx, Tracer::Compute, &gpu.tracing_layout)?)
+            }
+        };
         let shape = Shape {
             size: ctx.size,
             grid: self.params.grid,
             lights: ctx.lights.len(),
         };
         if gpu.buffers.as_ref().is_none_or(|b| b.shape != shape) {
-            let Some(tracing) = &gpu.tracing else {
-                return Ok(());
-            };
             let stages = grid::Stages {
                 compute: [
                     &gpu.samples,
@@ -250,7 +253,9 @@ impl ShadowTechnique for FrustumTraced {
             gpu.stats = Some(Mutex::new(ring));
             gpu.buffers = Some(buffers);
         }
-        self.debug.respec_all(debug_specs(self.params.grid));
+        let max_texture = ctx.gpu.device.limits().max_texture_dimension_2d;
+        self.debug
+            .respec_all(debug_specs(self.params.grid, max_texture));
         self.debug.prepare(ctx);
         Ok(())
     }
@@ -281,15 +286,21 @@ impl ShadowTechnique for FrustumTraced {
         let last = ctx.lights.len().saturating_sub(1);
         let debug_light = (self.params.debug_light as usize).min(last);
         for light in 0..ctx.lights.len() {
-            // Empty lists, and no bounds or queued triangles yet.
+            // Empty lists on the light's views, and no bounds or queued triangles yet.
+            let views = match ctx.lights[light].kind {
+                LightKind::Directional => 1,
+                _ => grid::MAX_VIEWS,
+            };
             let encoder = rec.encoder();
-            encoder.clear_buffer(&buffers.grid, 0, Some(shape.list_words() * 4));
+            for range in shape.list_ranges(views) {
+                encoder.clear_buffer(&buffers.grid, range.start, Some(range.end - range.start));
+            }
             encoder.clear_buffer(&buffers.state, counter_bytes, None);
             let slot = gpu.uniforms.at(light);
             let shared = [&slot as &dyn kit::SharedGroup, &tracing];
             let name = kit::light_pass_name("Frustum-traced", light);
             let mut pass = rec.compute_pass(&name);
-            let [samples, insert, volumes, big] = &buffers.groups;
+            let [samples, insert, triangle_group, big] = &buffers.groups;
             let pixels = [size.x, size.y, 1];
             gpu.samples
                 .dispatch_in(ctx, &mut pass, (&[samples], &shared), pixels)?;
@@ -298,7 +309,7 @@ impl ShadowTechnique for FrustumTraced {
             if triangles > 0 {
                 let extent = [triangles.div_ceil(GROUP).min(TRIANGLE_GROUPS) * GROUP, 1, 1];
                 gpu.triangles
-                    .dispatch_in(ctx, &mut pass, (&[volumes], &shared), extent)?;
+                    .dispatch_in(ctx, &mut pass, (&[triangle_group], &shared), extent)?;
                 let extent = [BIG_GROUPS * GROUP, 1, 1];
                 gpu.big_triangles
                     .dispatch_in(ctx, &mut pass, (&[big], &shared), extent)?;
@@ -339,10 +350,11 @@ impl ShadowTechnique for FrustumTraced {
     }
 }
 
-fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+fn create(gpu: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
     let params = FtParams::from_values(values)?;
+    let max_texture = gpu.device.limits().max_texture_dimension_2d;
     Ok(Box::new(FrustumTraced {
-        debug: NamedTextures::new("frustum-traced", debug_specs(params.grid)),
+        debug: NamedTextures::new("frustum-traced", debug_specs(params.grid, max_texture)),
         params,
         gpu: LazyGpu::default(),
     }))

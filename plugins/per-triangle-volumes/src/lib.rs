@@ -127,14 +127,14 @@ struct PerTriangleVolumes {
 impl ShadowTechnique for PerTriangleVolumes {
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
         let gpu = self.gpu.prepare(false, || Gpu::new(ctx))?;
-        if changes.scene || gpu.tracing.as_ref().is_none_or(|t| !t.is_for(ctx)) {
-            gpu.tracing = Some(RayTracing::new(ctx, Tracer::Compute, &gpu.tracing_layout)?);
-            gpu.buffers = None;
-        }
+        let tracing = match &mut gpu.tracing {
+            Some(tracing) if !changes.scene && tracing.is_for(ctx) => tracing,
+            slot => {
+                gpu.buffers = None;
+                slot.insert(RayTracing::new(ctx, Tracer::Compute, &gpu.tracing_layout)?)
+            }
+        };
         if gpu.buffers.as_ref().is_none_or(|b| !b.fits(ctx)) {
-            let Some(tracing) = &gpu.tracing else {
-                return Ok(());
-            };
             let stages = (&gpu.samples, &gpu.reduce, &gpu.triangles, &gpu.resolve);
             let buffers = ViewSamples::new(ctx, stages, tracing)?;
             let label = "per-triangle volumes counters";
@@ -206,11 +206,11 @@ impl ShadowTechnique for PerTriangleVolumes {
     fn counters(&self) -> Vec<(String, f64)> {
         let gpu = self.gpu.built();
         let tracing = gpu.and_then(|g| g.tracing.as_ref());
-        let batches = tracing.map_or(&[][..], |t| &t.batches);
-        let triangles = batches.last().map_or(0, |b| b.start + b.count);
+        let triangles = tracing.map_or(0, RayTracing::caster_triangles);
+        let batches = tracing.map_or(0, |t| t.batches.len());
         let mut counters = vec![
             ("caster triangles".to_string(), f64::from(triangles)),
-            ("caster batches".to_string(), batches.len() as f64),
+            ("caster batches".to_string(), batches as f64),
         ];
         if let Some([descended, nodes, tests]) = gpu.and_then(Gpu::totals) {
             counters.extend([

@@ -30,7 +30,8 @@ zoo_host::technique_params! {
     pub struct SmParams {
         use map: MapParams;
         use filtering: FilterParams;
-        /// Constant depth bias of the depth pass, in units of the depth format's resolution.
+        /// Constant depth bias of the depth pass, in units of the depth format's resolution. Too
+        /// much pushes shadows away from where casters touch receivers (peter-panning).
         constant_bias: u32 = 0, range(0, 100000), step(100), flags(rebuild);
         /// Cull front faces in the depth pass (stores back faces).
         cull_front: bool = false, flags(rebuild);

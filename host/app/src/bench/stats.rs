@@ -1,6 +1,6 @@
 //! Summary statistics over per-frame samples.
 
-/// Median, percentiles and range of a sample.
+/// Median, mean, percentiles and range of a sample.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Summary {
     pub median: f64,
