@@ -134,11 +134,11 @@ fn exact_methods_stay_exact_under_stress() {
     for (name, text) in STRESS_SCENES {
         let scene = stress_scene(name, text);
         for id in PER_TRIANGLE {
-            assert_core_within(&judge_scene(scene.clone(), id, &[], SIZE), id, 0.0005);
+            judge_scene(scene.clone(), id, &[], SIZE).assert_core_error(0.0005);
         }
         let one_ray = [("rays_per_pixel", "1")];
         let rays = judge_scene(scene.clone(), "rt-shadows", &one_ray, SIZE);
-        assert_core_within(&rays, "rt-shadows", 0.0005);
+        rays.assert_core_error(0.0005);
     }
 }
 
@@ -164,11 +164,11 @@ fn a_light_on_a_casters_edge_is_not_shadowed_by_it() {
         .retain(|l| l.kind == zoo_host::LightKind::Point);
     assert_eq!(scene.lights.len(), 1);
     for id in PER_TRIANGLE {
-        assert_core_within(&judge_scene(scene.clone(), id, &[], SIZE), id, 0.002);
+        judge_scene(scene.clone(), id, &[], SIZE).assert_core_error(0.002);
     }
     let one_ray = [("rays_per_pixel", "1")];
     let rays = judge_scene(scene, "rt-shadows", &one_ray, SIZE);
-    assert_core_within(&rays, "rt-shadows", 0.002);
+    rays.assert_core_error(0.002);
 }
 
 /// Scene `name` from RON `text` (relative paths from `scenes/`).
@@ -176,17 +176,6 @@ fn stress_scene(name: &str, text: &str) -> Scene {
     let base = zoo_host::test_support::scene_path("contact.ron");
     let base = base.parent().unwrap();
     Scene::from_ron(text, std::path::Path::new(name), base).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Asserts that every light of `run` (technique `id`) has a core error at most `bound`.
-fn assert_core_within(run: &JudgeRun, id: &str, bound: f64) {
-    for (light, score) in run.judged.scores.iter().enumerate() {
-        let m = score.metrics.expect("every light kind is supported");
-        let core = m.false_shadow_core + m.false_lit_core;
-        let scene = &run.scene;
-        eprintln!("{id} on {scene} light {light}: core {core:.5} {m:?}");
-        assert!(core <= bound, "{id} on {scene} light {light}: core {core}");
-    }
 }
 
 /// A million caster triangles (a finely tessellated sphere and torus over a floor) under the
@@ -214,6 +203,6 @@ fn per_triangle_methods_stay_exact_over_a_million_triangles() {
     assert!(scene.triangle_count() >= 1_000_000);
     for id in PER_TRIANGLE {
         let run = judge_scene(scene.clone(), id, &[], UVec2::new(96, 96));
-        assert_core_within(&run, id, 0.0005);
+        run.assert_core_error(0.0005);
     }
 }

@@ -307,6 +307,21 @@ pub fn assert_soft_near_walls(
 }
 
 impl JudgeRun {
+    /// Asserts that every light's core error (false shadow and false lit off the shadow edges)
+    /// is at most `bound`, printing each; every light kind must be supported.
+    pub fn assert_core_error(&self, bound: f64) {
+        for light in 0..self.judged.scores.len() {
+            let m = self.metrics(light);
+            let core = m.false_shadow_core + m.false_lit_core;
+            let (id, scene) = (&self.judged.technique, &self.scene);
+            eprintln!("{id} on {scene} light {light}: core {core:.5} {m:?}");
+            assert!(
+                core <= bound,
+                "{id} on {scene} light {light}: core error {core}"
+            );
+        }
+    }
+
     /// The metrics of `light`; panics if the technique does not support its kind.
     pub fn metrics(&self, light: usize) -> zoo_judge::Metrics {
         self.judged.scores[light].metrics.unwrap_or_else(|| {

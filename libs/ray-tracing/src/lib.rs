@@ -51,6 +51,18 @@ pub const QUERY_MODULE: &str = "ray-tracing/query.wgsl";
 /// flagged in its `shadowed` buffer (one `u32` a pixel).
 pub const RESOLVE_SHADOWED_SHADER: &str = "ray-tracing/shadowed.wgsl";
 
+/// The device limits of the exact per-triangle methods (per-triangle-volumes, frustum-traced):
+/// in compute, the frame's lights and objects, the casters' five buffers and five of the
+/// method's own; a fifth group for the method's buffers beside the frame, G-buffer, per-light
+/// and casters' groups.
+pub fn per_triangle_limits() -> wgpu::Limits {
+    wgpu::Limits {
+        max_storage_buffers_per_shader_stage: 12,
+        max_bind_groups: 5,
+        ..wgpu::Limits::downlevel_defaults()
+    }
+}
+
 /// Stages that may trace rays.
 const STAGES: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
 

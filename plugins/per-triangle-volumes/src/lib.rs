@@ -237,14 +237,7 @@ zoo_host::register_technique! {
     source: "Sintorn, Olsson, Assarsson 2011; Sintorn, Kämpe, Olsson, Assarsson 2014",
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
-    // The frame's lights and objects, the casters' five buffers and the samples' five, in
-    // compute; a fifth group for the samples beside the frame, G-buffer, per-light and
-    // casters' groups.
-    required_limits: || wgpu::Limits {
-        max_storage_buffers_per_shader_stage: 12,
-        max_bind_groups: 5,
-        ..wgpu::Limits::downlevel_defaults()
-    },
+    required_limits: zoo_ray_tracing::per_triangle_limits,
     required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS,
     params: PtvParams::schema,
     create: create,

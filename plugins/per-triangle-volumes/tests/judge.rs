@@ -7,7 +7,7 @@ use zoo_plugin_per_triangle_volumes as _;
 
 use zoo_host::glam::UVec2;
 use zoo_host::params::{apply_assignments, defaults};
-use zoo_host::test_support::{JudgeRun, counter, gpu, judge, scene_path, standard_scenes};
+use zoo_host::test_support::{counter, gpu, judge, scene_path, standard_scenes};
 use zoo_host::{Renderer, Scene, View};
 
 const SIZE: UVec2 = UVec2::new(128, 128);
@@ -16,25 +16,6 @@ const ID: &str = "per-triangle-volumes";
 /// Most of a light's pixels off its shadow edges that may be judged wrongly (false shadow and
 /// false lit together).
 const CORE_BOUND: f64 = 0.0005;
-
-/// `run`'s core error (false shadow and false lit off the shadow edges) of every light, printed
-/// and held to [`CORE_BOUND`].
-fn assert_exact(run: &JudgeRun) {
-    for (light, score) in run.judged.scores.iter().enumerate() {
-        let m = score.metrics.expect("every light kind is supported");
-        let core = m.false_shadow_core + m.false_lit_core;
-        eprintln!(
-            "{} light {light} ({}): core {core:.5} {m:?}",
-            run.scene,
-            score.kind.name()
-        );
-        assert!(
-            core <= CORE_BOUND,
-            "{} light {light}: core error {core}",
-            run.scene
-        );
-    }
-}
 
 /// Scenes the suite judges: alpha masks and contact (every standard scene, the kilometre scale
 /// among them, is the long check's: `every_standard_scene_is_exact`; instances are the
@@ -45,7 +26,7 @@ const SUITE_SCENES: [&str; 2] = ["foliage.ron", "contact.ron"];
 #[test]
 fn masks_and_contact_are_exact() {
     for scene in SUITE_SCENES {
-        assert_exact(&judge(scene, ID, &[], SIZE));
+        judge(scene, ID, &[], SIZE).assert_core_error(CORE_BOUND);
     }
 }
 
@@ -58,7 +39,7 @@ fn masks_and_contact_are_exact() {
 fn every_standard_scene_is_exact() {
     for path in standard_scenes() {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        assert_exact(&judge(&name, ID, &[], SIZE));
+        judge(&name, ID, &[], SIZE).assert_core_error(CORE_BOUND);
     }
 }
 
