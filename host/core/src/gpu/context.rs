@@ -24,6 +24,8 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     pub info: wgpu::AdapterInfo,
     uncaptured: Arc<Mutex<Vec<String>>>,
+    /// On wgpu's GL backend only: the buffer [`Self::order_raster_before_compute`] moves.
+    raster_fence: Option<wgpu::Buffer>,
 }
 
 impl GpuContext {
@@ -143,6 +145,14 @@ impl GpuContext {
             }
         }));
         let info = adapter.get_info();
+        let raster_fence = (info.backend == wgpu::Backend::Gl).then(|| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("GL raster-before-compute fence"),
+                size: 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        });
         GpuContext {
             instance,
             adapter,
@@ -150,6 +160,30 @@ impl GpuContext {
             queue,
             info,
             uncaptured,
+            raster_fence,
+        }
+    }
+
+    /// Makes compute passes recorded next in `encoder` see what the render passes before them
+    /// wrote (a G-buffer, a shadow map). wgpu's barriers order this on Vulkan, Metal, DX12 and
+    /// WebGPU; its GL backend issues a memory barrier only after shader storage writes, and
+    /// Mesa's llvmpipe can run a compute dispatch while rasterisation it has queued is still
+    /// unfinished (the frustum-traced technique read a G-buffer half drawn there, one frame
+    /// in some tens). On GL a storage-write transition of a small buffer issues that barrier,
+    /// and the driver finishes the rasterisation first; elsewhere this does nothing.
+    pub fn order_raster_before_compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        let Some(fence) = &self.raster_fence else {
+            return;
+        };
+        for state in [
+            wgpu::BufferUses::STORAGE_READ_WRITE,
+            wgpu::BufferUses::COPY_DST,
+        ] {
+            let transition = wgpu::BufferTransition {
+                buffer: fence,
+                state,
+            };
+            encoder.transition_resources(std::iter::once(transition), std::iter::empty());
         }
     }
 

@@ -283,6 +283,8 @@ pub struct PassRecorder<'a> {
     /// Chunks this frame has used, in order.
     timestamp_chunks: Vec<QueryChunk>,
     statistics_chunks: Vec<QueryChunk>,
+    /// Whether a render pass was recorded since the last compute pass.
+    rendered: bool,
 }
 
 impl<'a> PassRecorder<'a> {
@@ -298,6 +300,7 @@ impl<'a> PassRecorder<'a> {
             cpu_times: Vec::new(),
             timestamp_chunks: Vec::new(),
             statistics_chunks: Vec::new(),
+            rendered: false,
         }
     }
 
@@ -400,6 +403,7 @@ impl<'a> PassRecorder<'a> {
             occlusion_query_set: desc.occlusion_query_set,
             multiview_mask: desc.multiview_mask,
         };
+        self.rendered = true;
         let mut pass = self.encoder().begin_render_pass(&desc);
         if let Some((set, index)) = &next.statistics {
             pass.begin_pipeline_statistics_query(set, *index);
@@ -421,6 +425,10 @@ impl<'a> PassRecorder<'a> {
                     beginning_of_pass_write_index: Some(*begin),
                     end_of_pass_write_index: Some(begin + 1),
                 });
+        if std::mem::take(&mut self.rendered) {
+            let gpu = self.gpu;
+            gpu.order_raster_before_compute(self.encoder());
+        }
         let mut pass = self
             .encoder()
             .begin_compute_pass(&wgpu::ComputePassDescriptor {
