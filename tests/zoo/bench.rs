@@ -43,7 +43,7 @@ fn a_tiny_run_writes_well_formed_csv_markdown_and_plots() {
     let mut p = plan(&["unshadowed", "planar"], PathMode::Camera, 3, &[]);
     p.sweeps = vec![parse_sweep("size", &["64x64".into(), "96x96".into()]).unwrap()];
     let out = temp_dir("tiny");
-    let results = bench::run_plans(&[p], &ShaderLibrary::embedded(), &out, None)
+    let results = bench::run_plans(&[p], &ShaderLibrary::embedded(), &out, None, Vec::new())
         .unwrap()
         .results;
     assert_eq!(results.len(), 4, "2 techniques x 2 sizes");
@@ -214,7 +214,12 @@ fn every_suite_resolves() {
             suite.name
         );
         for run in &suite.runs {
-            let scene = path.parent().unwrap_or(Path::new(".")).join(&run.scene);
+            let dir = path.parent().unwrap_or(Path::new("."));
+            if let Some(reason) = run.missing(dir) {
+                eprintln!("SKIPPED: {} run {}: {reason}", suite.name, run.name);
+                continue;
+            }
+            let scene = dir.join(&run.scene);
             zoo_host::Scene::load(&scene).unwrap_or_else(|e| panic!("{}: {e}", suite.name));
             for t in &run.techniques {
                 zoo_host::find_technique(t).unwrap();

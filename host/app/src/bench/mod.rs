@@ -54,12 +54,14 @@ fn is_unavailable(error: &anyhow::Error) -> bool {
 }
 
 /// Runs plans with `shaders`, writes the outputs, and returns the results. Configurations this
-/// adapter cannot run are skipped and listed; any other failure stops the benchmark.
+/// adapter cannot run are skipped and listed beside the `absent` runs (those whose files are
+/// missing); any other failure stops the benchmark.
 pub fn run_plans(
     plans: &[BenchPlan],
     shaders: &ShaderLibrary,
     out: &Path,
     suite: Option<&suite::Suite>,
+    absent: Vec<Skipped>,
 ) -> anyhow::Result<BenchRun> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output folder {}", out.display()))?;
@@ -85,7 +87,7 @@ pub fn run_plans(
             .expect("valid template"),
     );
     let mut results = Vec::new();
-    let mut skipped = Vec::new();
+    let mut skipped = absent;
     for (i, config) in &configs {
         bar.set_message(config.label());
         match run_configuration(&gpu, shaders, &plans[*i], config, || bar.inc(1)) {
@@ -114,14 +116,24 @@ pub fn run_plans(
 
 /// Runs `shadow-zoo bench`.
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    let mut absent = Vec::new();
     let (plans, suite) = match (&args.suite, &args.scene) {
         (Some(name), _) => {
             let path = suite::locate(name)?;
             let s = suite::load(&path)?;
             let dir = path.parent().unwrap_or(Path::new("."));
+            for run in &s.runs {
+                if let Some(reason) = run.missing(dir) {
+                    absent.push(Skipped {
+                        configuration: format!("{}: every configuration", run.name),
+                        reason,
+                    });
+                }
+            }
             let plans = s
                 .runs
                 .iter()
+                .filter(|run| run.missing(dir).is_none())
                 .map(|run| {
                     let scene_path = dir.join(&run.scene);
                     let mut techniques = run
@@ -164,7 +176,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         bail!("--frames must be at least 1");
     }
     let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
-    let BenchRun { results, skipped } = run_plans(&plans, &shaders, &args.out, suite.as_ref())?;
+    let BenchRun { results, skipped } =
+        run_plans(&plans, &shaders, &args.out, suite.as_ref(), absent)?;
     for r in &results {
         println!(
             "  {:10} {:50} frame {:8.2} ms  {}  flicker {}",

@@ -42,6 +42,21 @@ pub struct SuiteRun {
     /// Technique parameters as `ID.KEY` = value.
     #[serde(default)]
     pub set: Vec<(String, String)>,
+    /// A folder the scene reads, relative to the suite file, that is not part of the
+    /// repository (`../shared/models`' real meshes): where it is absent the run is skipped
+    /// and listed as such.
+    #[serde(default)]
+    pub needs: Option<String>,
+}
+
+impl SuiteRun {
+    /// Why the run cannot be measured here (its `needs` folder is absent), if so.
+    pub fn missing(&self, suite_dir: &std::path::Path) -> Option<String> {
+        let needs = self.needs.as_ref()?;
+        let folder = suite_dir.join(needs);
+        (!folder.is_dir())
+            .then(|| format!("needs {} (not part of the repository)", folder.display()))
+    }
 }
 
 fn default_size() -> (u32, u32) {
@@ -126,4 +141,26 @@ pub fn load(path: &Path) -> anyhow::Result<Suite> {
             e.code
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run_needing(folder: &str) -> SuiteRun {
+        let text =
+            format!("(name: \"r\", scene: \"s.ron\", techniques: [], needs: Some(\"{folder}\"))");
+        ron::from_str(&text).unwrap()
+    }
+
+    #[test]
+    fn a_run_whose_folder_is_absent_says_which() {
+        let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        assert_eq!(run_needing("scenes/bench").missing(here), None);
+        let reason = run_needing("no-such-folder").missing(here).unwrap();
+        assert!(reason.contains("no-such-folder"), "{reason}");
+        let plain: SuiteRun =
+            ron::from_str("(name: \"r\", scene: \"s.ron\", techniques: [])").unwrap();
+        assert_eq!(plain.missing(here), None);
+    }
 }
