@@ -54,6 +54,11 @@ fi
 # names every integration test but `zoo` (no other test target's name starts with z).
 "${test[@]}" --no-run
 zoo_log="$(mktemp)"
+# One folder of traced references for the run's test binaries, each its own process: a view
+# that several judge is traced once (half the suite's tracing; `judging::shared_references`).
+# Fresh for this run and removed with it, so only the code that traced a reference reuses it.
+shared_references="$(mktemp -d)"
+export ZOO_SHARED_REFERENCES="$shared_references"
 echo "tests/zoo runs beside the other tests; its output follows theirs (live in $zoo_log)"
 "${test[@]}" --test zoo >"$zoo_log" 2>&1 &
 zoo=$!
@@ -63,6 +68,7 @@ stop_zoo() {
     if command -v pkill >/dev/null; then pkill -P "$zoo" 2>/dev/null || true; fi
     kill "$zoo" 2>/dev/null || true
     rm -f "$zoo_log"
+    rm -rf "$shared_references"
 }
 trap stop_zoo EXIT
 trap 'exit 130' INT TERM

@@ -4,6 +4,7 @@
 //! per view and every technique rendered from that view is scored against it.
 
 pub mod perceptual;
+pub mod shared_references;
 
 use std::time::Instant;
 
@@ -73,12 +74,23 @@ impl SceneReference {
         let start = Instant::now();
         let occluders = Occluders::new(renderer.scene());
         let points = surface_points(&gbuffer, &Surfaces::new(renderer.scene()));
+        let shared = shared_references::folder()
+            .map(|folder| (folder, shared_references::scene_digest(renderer.scene())));
         let lights = renderer
             .lights()
             .iter()
             .enumerate()
             .map(|(i, light)| {
-                let r = reference_visibility(&occluders, light, &points, samples);
+                let r = match &shared {
+                    Some((folder, scene)) => shared_references::light_reference(
+                        folder,
+                        (*scene, &occluders),
+                        light,
+                        &points,
+                        samples,
+                    ),
+                    None => reference_visibility(&occluders, light, &points, samples),
+                };
                 progress(i);
                 r
             })
