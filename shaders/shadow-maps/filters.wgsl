@@ -142,10 +142,12 @@ fn plane_tap(plane: TapPlane, frame: mat2x3<f32>, offset: vec2<f32>) -> vec3<f32
 // n x n bilinear comparison taps one texel apart.
 fn grid_pcf(plane: TapPlane, frame: mat2x3<f32>, texel: f32, n: i32) -> f32 {
     var sum = 0.0;
-    let h = n / 2;
-    for (var j = -h; j <= h; j++) {
-        for (var i = -h; i <= h; i++) {
-            sum += shadow_tap(plane_tap(plane, frame, vec2<f32>(f32(i), f32(j)) * texel), true);
+    // Offsets a texel apart, centred on the receiver: whole texels for odd n, halves for even.
+    let centre = 0.5 * f32(n - 1);
+    for (var j = 0; j < n; j++) {
+        for (var i = 0; i < n; i++) {
+            let offset = vec2<f32>(f32(i), f32(j)) - centre;
+            sum += shadow_tap(plane_tap(plane, frame, offset * texel), true);
         }
     }
     return sum / f32(n * n);
@@ -234,6 +236,11 @@ const FILTER_PCF9X9: u32 = 5u;
 const FILTER_POISSON: u32 = 6u;
 const FILTER_PCSS: u32 = 7u;
 const FILTER_STOCHASTIC: u32 = 8u;
+const FILTER_PCF4X4: u32 = 9u;
+const FILTER_PCF8X8: u32 = 10u;
+const FILTER_PCF11X11: u32 = 11u;
+const FILTER_PCF16X16: u32 = 12u;
+const FILTER_PCF23X23: u32 = 13u;
 
 // One light's filter (`MapFilter` in the library's Rust, written by `MapFilters::filter`).
 #import "shadow-maps/map_filter.wgsl"
@@ -252,6 +259,11 @@ fn filter_map(f: MapFilter, plane: TapPlane, frame: mat2x3<f32>, texel: f32, noi
         case FILTER_PCF5X5: { visibility = grid_pcf(plane, frame, texel, 5); }
         case FILTER_PCF7X7: { visibility = grid_pcf(plane, frame, texel, 7); }
         case FILTER_PCF9X9: { visibility = grid_pcf(plane, frame, texel, 9); }
+        case FILTER_PCF4X4: { visibility = grid_pcf(plane, frame, texel, 4); }
+        case FILTER_PCF8X8: { visibility = grid_pcf(plane, frame, texel, 8); }
+        case FILTER_PCF11X11: { visibility = grid_pcf(plane, frame, texel, 11); }
+        case FILTER_PCF16X16: { visibility = grid_pcf(plane, frame, texel, 16); }
+        case FILTER_PCF23X23: { visibility = grid_pcf(plane, frame, texel, 23); }
         case FILTER_POISSON: { visibility = poisson_pcf(plane, frame, f.kernel_texels * texel, r); }
         case FILTER_STOCHASTIC: { visibility = stochastic_pcf(plane, frame, f.kernel_texels * texel, noise.moving); }
         default: {

@@ -14,10 +14,15 @@ const FILTERS: &str = "shadow-maps/header_lookup.wgsl";
 
 zoo_host::param_choice! {
     /// How shadow-map comparisons are filtered: one tap, the hardware's bilinear 2x2, an N x N
-    /// grid, a rotated Poisson disc, PCSS (penumbrae sized by the blocker distance), or
-    /// stochastic PCF (four taps of the Poisson disc's area, moved every frame: noisy alone,
-    /// the disc's filtering on average over frames).
-    pub enum Filter { None, Hardware2x2, Pcf3x3, Pcf5x5, Pcf7x7, Pcf9x9, Poisson, Pcss, Stochastic }
+    /// grid (odd kernels centred on a texel, even ones between four; 4x4, 8x8 and 16x16 as in
+    /// seed 000, 11x11 and 23x23 as in seed 001's Table 1), a rotated Poisson disc, PCSS
+    /// (penumbrae sized by the blocker distance), or stochastic PCF (four taps of the Poisson
+    /// disc's area, moved every frame: noisy alone, the disc's filtering on average over
+    /// frames).
+    pub enum Filter {
+        None, Hardware2x2, Pcf3x3, Pcf4x4, Pcf5x5, Pcf7x7, Pcf8x8, Pcf9x9, Pcf11x11, Pcf16x16,
+        Pcf23x23, Poisson, Pcss, Stochastic
+    }
 }
 
 zoo_host::gpu_struct! {

@@ -413,3 +413,34 @@ fn mean_gap(a: &[f32], b: &[f32]) -> f64 {
         .sum::<f64>()
         / a.len() as f64
 }
+
+/// Grid kernels of every size, odd and even (seed 000's 4x4, 8x8 and 16x16; seed 001's 11x11
+/// and 23x23, its Table 1), on planar-room with 512² maps: each keeps sm-pcf's core bounds, and
+/// the penumbra (the light's pixels neither wholly lit nor wholly shadowed) widens with the
+/// kernel, 23x23's several times 3x3's.
+#[test]
+fn grid_kernels_of_every_size_widen_the_penumbra_within_bounds() {
+    let kernels = [3, 4, 5, 7, 8, 9, 11, 16, 23];
+    let mut penumbrae = Vec::new();
+    for n in kernels {
+        let filter = format!("Pcf{n}x{n}");
+        let settings = [("filter", filter.as_str()), ("map_size", "512")];
+        let run = judge("planar-room.ron", "sm-pcf", &settings, UVec2::new(128, 128));
+        run.assert_core_bounds(0.01, 0.02);
+        let (mut partial, mut pixels) = (0usize, 0usize);
+        for (light, visibility) in run.judged.visibility.iter().enumerate() {
+            let reaches = &run.reference.lights[light].contributing;
+            for (v, _) in visibility.iter().zip(reaches).filter(|(_, c)| **c) {
+                pixels += 1;
+                partial += usize::from(*v > 0.02 && *v < 0.98);
+            }
+        }
+        penumbrae.push(partial as f64 / pixels as f64);
+    }
+    eprintln!("penumbra fractions for {kernels:?}: {penumbrae:.4?}");
+    assert!(
+        penumbrae.windows(2).all(|w| w[1] >= w[0]),
+        "{kernels:?}: {penumbrae:?}"
+    );
+    assert!(penumbrae[8] > 3.0 * penumbrae[0], "{penumbrae:?}");
+}
