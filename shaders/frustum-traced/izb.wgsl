@@ -174,13 +174,21 @@ struct Extent {
 
 fn view_bounds(view: u32) -> Extent {
     let first = bounds_index(view);
-    let high = vec2<u32>(atomicLoad(&state[first + 2u]), atomicLoad(&state[first + 3u]));
-    let low = vec2<u32>(~atomicLoad(&state[first]), ~atomicLoad(&state[first + 1u]));
-    let used = high.x != 0u;
+    var words: vec4<u32>;
+    for (var k = 0u; k < BOUNDS; k++) {
+        words[k] = atomicLoad(&state[first + k]);
+    }
+    return extent_of(words);
+}
+
+// The extent that a view's `BOUNDS` words of `state` hold.
+fn extent_of(words: vec4<u32>) -> Extent {
+    let low = ~words.xy;
+    let high = words.zw;
     return Extent(
         vec2<f32>(from_order_key(low.x), from_order_key(low.y)),
         vec2<f32>(from_order_key(high.x), from_order_key(high.y)),
-        used,
+        high.x != 0u,
     );
 }
 
@@ -301,9 +309,8 @@ fn clip(polygon: Polygon, plane: vec3<f32>) -> Polygon {
     return out;
 }
 
-// The texels of view `view` that the triangle with world `corners` can cover.
-fn triangle_rect(light: Light, view: u32, corners: array<vec3<f32>, 3>) -> Rect {
-    let extent = view_bounds(view);
+// The texels of view `view` (of `extent`) that the triangle with world `corners` can cover.
+fn triangle_rect(light: Light, view: u32, extent: Extent, corners: array<vec3<f32>, 3>) -> Rect {
     if !extent.used {
         return NO_RECT;
     }
@@ -420,7 +427,7 @@ fn cs_triangles(@builtin(global_invocation_id) id: vec3<u32>) {
         let caster = caster_triangle(flat);
         let corners = caster_world_corners(caster);
         for (var view = 0u; view < views; view++) {
-            let rect = triangle_rect(light, view, corners);
+            let rect = triangle_rect(light, view, view_bounds(view), corners);
             let count = rect_texels(rect);
             if count == 0u {
                 continue;
@@ -451,7 +458,7 @@ fn cs_big_triangles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invo
         let packed = atomicLoad(&grid[queue_index(entry)]);
         let view = packed % MAX_VIEWS;
         let caster = caster_triangle(packed / MAX_VIEWS);
-        let rect = triangle_rect(light, view, caster_world_corners(caster));
+        let rect = triangle_rect(light, view, view_bounds(view), caster_world_corners(caster));
         walk_rect(view, rect, caster, lane, GROUP);
     }
     add_counts();

@@ -4,13 +4,13 @@
 // ray against the plane of the triangle stored in its texel here (`coverage_blocked` in
 // `hybrid-edge/band.wgsl`).
 //
-// Each triangle grows by half a texel on every side in the vertex shader: its edges move out
-// by the half texel's extent along their normals and the corners go where the moved edges
-// meet (overestimating conservative rasterisation); the triangle's box grown by half a texel
-// discards what the growth adds beyond sharp corners. The depth test keeps, per texel, the
+// Each triangle grows by half a texel on every side in the vertex shader
+// (`common/conservative.wgsl`); the triangle's box grown by half a texel discards what the
+// growth adds beyond sharp corners. The depth test keeps, per texel, the
 // triangle whose plane is nearest the light at the texel's centre, within the triangle's own
 // depth range (so a receiver's own triangle, not a steep one behind it, holds its texel).
 
+#import "common/conservative.wgsl"
 #import "hybrid-edge/casters.wgsl"
 
 struct CoverageVertex {
@@ -27,26 +27,6 @@ struct CoverageVertex {
 struct CoverageOut {
     @location(0) triangle: u32,
     @builtin(frag_depth) depth: f32,
-}
-
-// 2D cross product.
-fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
-    return a.x * b.y - a.y * b.x;
-}
-
-// The line through a and b moved out by `half` (half a texel per axis), as (normal, offset):
-// points x with dot(normal, x) <= offset are on the triangle's side. `orientation` is the
-// sign of the triangle's area.
-fn grown_edge(a: vec2<f32>, b: vec2<f32>, orientation: f32, half: vec2<f32>) -> vec3<f32> {
-    let d = b - a;
-    let normal = vec2<f32>(d.y, -d.x) * orientation;
-    return vec3<f32>(normal, dot(normal, a) + dot(abs(normal), half));
-}
-
-// Where two edge lines (normal, offset) meet.
-fn meet(e: vec3<f32>, f: vec3<f32>) -> vec2<f32> {
-    let det = cross2(e.xy, f.xy);
-    return vec2<f32>(e.z * f.y - f.z * e.y, e.x * f.z - f.x * e.z) / det;
 }
 
 @vertex
@@ -80,12 +60,8 @@ fn vs_coverage(@builtin(vertex_index) vertex: u32, @builtin(instance_index) obje
         return out;
     }
     let half = vec2<f32>(1.0 / f32(layer_camera.tile.size));
-    let orientation = sign(area);
-    let before = (corner + 2u) % 3u;
-    let after = (corner + 1u) % 3u;
-    let incoming = grown_edge(ndc[before].xy, ndc[corner].xy, orientation, half);
-    let outgoing = grown_edge(ndc[corner].xy, ndc[after].xy, orientation, half);
-    let position = meet(incoming, outgoing);
+    let flat = array<vec2<f32>, 3>(ndc[0].xy, ndc[1].xy, ndc[2].xy);
+    let position = grown_corner(flat, corner, half);
     // The triangle's plane: depth = ndc[0].z + dot(slope, xy - ndc[0].xy).
     let dz1 = ndc[1].z - ndc[0].z;
     let dz2 = ndc[2].z - ndc[0].z;

@@ -128,7 +128,8 @@ const STRESS_SCENES: [(&str, &str); 3] = [
 ];
 
 /// Core error (false shadow and false lit off the shadow edges) at most 0.0005 for every light
-/// of every [`STRESS_SCENES`] scene, for each per-triangle method and rt-shadows' one ray.
+/// of every [`STRESS_SCENES`] scene, for each per-triangle method (frustum-traced by both of
+/// its rasterisers) and rt-shadows' one ray.
 #[test]
 fn exact_methods_stay_exact_under_stress() {
     for (name, text) in STRESS_SCENES {
@@ -136,6 +137,9 @@ fn exact_methods_stay_exact_under_stress() {
         for id in PER_TRIANGLE {
             judge_scene(scene.clone(), id, &[], SIZE).assert_core_error(0.0005);
         }
+        let raster = [("rasteriser", "Raster")];
+        let drawn = judge_scene(scene.clone(), "frustum-traced", &raster, SIZE);
+        drawn.assert_core_error(0.0005);
         let one_ray = [("rays_per_pixel", "1")];
         let rays = judge_scene(scene.clone(), "rt-shadows", &one_ray, SIZE);
         rays.assert_core_error(0.0005);

@@ -324,9 +324,10 @@ pub(crate) fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     bind_group_layout(device, "ray tracing layout (compute)", &entries())
 }
 
-/// The group's entries, binding by binding as `ray-tracing/trace.wgsl` declares them.
+/// The group's entries, binding by binding as `ray-tracing/trace.wgsl` declares them (the
+/// vertex stage too: frustum-traced's raster path places caster triangles from them).
 pub(crate) fn entries() -> Vec<wgpu::BindGroupLayoutEntry> {
-    let stages = crate::STAGES;
+    let stages = crate::STAGES | wgpu::ShaderStages::VERTEX;
     vec![
         storage(0, stages, true),
         storage(1, stages, true),

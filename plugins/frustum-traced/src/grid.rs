@@ -50,6 +50,11 @@ impl Shape {
     pub fn counter_words(self) -> u64 {
         self.lights.max(1) as u64 * COUNTERS
     }
+
+    /// Bytes of every view's bounds in the state buffer (after the counters).
+    pub fn bounds_bytes() -> u64 {
+        4 * MAX_VIEWS * BOUNDS
+    }
 }
 
 /// The stages that bind the buffers: samples, insertion, the two triangle passes, and the
@@ -57,6 +62,16 @@ impl Shape {
 pub struct Stages<'a> {
     pub compute: [&'a Stage; 4],
     pub resolve: &'a Stage,
+    /// The raster path's stage, when it is chosen.
+    pub raster: Option<&'a Stage>,
+}
+
+/// The raster path's own resources: the grid-sized target its casters are drawn into and the
+/// views' bounds its vertex stage reads.
+pub struct RasterTarget {
+    pub view: wgpu::TextureView,
+    pub bounds: wgpu::Buffer,
+    pub group: StageBindGroup,
 }
 
 /// The buffers and each stage's bind group over them.
@@ -70,6 +85,8 @@ pub struct IrregularGrid {
     pub groups: [StageBindGroup; 4],
     /// The resolve stage's bind group (the shadowed flags).
     pub resolve_group: StageBindGroup,
+    /// The raster path's target, bounds and bind group, when it is chosen.
+    pub raster: Option<RasterTarget>,
     /// The view samples (which the debug stages bind with the grid and the state).
     view_samples: wgpu::Buffer,
 }
@@ -133,9 +150,14 @@ impl IrregularGrid {
         ];
         let bind = |stage: &Stage| stage.bind(ctx, "frustum-traced buffers", &resources);
         let [samples, insert, triangles, big] = stages.compute;
+        let raster = match stages.raster {
+            Some(stage) => Some(RasterTarget::new(ctx, stage, shape, &resources)?),
+            None => None,
+        };
         Ok(IrregularGrid {
             shape,
             groups: [bind(samples)?, bind(insert)?, bind(triangles)?, bind(big)?],
+            raster,
             resolve_group: stages.resolve.bind(
                 ctx,
                 "frustum-traced resolve",
@@ -163,3 +185,38 @@ impl IrregularGrid {
         stage.bind(ctx, "frustum-traced debug view", &resources)
     }
 }
+
+impl RasterTarget {
+    fn new(
+        ctx: &RenderContext<'_>,
+        stage: &Stage,
+        shape: Shape,
+        resources: &[(&str, wgpu::BindingResource<'_>)],
+    ) -> TechniqueResult<RasterTarget> {
+        let device = &ctx.gpu.device;
+        let (_, view) = zoo_host::gpu::render_target(
+            device,
+            "frustum-traced raster target",
+            UVec2::splat(shape.grid),
+            RASTER_FORMAT,
+            wgpu::TextureUsages::empty(),
+        );
+        let bounds = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frustum-traced raster bounds"),
+            size: Shape::bounds_bytes(),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut all: Vec<(&str, wgpu::BindingResource<'_>)> = resources.to_vec();
+        all.push(("raster_bounds", bounds.as_entire_binding()));
+        let group = stage.bind(ctx, "frustum-traced raster", &all)?;
+        Ok(RasterTarget {
+            view,
+            bounds,
+            group,
+        })
+    }
+}
+
+/// The raster path's target format (its colour is never written).
+pub const RASTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;

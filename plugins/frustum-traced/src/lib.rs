@@ -28,9 +28,21 @@ mod grid;
 
 use grid::{IrregularGrid, Shape};
 
+zoo_host::param_choice! {
+    /// How caster triangles find the texels they may cover: a compute pass walking each
+    /// triangle's conservative rectangle (any device with compute), or the raster pipeline
+    /// drawing each triangle conservatively, by the hardware's conservative mode where the
+    /// device has it and grown by half a texel otherwise, each fragment walking its texel's list
+    /// (needs vertex-stage storage reads and fragment-stage storage writes).
+    pub enum Rasteriser { Compute, Raster }
+}
+
 zoo_host::technique_params! {
     /// Parameters of frustum-traced shadows.
     pub struct FtParams {
+        /// Compute (rectangles walked in a compute pass) or Raster (triangles drawn
+        /// conservatively, fragments walking the lists): the same shadows either way.
+        rasteriser: Rasteriser = Rasteriser::Compute, flags(rebuild);
         /// Texels per side of each light plane's grid (a cube face for point and spot lights):
         /// finer grids make shorter lists and more texels per large triangle; the shadows are
         /// the same at any size.
@@ -43,7 +55,9 @@ zoo_host::technique_params! {
 zoo_host::gpu_struct! {
     "frustum-traced/ft_light.wgsl" =>
     /// The per-light uniform of the grid passes: the light and the number of lights, the
-    /// frame's size, the flat count of caster triangles and the grid's texels per side.
+    /// frame's size, the flat count of caster triangles, the grid's texels per side, and how
+    /// far the raster path grows each triangle in the vertex stage (half a texel, or 0 where
+    /// the rasteriser is conservative itself).
     #[derive(Debug, Clone, Copy)]
     pub(crate) struct FtLight {
         light: u32,
@@ -52,15 +66,21 @@ zoo_host::gpu_struct! {
         height: u32,
         triangles: u32,
         grid: u32,
+        grow: f32,
     }
 }
 
 const SHADER: &str = "frustum-traced/izb.wgsl";
+const RASTER_SHADER: &str = "frustum-traced/raster.wgsl";
 /// Workgroups of `cs_triangles` at most (each invocation takes every
 /// `TRIANGLE_GROUPS * GROUP`-th triangle) and of `cs_big_triangles` (`TRIANGLE_GROUPS`,
 /// `BIG_GROUPS` in the shader).
 const TRIANGLE_GROUPS: u32 = 2048;
 const BIG_GROUPS: u32 = 512;
+/// How far the raster path grows each triangle where the rasteriser is not conservative
+/// itself, in texels: half a texel, and a fiftieth more for the projections' rounding (a ray
+/// that grazes a triangle's edge on a texel's border still finds it).
+const GROWTH: f32 = 0.52;
 /// Invocations of a triangle pass workgroup (`GROUP` in the shader).
 const GROUP: u32 = 64;
 
@@ -104,6 +124,10 @@ struct Gpu {
     list_length: kit::Stage,
     samples_per_texel: kit::Stage,
     resolve: kit::Stage,
+    /// The raster path's stage, when it is chosen.
+    raster: Option<kit::Stage>,
+    /// Whether the raster path's rasteriser is conservative itself.
+    conservative: bool,
     buffers: Option<IrregularGrid>,
     /// The lights' counters, read back a frame or two late.
     stats: Option<Mutex<ReadbackRing>>,
@@ -111,13 +135,13 @@ struct Gpu {
 }
 
 impl Gpu {
-    fn new(ctx: &RenderContext<'_>) -> TechniqueResult<Gpu> {
+    fn new(ctx: &RenderContext<'_>, rasteriser: Rasteriser) -> TechniqueResult<Gpu> {
         let tracing_layout = Tracer::Compute.layout(&ctx.gpu.device);
         let uniforms = kit::UniformSlots::new(
             ctx.gpu,
             "frustum-traced lights",
             ctx.lights.len().max(1),
-            wgpu::ShaderStages::COMPUTE,
+            wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::VERTEX_FRAGMENT,
         );
         let tracing = Tracer::Compute.group(&tracing_layout, None);
         let compute = |entry| {
@@ -125,7 +149,15 @@ impl Gpu {
                 .shared(&[&uniforms.at(0), &tracing])
                 .build(ctx)
         };
+        let conservative =
+            (ctx.gpu.device.features()).contains(wgpu::Features::CONSERVATIVE_RASTERIZATION);
+        let raster = match rasteriser {
+            Rasteriser::Compute => None,
+            Rasteriser::Raster => Some(raster_stage(ctx, &uniforms, &tracing, conservative)?),
+        };
         Ok(Gpu {
+            raster,
+            conservative,
             samples: compute("cs_samples")?,
             insert: compute("cs_insert")?,
             triangles: compute("cs_triangles")?,
@@ -159,6 +191,38 @@ impl Gpu {
         }
         Some(totals)
     }
+}
+
+/// The raster path's stage: caster triangles drawn into the grid, conservatively.
+fn raster_stage(
+    ctx: &RenderContext<'_>,
+    uniforms: &kit::UniformSlots<FtLight>,
+    tracing: &dyn kit::SharedGroup,
+    conservative: bool,
+) -> TechniqueResult<kit::Stage> {
+    let needs =
+        wgpu::DownlevelFlags::VERTEX_STORAGE | wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE;
+    let missing = needs - ctx.gpu.adapter.get_downlevel_capabilities().flags;
+    if !missing.is_empty() {
+        return Err(TechniqueError::Unavailable {
+            id: "frustum-traced".into(),
+            reason: format!("rasteriser Raster needs {missing:?}, which this device lacks"),
+        });
+    }
+    let target = wgpu::ColorTargetState {
+        format: grid::RASTER_FORMAT,
+        blend: None,
+        write_mask: wgpu::ColorWrites::empty(),
+    };
+    kit::Stage::render(RASTER_SHADER, "vs_caster")
+        .fragment("fs_walk")
+        .shared(&[&uniforms.at(0), tracing])
+        .targets(&[Some(target)])
+        .primitive(wgpu::PrimitiveState {
+            conservative,
+            ..Default::default()
+        })
+        .build(ctx)
 }
 
 /// The longest list among the counters (`LONGEST_LIST` in the shader).
@@ -214,6 +278,41 @@ fn record_debug(
     )
 }
 
+/// One light's raster pass: the views' bounds copied where the vertex stage reads them, then
+/// every caster triangle drawn once a view.
+struct RasterDraw<'a> {
+    stage: &'a kit::Stage,
+    target: &'a grid::RasterTarget,
+    triangles: u32,
+    views: u32,
+}
+
+impl RasterDraw<'_> {
+    fn record(
+        &self,
+        (ctx, rec): (&RenderContext<'_>, &mut PassRecorder<'_>),
+        state: &wgpu::Buffer,
+        bounds_offset: u64,
+        name: &str,
+        shared: &[&dyn kit::SharedGroup],
+    ) -> TechniqueResult {
+        let bytes = grid::Shape::bounds_bytes();
+        (rec.encoder()).copy_buffer_to_buffer(state, bounds_offset, &self.target.bounds, 0, bytes);
+        if self.triangles == 0 {
+            return Ok(());
+        }
+        let attachments = [zoo_host::gpu::color_attachment(
+            &self.target.view,
+            wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+        )];
+        let mut pass = rec.render_pass(&zoo_host::gpu::color_pass(name, &attachments));
+        self.stage
+            .set_on(ctx, &mut pass, &[&self.target.group], shared)?;
+        pass.draw(0..self.triangles * 6, 0..self.views);
+        Ok(())
+    }
+}
+
 impl ShadowTechnique for FrustumTraced {
     fn resources(&self) -> Vec<ResourceInfo> {
         self.debug.resources()
@@ -224,7 +323,8 @@ impl ShadowTechnique for FrustumTraced {
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
-        let gpu = self.gpu.prepare(false, || Gpu::new(ctx))?;
+        let rasteriser = self.params.rasteriser;
+        let gpu = self.gpu.prepare(false, || Gpu::new(ctx, rasteriser))?;
         let tracing = match &mut gpu.tracing {
             Some(tracing) if !changes.scene && tracing.is_for(ctx) => tracing,
             slot => {
@@ -246,6 +346,7 @@ impl ShadowTechnique for FrustumTraced {
                     &gpu.big_triangles,
                 ],
                 resolve: &gpu.resolve,
+                raster: gpu.raster.as_ref(),
             };
             let buffers = IrregularGrid::new(ctx, stages, tracing, shape)?;
             let bytes = shape.counter_words() * 4;
@@ -275,6 +376,7 @@ impl ShadowTechnique for FrustumTraced {
                 height: size.y,
                 triangles,
                 grid: self.params.grid,
+                grow: if gpu.conservative { 0.0 } else { GROWTH },
             })
             .collect();
         gpu.uniforms.write(ctx.gpu, &values);
@@ -306,7 +408,7 @@ impl ShadowTechnique for FrustumTraced {
                 .dispatch_in(ctx, &mut pass, (&[samples], &shared), pixels)?;
             gpu.insert
                 .dispatch_in(ctx, &mut pass, (&[insert], &shared), pixels)?;
-            if triangles > 0 {
+            if triangles > 0 && gpu.raster.is_none() {
                 let extent = [triangles.div_ceil(GROUP).min(TRIANGLE_GROUPS) * GROUP, 1, 1];
                 gpu.triangles
                     .dispatch_in(ctx, &mut pass, (&[triangle_group], &shared), extent)?;
@@ -315,6 +417,16 @@ impl ShadowTechnique for FrustumTraced {
                     .dispatch_in(ctx, &mut pass, (&[big], &shared), extent)?;
             }
             drop(pass);
+            if let (Some(stage), Some(target)) = (&gpu.raster, &buffers.raster) {
+                let name = kit::light_pass_name("Frustum-traced raster", light);
+                let draw = RasterDraw {
+                    stage,
+                    target,
+                    triangles,
+                    views: views as u32,
+                };
+                draw.record((ctx, rec), &buffers.state, counter_bytes, &name, &shared)?;
+            }
             if light == debug_light {
                 let grid = self.params.grid;
                 record_debug((ctx, rec), (gpu, buffers, &self.debug), light, grid)?;
@@ -342,6 +454,12 @@ impl ShadowTechnique for FrustumTraced {
         let tracing = gpu.and_then(|g| g.tracing.as_ref());
         let triangles = tracing.map_or(0, RayTracing::caster_triangles);
         let mut counters = vec![("caster triangles".to_string(), f64::from(triangles))];
+        if let Some(gpu) = gpu.filter(|g| g.raster.is_some()) {
+            // 1 where the raster path's rasteriser is conservative itself, 0 where the vertex
+            // stage grows the triangles.
+            let hardware = f64::from(u8::from(gpu.conservative));
+            counters.push(("hardware conservative rasterisation".to_string(), hardware));
+        }
         if let Some(totals) = gpu.and_then(Gpu::totals) {
             let named = COUNTER_NAMES.iter().zip(totals);
             counters.extend(named.map(|(name, value)| (name.to_string(), value as f64)));
@@ -369,6 +487,7 @@ zoo_host::register_technique! {
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     required_limits: zoo_ray_tracing::per_triangle_limits,
     required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS,
+    optional_features: || wgpu::Features::CONSERVATIVE_RASTERIZATION,
     params: FtParams::schema,
     create: create,
 }

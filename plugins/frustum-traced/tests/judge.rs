@@ -39,16 +39,17 @@ fn every_standard_scene_is_exact() {
     }
 }
 
-/// Every light's visibility in `forest` at 64x64 with a grid of `grid` texels a side, and the
-/// longest list.
-fn forest_frame(grid: u32) -> (Vec<Vec<f32>>, f64) {
-    let scene = Scene::load(&scene_path("forest.ron")).unwrap();
+/// Every light's visibility in `scene` at 64x64 with parameters `set`, and the longest list.
+fn frame(scene: &str, set: &[(&str, &str)]) -> (Vec<Vec<f32>>, f64) {
+    let scene = Scene::load(&scene_path(scene)).unwrap();
     let lights = scene.lights.len();
     let mut renderer = Renderer::new(gpu(), scene, UVec2::splat(64)).unwrap();
     let schema = (zoo_host::find_technique(ID).unwrap().params)();
     let mut values = defaults(&schema);
-    let assignment = ("grid".to_string(), grid.to_string());
-    apply_assignments(&schema, &mut values, &[assignment]).unwrap();
+    let assignments: Vec<_> = (set.iter())
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    apply_assignments(&schema, &mut values, &assignments).unwrap();
     renderer.set_technique(ID, &values).unwrap();
     renderer.render(&View::Final).unwrap();
     // The counters arrive a frame or two late.
@@ -66,8 +67,8 @@ fn forest_frame(grid: u32) -> (Vec<Vec<f32>>, f64) {
 /// and every light kind, the coarse one with longer lists.
 #[test]
 fn the_grid_size_changes_no_pixel() {
-    let (coarse, coarse_longest) = forest_frame(16);
-    let (fine, fine_longest) = forest_frame(512);
+    let (coarse, coarse_longest) = frame("forest.ron", &[("grid", "16")]);
+    let (fine, fine_longest) = frame("forest.ron", &[("grid", "512")]);
     for (light, (a, b)) in coarse.iter().zip(&fine).enumerate() {
         assert!(
             a == b,
@@ -76,4 +77,23 @@ fn the_grid_size_changes_no_pixel() {
     }
     eprintln!("longest list: {coarse_longest} at 16x16, {fine_longest} at 512x512");
     assert!(fine_longest > 0.0 && fine_longest < coarse_longest);
+}
+
+/// The raster path (each triangle drawn conservatively into the grid, each fragment walking
+/// its texel's list) shadows exactly the pixels the compute path does, on `forest` (instances,
+/// every light kind), `foliage` (masks) and `planar-room` (walls passing beside a point light,
+/// drawn as their rectangles on the faces behind whose apex they reach).
+#[test]
+fn the_raster_path_shadows_the_same_pixels() {
+    for scene in ["forest.ron", "foliage.ron", "planar-room.ron"] {
+        let (compute, _) = frame(scene, &[]);
+        let (raster, _) = frame(scene, &[("rasteriser", "Raster")]);
+        for (light, (a, b)) in compute.iter().zip(&raster).enumerate() {
+            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            assert_eq!(
+                differ, 0,
+                "{scene} light {light}: pixels the raster path changed"
+            );
+        }
+    }
 }
