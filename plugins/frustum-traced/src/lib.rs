@@ -278,6 +278,22 @@ fn record_debug(
     )
 }
 
+/// Each light's uniform: `triangles` casters over a grid of `grid` texels a side, triangles
+/// grown by `grow` texels on the raster path.
+fn light_uniforms(ctx: &RenderContext<'_>, triangles: u32, grid: u32, grow: f32) -> Vec<FtLight> {
+    (0..ctx.lights.len())
+        .map(|light| FtLight {
+            light: light as u32,
+            lights: ctx.lights.len() as u32,
+            width: ctx.size.x,
+            height: ctx.size.y,
+            triangles,
+            grid,
+            grow,
+        })
+        .collect()
+}
+
 /// One light's raster pass: the views' bounds copied where the vertex stage reads them, then
 /// every caster triangle drawn once a view.
 struct RasterDraw<'a> {
@@ -368,17 +384,8 @@ impl ShadowTechnique for FrustumTraced {
         };
         let size = ctx.size;
         let triangles = tracing.caster_triangles();
-        let values: Vec<FtLight> = (0..ctx.lights.len())
-            .map(|light| FtLight {
-                light: light as u32,
-                lights: ctx.lights.len() as u32,
-                width: size.x,
-                height: size.y,
-                triangles,
-                grid: self.params.grid,
-                grow: if gpu.conservative { 0.0 } else { GROWTH },
-            })
-            .collect();
+        let grow = if gpu.conservative { 0.0 } else { GROWTH };
+        let values = light_uniforms(ctx, triangles, self.params.grid, grow);
         gpu.uniforms.write(ctx.gpu, &values);
         let tracing = Tracer::Compute.group(&gpu.tracing_layout, Some(tracing));
         let shape = buffers.shape;

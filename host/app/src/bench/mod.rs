@@ -114,62 +114,74 @@ pub fn run_plans(
     Ok(BenchRun { results, skipped })
 }
 
+/// The plans of suite `name`'s runs, the suite, and the runs skipped because files they need
+/// are absent.
+fn suite_plans(
+    name: &str,
+    args: &BenchArgs,
+) -> anyhow::Result<(Vec<BenchPlan>, suite::Suite, Vec<Skipped>)> {
+    let path = suite::locate(name)?;
+    let s = suite::load(&path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let absent = (s.runs.iter())
+        .filter_map(|run| {
+            let reason = run.missing(dir)?;
+            let configuration = format!("{}: every configuration", run.name);
+            Some(Skipped {
+                configuration,
+                reason,
+            })
+        })
+        .collect();
+    let plans = (s.runs.iter())
+        .filter(|run| run.missing(dir).is_none())
+        .map(|run| suite_run_plan(run, dir, args))
+        .collect::<anyhow::Result<Vec<_>>>()
+        .with_context(|| format!("suite {}", path.display()))?;
+    Ok((plans, s, absent))
+}
+
+/// The plan of one suite run (its scene relative to the suite's folder `dir`).
+fn suite_run_plan(
+    run: &suite::SuiteRun,
+    dir: &Path,
+    args: &BenchArgs,
+) -> anyhow::Result<BenchPlan> {
+    let scene_path = dir.join(&run.scene);
+    let mut techniques = (run.techniques.iter())
+        .map(|t| zoo_host::find_technique(t).map_err(anyhow::Error::from))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let baseline = zoo_host::find_technique(zoo_host::builtin::UNSHADOWED_ID)?;
+    if !techniques.iter().any(|t| t.id == baseline.id) {
+        techniques.insert(0, baseline);
+    }
+    Ok(BenchPlan {
+        run: run.name.clone(),
+        description: zoo_host::scene::read_description(&scene_path)?,
+        scene_path,
+        size: zoo_host::glam::UVec2::new(run.size.0, run.size.1),
+        frames: args.frames.unwrap_or(run.frames),
+        warmup: run.warmup,
+        path: run.path,
+        sweeps: (run.sweeps.iter())
+            .map(|(k, v)| parse_sweep(k, v))
+            .collect::<anyhow::Result<_>>()?,
+        set: split_sets(&run.set, &techniques)?,
+        techniques,
+        flicker: !args.no_flicker,
+        cpu_timing: args.cpu_timing,
+        reuse_unchanged: args.reuse_unchanged,
+    })
+}
+
 /// Runs `shadow-zoo bench`.
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
-    let mut absent = Vec::new();
-    let (plans, suite) = match (&args.suite, &args.scene) {
+    let (plans, suite, absent) = match (&args.suite, &args.scene) {
         (Some(name), _) => {
-            let path = suite::locate(name)?;
-            let s = suite::load(&path)?;
-            let dir = path.parent().unwrap_or(Path::new("."));
-            for run in &s.runs {
-                if let Some(reason) = run.missing(dir) {
-                    absent.push(Skipped {
-                        configuration: format!("{}: every configuration", run.name),
-                        reason,
-                    });
-                }
-            }
-            let plans = s
-                .runs
-                .iter()
-                .filter(|run| run.missing(dir).is_none())
-                .map(|run| {
-                    let scene_path = dir.join(&run.scene);
-                    let mut techniques = run
-                        .techniques
-                        .iter()
-                        .map(|t| zoo_host::find_technique(t).map_err(anyhow::Error::from))
-                        .collect::<anyhow::Result<Vec<_>>>()?;
-                    let baseline = zoo_host::find_technique(zoo_host::builtin::UNSHADOWED_ID)?;
-                    if !techniques.iter().any(|t| t.id == baseline.id) {
-                        techniques.insert(0, baseline);
-                    }
-                    Ok(BenchPlan {
-                        run: run.name.clone(),
-                        description: zoo_host::scene::read_description(&scene_path)?,
-                        scene_path,
-                        size: zoo_host::glam::UVec2::new(run.size.0, run.size.1),
-                        frames: args.frames.unwrap_or(run.frames),
-                        warmup: run.warmup,
-                        path: run.path,
-                        sweeps: run
-                            .sweeps
-                            .iter()
-                            .map(|(k, v)| parse_sweep(k, v))
-                            .collect::<anyhow::Result<_>>()?,
-                        set: split_sets(&run.set, &techniques)?,
-                        techniques,
-                        flicker: !args.no_flicker,
-                        cpu_timing: args.cpu_timing,
-                        reuse_unchanged: args.reuse_unchanged,
-                    })
-                })
-                .collect::<anyhow::Result<Vec<_>>>()
-                .with_context(|| format!("suite {}", path.display()))?;
-            (plans, Some(s))
+            let (plans, suite, absent) = suite_plans(name, args)?;
+            (plans, Some(suite), absent)
         }
-        (None, Some(scene)) => (vec![plan_from_args(args, scene)?], None),
+        (None, Some(scene)) => (vec![plan_from_args(args, scene)?], None, Vec::new()),
         (None, None) => bail!("give --scene FILE or --suite NAME"),
     };
     if plans.iter().any(|p| p.frames == 0) {
