@@ -48,10 +48,11 @@ test=(cargo test --workspace --locked --no-default-features)
 if [ "$#" -gt 0 ]; then
     exec "${test[@]}" "$@"
 fi
-# The suite: built once, then `tests/zoo` beside every other test binary (cargo runs test
-# binaries one after another, and a binary whose last test runs alone leaves a core idle; two
-# streams keep both busy: about a fifth off the suite's running time on two cores). `[!z]*`
-# names every integration test but `zoo` (no other test target's name starts with z).
+# The suite: built once, then `tests/zoo` and the doc tests beside every other test binary
+# (cargo runs test binaries one after another, and a binary whose last test runs alone leaves a
+# core idle; two streams keep both busy: about a fifth off the suite's running time on two
+# cores; the doc tests go with the shorter one). `[!z]*` names every integration test but `zoo`
+# (no other test target's name starts with z).
 "${test[@]}" --no-run
 zoo_log="$(mktemp)"
 # One folder of traced references for the run's test binaries, each its own process: a view
@@ -59,14 +60,27 @@ zoo_log="$(mktemp)"
 # Fresh for this run and removed with it, so only the code that traced a reference reuses it.
 shared_references="$(mktemp -d)"
 export ZOO_SHARED_REFERENCES="$shared_references"
-echo "tests/zoo runs beside the other tests; its output follows theirs (live in $zoo_log)"
-"${test[@]}" --test zoo >"$zoo_log" 2>&1 &
+echo "tests/zoo and the doc tests run beside the other tests; their output follows theirs"
+echo "(live in $zoo_log)"
+(
+    zoo_status=0
+    "${test[@]}" --test zoo || zoo_status=$?
+    "${test[@]}" --doc || zoo_status=$?
+    exit "$zoo_status"
+) >"$zoo_log" 2>&1 &
 zoo=$!
-# On any exit (an interrupt too), the zoo stream stops with the script: its test binary, then
-# cargo.
+# A process and its descendants, the children first.
+stop_tree() {
+    local child
+    if command -v pgrep >/dev/null; then
+        for child in $(pgrep -P "$1"); do stop_tree "$child"; done
+    fi
+    kill "$1" 2>/dev/null || true
+}
+# On any exit (an interrupt too), the zoo stream stops with the script: its test binaries,
+# cargo, its shell.
 stop_zoo() {
-    if command -v pkill >/dev/null; then pkill -P "$zoo" 2>/dev/null || true; fi
-    kill "$zoo" 2>/dev/null || true
+    stop_tree "$zoo"
     rm -f "$zoo_log"
     rm -rf "$shared_references"
 }
@@ -74,8 +88,7 @@ trap stop_zoo EXIT
 trap 'exit 130' INT TERM
 status=0
 "${test[@]}" --lib --bins --test '[!z]*' || status=$?
-"${test[@]}" --doc || status=$?
 wait "$zoo" || status=$?
-echo "--- tests/zoo ---"
+echo "--- tests/zoo and the doc tests ---"
 cat "$zoo_log"
 exit "$status"

@@ -175,19 +175,20 @@ pub fn suite_ratios(
     let mut out = Vec::new();
     for ratio in &s.ratios {
         let (n, d) = (&ratio.numerator, &ratio.denominator);
-        for num in results
-            .iter()
-            .filter(|r| r.config.run == n.run && r.config.technique.id == n.technique)
-        {
+        // Sweeps a measure picks a value of are not paired.
+        let pinned = |key: &str| n.swept.iter().chain(&d.swept).any(|(k, _)| k == key);
+        for num in results.iter().filter(|r| {
+            r.config.run == n.run
+                && r.config.technique.id == n.technique
+                && n.picks(&r.config.swept)
+        }) {
             // Same size and tessellation, and equal values for every sweep both sides share.
             let den = results.iter().find(|r| {
                 r.config.run == d.run
                     && r.config.technique.id == d.technique
+                    && d.picks(&r.config.swept)
                     && r.config.common_key() == num.config.common_key()
-                    && num
-                        .config
-                        .swept
-                        .iter()
+                    && (num.config.swept.iter().filter(|(k, _)| !pinned(k)))
                         .all(|(k, v)| r.config.swept.iter().all(|(k2, v2)| k2 != k || v2 == v))
             });
             if let Some(den) = den {
@@ -690,5 +691,36 @@ mod tests {
                 ("unmeasured", None)
             ]
         );
+    }
+
+    #[test]
+    fn ratios_can_divide_two_configurations_of_one_sweep() {
+        let suite: suite::Suite = ron::from_str(
+            r#"(name: "t", description: "", runs: [], ratios: [
+                (label: "wide over narrow", numerator: (run: "a", technique: "unshadowed",
+                    swept: [("k", "wide")]), denominator: (run: "a", technique: "unshadowed",
+                    swept: [("k", "narrow")]), seed: "-"),
+            ])"#,
+        )
+        .unwrap();
+        let swept = |kernel: &str, lights: &str, ms: f64| {
+            let mut r = result("a", &[("Lookup", ms, None)], &[], &[]);
+            r.config.swept = vec![
+                ("k".to_string(), kernel.to_string()),
+                ("scene.lights".to_string(), lights.to_string()),
+            ];
+            r
+        };
+        let results = [
+            swept("narrow", "1", 2.0),
+            swept("wide", "1", 6.0),
+            swept("narrow", "4", 4.0),
+            swept("wide", "4", 20.0),
+        ];
+        let values: Vec<Option<f64>> = (suite_ratios(&suite, &results).iter())
+            .map(|r| r.2)
+            .collect();
+        // Each wide configuration over the narrow one with the same light count.
+        assert_eq!(values, [Some(3.0), Some(5.0)]);
     }
 }

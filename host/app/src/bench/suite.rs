@@ -82,6 +82,18 @@ pub struct Measure {
     /// of those passes (where the device counts them).
     #[serde(default = "default_measure")]
     pub passes: String,
+    /// Only the configurations with these swept values, as (key, value) of the run's
+    /// `sweeps`: a ratio of two configurations of one sweep (PCF 23x23 over 5x5). Other sweeps
+    /// still pair the configurations with equal values.
+    #[serde(default)]
+    pub swept: Vec<(String, String)>,
+}
+
+impl Measure {
+    /// Whether a configuration swept to `swept` is one this measure takes.
+    pub fn picks(&self, swept: &[(String, String)]) -> bool {
+        (self.swept.iter()).all(|(k, v)| swept.iter().any(|(k2, v2)| k2 == k && v2 == v))
+    }
 }
 
 fn default_measure() -> String {
