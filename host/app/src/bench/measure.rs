@@ -4,7 +4,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use zoo_host::gpu::{FrameTimings, PassOwner, TimingSource};
+use zoo_host::gpu::{FrameTimings, PassCounts, PassOwner, TimingSource};
 use zoo_host::judge::{Occluders, Surfaces, reference_visibility};
 use zoo_host::judging::surface_points;
 use zoo_host::scene::paths;
@@ -21,9 +21,11 @@ use super::plan::*;
 pub struct ConfigResult {
     pub config: Configuration,
     pub passes: Vec<(String, PassOwner, Summary)>,
-    /// Median vertex, fragment and compute invocations per pass (same order as `passes`),
-    /// where the device has pipeline-statistics queries.
-    pub invocations: Vec<Option<[u64; 3]>>,
+    /// Median counts per pass (same order as `passes`), where the device has
+    /// pipeline-statistics queries.
+    pub counts: Vec<Option<PassCounts>>,
+    /// Each pass's counts per measured frame (same order as `passes`; empty where not counted).
+    pub frame_counts: Vec<Vec<PassCounts>>,
     pub frame_gpu: Summary,
     pub technique_gpu: Summary,
     pub frame_cpu: Summary,
@@ -41,7 +43,7 @@ struct PassSamples {
     name: String,
     owner: PassOwner,
     times: Vec<f64>,
-    invocations: Vec<[u64; 3]>,
+    counts: Vec<PassCounts>,
 }
 
 /// Renders one configuration along the path and measures it.
@@ -192,14 +194,14 @@ impl Samples {
                         name: pass.name.clone(),
                         owner: pass.owner,
                         times: Vec::new(),
-                        invocations: Vec::new(),
+                        counts: Vec::new(),
                     });
                     self.passes.len() - 1
                 }
             };
             self.passes[index].times.push(pass.milliseconds);
-            if let Some(counts) = pass.invocations {
-                self.passes[index].invocations.push(counts);
+            if let Some(counts) = pass.counts {
+                self.passes[index].counts.push(counts);
             }
         }
     }
@@ -213,9 +215,10 @@ impl Samples {
     ) -> ConfigResult {
         ConfigResult {
             config: config.clone(),
-            invocations: (self.passes.iter())
-                .map(|p| median_counts(&p.invocations))
+            counts: (self.passes.iter())
+                .map(|p| median_counts(&p.counts))
                 .collect(),
+            frame_counts: self.passes.iter().map(|p| p.counts.clone()).collect(),
             passes: (self.passes.into_iter())
                 .map(|p| (p.name, p.owner, Summary::of(&p.times)))
                 .collect(),
@@ -231,15 +234,14 @@ impl Samples {
     }
 }
 
-/// The median of each of the vertex, fragment and compute invocation counts (`None`
-/// without counts).
-fn median_counts(counts: &[[u64; 3]]) -> Option<[u64; 3]> {
+/// The median of each count over the frames (`None` without counts).
+fn median_counts(counts: &[PassCounts]) -> Option<PassCounts> {
     (!counts.is_empty()).then(|| {
-        [0, 1, 2].map(|k| {
-            let mut v: Vec<u64> = counts.iter().map(|c| c[k]).collect();
+        PassCounts::from_values([0, 1, 2, 3].map(|k| {
+            let mut v: Vec<u64> = counts.iter().map(|c| c.values()[k]).collect();
             v.sort_unstable();
             v[v.len() / 2]
-        })
+        }))
     })
 }
 

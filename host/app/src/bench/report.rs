@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use zoo_host::gpu::PassOwner;
+use zoo_host::gpu::{PassCounts, PassOwner};
 
 use crate::cli::parse_size;
 
@@ -30,14 +30,14 @@ pub(super) fn ratio_to_baseline(results: &[ConfigResult], r: &ConfigResult) -> O
 /// `bench.csv`: one row per configuration and pass (plus frame and technique totals).
 pub fn bench_csv(results: &[ConfigResult]) -> String {
     let mut out = String::from(
-        "run,configuration,technique,size,tessellation,pass,owner,median_ms,mean_ms,p95_ms,p99_ms,min_ms,max_ms,frames,vertex_invocations,fragment_invocations,compute_invocations\n",
+        "run,configuration,technique,size,tessellation,pass,owner,median_ms,mean_ms,p95_ms,p99_ms,min_ms,max_ms,frames,vertex_invocations,fragment_invocations,compute_invocations,samples_passed\n",
     );
     for r in results {
         let c = &r.config;
         let rows = r
             .passes
             .iter()
-            .zip(&r.invocations)
+            .zip(&r.counts)
             .map(|((name, owner, s), counts)| {
                 let owner = match owner {
                     PassOwner::Host => "host",
@@ -56,7 +56,10 @@ pub fn bench_csv(results: &[ConfigResult]) -> String {
                 ("frame (cpu wall)".to_string(), "total", r.frame_cpu, None),
             ]);
         for (name, owner, s, counts) in rows {
-            let counts = counts.map_or(",,".to_string(), |[v, f, c]| format!("{v},{f},{c}"));
+            let counts = counts.map_or(",,,".to_string(), |c| {
+                let [v, f, c, s] = c.values();
+                format!("{v},{f},{c},{s}")
+            });
             let _ = writeln!(
                 out,
                 "{},\"{}\",{},{}x{},{},\"{}\",{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{},{counts}",
@@ -129,17 +132,18 @@ fn today() -> String {
 
 /// A result's measure (see [`suite::Measure::passes`]): the median time of the frame, of the
 /// technique or of the passes starting with a prefix; a counter's mean over the measured frames;
-/// or the passes' median invocations of one kind. `None` where it was not measured (a counter
-/// the technique lacks, invocations on a device without pipeline statistics).
+/// or the passes' median count of one kind ([`PassCounts::NAMES`]). `None` where it was not
+/// measured (a counter the technique lacks, counts on a device without pipeline statistics).
 fn measure(r: &ConfigResult, passes: &str) -> Option<f64> {
     if let Some(name) = passes.strip_prefix("counter:") {
         return counter_mean(r, name);
     }
-    for (kind, index) in [("vertices:", 0), ("fragments:", 1), ("compute:", 2)] {
-        if let Some(prefix) = passes.strip_prefix(kind) {
-            let counts: Option<Vec<u64>> = (r.passes.iter().zip(&r.invocations))
+    for (index, kind) in PassCounts::NAMES.iter().enumerate() {
+        let prefix = passes.strip_prefix(kind).and_then(|p| p.strip_prefix(':'));
+        if let Some(prefix) = prefix {
+            let counts: Option<Vec<u64>> = (r.passes.iter().zip(&r.counts))
                 .filter(|((name, _, _), _)| name.starts_with(prefix))
-                .map(|(_, counts)| counts.map(|c| c[index]))
+                .map(|(_, counts)| counts.map(|c| c.values()[index]))
                 .collect();
             return counts
                 .filter(|c| !c.is_empty())
@@ -152,7 +156,7 @@ fn measure(r: &ConfigResult, passes: &str) -> Option<f64> {
         prefix => (r.passes.iter())
             .filter(|(n, _, _)| n.starts_with(prefix))
             .map(|(_, _, s)| s.median)
-            .sum(),
+            .fold(0.0, |a, b| a + b),
     })
 }
 
@@ -166,12 +170,23 @@ fn counter_mean(r: &ConfigResult, name: &str) -> Option<f64> {
     }
 }
 
-/// Suite ratios: (label, configuration key, value, seed figure) for every matching pair; the
-/// value is `None` where a measure was not taken on this device.
-pub fn suite_ratios(
-    s: &suite::Suite,
-    results: &[ConfigResult],
-) -> Vec<(String, String, Option<f64>, String)> {
+/// One suite ratio for one pair of configurations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RatioRow {
+    pub label: String,
+    /// The numerator's size, tessellation and sweep values.
+    pub configuration: String,
+    /// `None` where a measure was not taken on this device.
+    pub value: Option<f64>,
+    /// Where both measures are counts: the least and greatest ratio of one frame's counts
+    /// along the path (the camera's or the light's positions differ per frame).
+    pub frame_range: Option<(f64, f64)>,
+    /// The seed's figure.
+    pub seed: String,
+}
+
+/// Suite ratios, one row for every matching pair of configurations.
+pub fn suite_ratios(s: &suite::Suite, results: &[ConfigResult]) -> Vec<RatioRow> {
     let mut out = Vec::new();
     for ratio in &s.ratios {
         let (n, d) = (&ratio.numerator, &ratio.denominator);
@@ -191,31 +206,73 @@ pub fn suite_ratios(
                     && (num.config.swept.iter().filter(|(k, _)| !pinned(k)))
                         .all(|(k, v)| r.config.swept.iter().all(|(k2, v2)| k2 != k || v2 == v))
             });
-            if let Some(den) = den {
-                let bottom = measure(den, &d.passes);
-                if bottom.is_none_or(|b| b > 0.0) {
-                    let key = format!(
-                        "{}x{}, tessellation {}{}",
-                        num.config.size.x,
-                        num.config.size.y,
-                        num.config.tessellation,
-                        if num.config.swept.is_empty() {
-                            String::new()
-                        } else {
-                            format!(" ({})", num.config.label())
-                        }
-                    );
-                    out.push((
-                        ratio.label.clone(),
-                        key,
-                        measure(num, &n.passes).zip(bottom).map(|(top, b)| top / b),
-                        ratio.seed.clone(),
-                    ));
-                }
+            let Some(den) = den else { continue };
+            let bottom = measure(den, &d.passes);
+            if bottom.is_some_and(|b| b <= 0.0) {
+                continue;
             }
+            let configuration = format!(
+                "{}x{}, tessellation {}{}",
+                num.config.size.x,
+                num.config.size.y,
+                num.config.tessellation,
+                if num.config.swept.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", num.config.label())
+                }
+            );
+            out.push(RatioRow {
+                label: ratio.label.clone(),
+                configuration,
+                value: measure(num, &n.passes).zip(bottom).map(|(top, b)| top / b),
+                frame_range: frame_ratio_range(num, &n.passes, den, &d.passes),
+                seed: ratio.seed.clone(),
+            });
         }
     }
     out
+}
+
+/// The least and greatest ratio of two count measures frame by frame (`None` unless both are
+/// counts of the same number of frames, all denominators positive).
+fn frame_ratio_range(
+    num: &ConfigResult,
+    top: &str,
+    den: &ConfigResult,
+    bottom: &str,
+) -> Option<(f64, f64)> {
+    let (tops, bottoms) = (frame_counts(num, top)?, frame_counts(den, bottom)?);
+    if tops.len() != bottoms.len() || bottoms.iter().any(|b| *b <= 0.0) {
+        return None;
+    }
+    let ratios = tops.iter().zip(&bottoms).map(|(t, b)| t / b);
+    ratios.fold(None, |range, r| match range {
+        None => Some((r, r)),
+        Some((low, high)) => Some((r.min(low), r.max(high))),
+    })
+}
+
+/// A count measure (`fragments:PREFIX`, ...) per measured frame: the sum over the passes so
+/// named. `None` for other measures or where counts were not taken.
+fn frame_counts(r: &ConfigResult, passes: &str) -> Option<Vec<f64>> {
+    let (index, prefix) = (PassCounts::NAMES.iter().enumerate()).find_map(|(index, kind)| {
+        let prefix = passes.strip_prefix(kind)?.strip_prefix(':')?;
+        Some((index, prefix))
+    })?;
+    let named: Vec<&Vec<PassCounts>> = (r.passes.iter().zip(&r.frame_counts))
+        .filter(|((name, _, _), _)| name.starts_with(prefix))
+        .map(|(_, frames)| frames)
+        .collect();
+    let frames = named.first()?.len();
+    if frames == 0 || named.iter().any(|f| f.len() != frames) {
+        return None;
+    }
+    Some(
+        (0..frames)
+            .map(|k| named.iter().map(|f| f[k].values()[index] as f64).sum())
+            .collect(),
+    )
 }
 
 /// For configurations swept over `scene.lights`: (run, configuration without the light
@@ -391,9 +448,19 @@ fn seeds_md(w: &mut String, suite: &suite::Suite, results: &[ConfigResult]) {
         let _ = writeln!(w, "\n## This project beside the seeds\n");
         let _ = writeln!(w, "| ratio | configuration | this project | seed |");
         let _ = writeln!(w, "|---|---|---|---|");
-        for (label, key, value, seed) in ratios {
-            let value = value.map_or("not measured on this device".into(), |v| format!("{v:.2}"));
-            let _ = writeln!(w, "| {label} | {key} | {value} | {seed} |");
+        for row in ratios {
+            let mut value =
+                (row.value).map_or("not measured on this device".into(), |v| format!("{v:.2}"));
+            if let Some((low, high)) = row.frame_range {
+                value += &format!(" (frames {low:.2} to {high:.2})");
+            }
+            let RatioRow {
+                label,
+                configuration,
+                seed,
+                ..
+            } = row;
+            let _ = writeln!(w, "| {label} | {configuration} | {value} | {seed} |");
         }
     }
     if !suite.seed_figures.is_empty() {
@@ -404,19 +471,22 @@ fn seeds_md(w: &mut String, suite: &suite::Suite, results: &[ConfigResult]) {
     }
 }
 
-/// Each configuration's pass times, with the shader invocations where they were counted.
+/// Each configuration's pass times, with the counts where they were taken.
 fn passes_md(w: &mut String, results: &[ConfigResult]) {
     let _ = writeln!(
         w,
-        "\n## Passes (median / p95 ms; vertex / fragment / compute invocations where counted)\n"
+        "\n## Passes (median / p95 ms; vertex / fragment / compute invocations / samples passing \
+         the depth and stencil tests, where counted)\n"
     );
     for r in results {
         let passes: Vec<String> = r
             .passes
             .iter()
-            .zip(&r.invocations)
-            .map(|((n, _, s), counts)| match counts {
-                Some([v, f, c]) => format!("{n} {:.2}/{:.2} ({v}/{f}/{c})", s.median, s.p95),
+            .zip(&r.counts)
+            .map(|((n, _, s), counts)| match counts.map(|c| c.values()) {
+                Some([v, f, c, p]) => {
+                    format!("{n} {:.2}/{:.2} ({v}/{f}/{c}/{p})", s.median, s.p95)
+                }
                 None => format!("{n} {:.2}/{:.2}", s.median, s.p95),
             })
             .collect();
@@ -596,7 +666,7 @@ mod tests {
     /// counters, some varying over three frames.
     fn result(
         run: &str,
-        passes: &[(&str, f64, Option<[u64; 3]>)],
+        passes: &[(&str, f64, Option<[u64; 4]>)],
         counters: &[(&str, f64)],
         varying: &[(&str, [f64; 3])],
     ) -> ConfigResult {
@@ -616,7 +686,12 @@ mod tests {
             passes: (passes.iter())
                 .map(|(name, ms, _)| (name.to_string(), PassOwner::Technique, summary(*ms)))
                 .collect(),
-            invocations: passes.iter().map(|p| p.2).collect(),
+            counts: (passes.iter())
+                .map(|p| p.2.map(PassCounts::from_values))
+                .collect(),
+            frame_counts: (passes.iter())
+                .map(|p| p.2.map(PassCounts::from_values).into_iter().collect())
+                .collect(),
             frame_gpu: summary(total),
             technique_gpu: summary(total),
             frame_cpu: summary(total),
@@ -637,8 +712,8 @@ mod tests {
         let r = result(
             "a",
             &[
-                ("Volumes: light 0", 2.0, Some([3, 100, 0])),
-                ("Volumes: light 1", 4.0, Some([5, 300, 0])),
+                ("Volumes: light 0", 2.0, Some([3, 100, 0, 40])),
+                ("Volumes: light 1", 4.0, Some([5, 300, 0, 20])),
                 ("Lighting", 1.0, None),
             ],
             &[("pages", 7.0), ("drawn", 6.0)],
@@ -648,6 +723,9 @@ mod tests {
         assert_eq!(measure(&r, "Volumes"), Some(6.0));
         assert_eq!(measure(&r, "fragments:Volumes"), Some(400.0));
         assert_eq!(measure(&r, "vertices:Volumes"), Some(8.0));
+        assert_eq!(measure(&r, "samples:Volumes"), Some(60.0));
+        // A count's name is followed by a colon; anything else is a pass prefix.
+        assert_eq!(measure(&r, "samplesVolumes"), Some(0.0));
         // Invocations a device did not count, or no pass of that name: not measured.
         assert_eq!(measure(&r, "fragments:Lighting"), None);
         assert_eq!(measure(&r, "fragments:Shadow"), None);
@@ -675,14 +753,17 @@ mod tests {
         .unwrap();
         let a = result(
             "a",
-            &[("Volumes", 3.0, Some([0, 50, 0])), ("Lighting", 1.0, None)],
+            &[
+                ("Volumes", 3.0, Some([0, 50, 0, 0])),
+                ("Lighting", 1.0, None),
+            ],
             &[],
             &[],
         );
-        let b = result("b", &[("Volumes", 6.0, Some([0, 1000, 0]))], &[], &[]);
+        let b = result("b", &[("Volumes", 6.0, Some([0, 1000, 0, 0]))], &[], &[]);
         let ratios = suite_ratios(&suite, &[a, b]);
         let values: Vec<(&str, Option<f64>)> =
-            ratios.iter().map(|(l, _, v, _)| (l.as_str(), *v)).collect();
+            ratios.iter().map(|r| (r.label.as_str(), r.value)).collect();
         assert_eq!(
             values,
             [
@@ -691,6 +772,51 @@ mod tests {
                 ("unmeasured", None)
             ]
         );
+    }
+
+    #[test]
+    fn count_ratios_give_their_range_over_the_frames() {
+        let suite: suite::Suite = ron::from_str(
+            r#"(name: "t", description: "", runs: [], ratios: [
+                (label: "samples", numerator: (run: "a", technique: "unshadowed",
+                    passes: "samples:Volumes"), denominator: (run: "b",
+                    technique: "unshadowed", passes: "samples:Volumes"), seed: "8-30x"),
+                (label: "time", numerator: (run: "a", technique: "unshadowed",
+                    passes: "Volumes"), denominator: (run: "b", technique: "unshadowed",
+                    passes: "Volumes"), seed: "-"),
+            ])"#,
+        )
+        .unwrap();
+        let per_frame = |samples: &[[u64; 2]]| -> Vec<Vec<PassCounts>> {
+            (0..2)
+                .map(|pass| {
+                    (samples.iter())
+                        .map(|s| PassCounts::from_values([0, 0, 0, s[pass]]))
+                        .collect()
+                })
+                .collect()
+        };
+        let passes = [
+            ("Volumes: light 0", 1.0, Some([0, 0, 0, 100])),
+            ("Volumes: light 1", 1.0, Some([0, 0, 0, 100])),
+        ];
+        let mut a = result("a", &passes, &[], &[]);
+        let mut b = result("b", &passes, &[], &[]);
+        // Frame by frame, both lights' samples: 300/30, 200/20 and 90/30.
+        a.frame_counts = per_frame(&[[100, 200], [150, 50], [40, 50]]);
+        b.frame_counts = per_frame(&[[10, 20], [10, 10], [10, 20]]);
+        let ratios = suite_ratios(&suite, &[a.clone(), b.clone()]);
+        assert_eq!(ratios[0].frame_range, Some((3.0, 10.0)));
+        // Times have no per-frame series here.
+        assert_eq!(ratios[1].frame_range, None);
+        // Series of different lengths, or a frame with no samples below, give no range.
+        b.frame_counts = per_frame(&[[10, 20], [10, 10]]);
+        assert_eq!(
+            suite_ratios(&suite, &[a.clone(), b.clone()])[0].frame_range,
+            None
+        );
+        b.frame_counts = per_frame(&[[10, 20], [10, 10], [0, 0]]);
+        assert_eq!(suite_ratios(&suite, &[a, b])[0].frame_range, None);
     }
 
     #[test]
@@ -718,7 +844,7 @@ mod tests {
             swept("wide", "4", 20.0),
         ];
         let values: Vec<Option<f64>> = (suite_ratios(&suite, &results).iter())
-            .map(|r| r.2)
+            .map(|r| r.value)
             .collect();
         // Each wide configuration over the narrow one with the same light count.
         assert_eq!(values, [Some(3.0), Some(5.0)]);

@@ -79,7 +79,8 @@ pub struct Measure {
     /// passes whose names start with a prefix (over `frame` of the same technique: the passes'
     /// share of the frame); `counter:NAME`, the counter's mean over the measured frames; or
     /// `vertices:PREFIX`, `fragments:PREFIX`, `compute:PREFIX`, the median shader invocations
-    /// of those passes (where the device counts them).
+    /// of those passes, or `samples:PREFIX`, their samples passing the depth and stencil tests
+    /// (where the device counts them).
     #[serde(default = "default_measure")]
     pub passes: String,
     /// Only the configurations with these swept values, as (key, value) of the run's

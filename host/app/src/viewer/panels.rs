@@ -582,7 +582,7 @@ mod tests {
             name: name.to_string(),
             owner: PassOwner::Technique,
             milliseconds,
-            invocations: None,
+            counts: None,
         }
     }
 

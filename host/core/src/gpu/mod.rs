@@ -12,8 +12,8 @@ mod targets;
 pub use context::{GpuContext, GpuError};
 pub use gpu_struct::{GpuStruct, GpuType, gpu_bytes, gpu_bytes_padded};
 pub use recorder::{
-    FrameTimings, PASSES_PER_CHUNK, PassOwner, PassRecorder, PassTiming, RecordedComputePass,
-    RecordedRenderPass, StatisticsQueries, TimestampQueries, TimingSource,
+    FrameTimings, PASSES_PER_CHUNK, PassCounts, PassOwner, PassRecorder, PassTiming,
+    RecordedComputePass, RecordedRenderPass, StatisticsQueries, TimestampQueries, TimingSource,
 };
 pub use shaders::{ComposedShader, LoadedShader, ShaderError, ShaderLibrary};
 pub use targets::{

@@ -46,8 +46,45 @@ pub struct PassTiming {
     pub name: String,
     pub owner: PassOwner,
     pub milliseconds: f64,
-    /// Vertex, fragment and compute shader invocations, when pipeline statistics are on.
-    pub invocations: Option<[u64; 3]>,
+    /// What the device counted in the pass, when pipeline statistics are on.
+    pub counts: Option<PassCounts>,
+}
+
+/// What the device counted in one pass (pipeline statistics and an occlusion query).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PassCounts {
+    pub vertex_invocations: u64,
+    pub fragment_invocations: u64,
+    pub compute_invocations: u64,
+    /// Samples that passed the depth and stencil tests (render passes; 0 in compute passes).
+    /// A device may run fragment shaders before those tests (lavapipe does), so this, not the
+    /// fragment invocations, is the work that early tests leave on a GPU.
+    pub samples_passed: u64,
+}
+
+impl PassCounts {
+    /// The counts in the order of [`PassCounts::NAMES`].
+    pub fn values(&self) -> [u64; 4] {
+        [
+            self.vertex_invocations,
+            self.fragment_invocations,
+            self.compute_invocations,
+            self.samples_passed,
+        ]
+    }
+
+    /// Counts from [`PassCounts::values`]' order.
+    pub fn from_values([v, f, c, s]: [u64; 4]) -> PassCounts {
+        PassCounts {
+            vertex_invocations: v,
+            fragment_invocations: f,
+            compute_invocations: c,
+            samples_passed: s,
+        }
+    }
+
+    /// Short names of the counts, in [`PassCounts::values`]' order.
+    pub const NAMES: [&'static str; 4] = ["vertices", "fragments", "compute", "samples"];
 }
 
 /// Times of one frame's passes, in recording order.
@@ -179,9 +216,11 @@ impl TimestampQueries {
     }
 }
 
-/// Pipeline-statistics query storage: vertex, fragment and compute invocations per pass.
+/// Pipeline-statistics query storage (vertex, fragment and compute invocations per pass) and
+/// occlusion query storage (samples passing the depth and stencil tests per render pass).
 pub struct StatisticsQueries {
     chunks: QueryChunks,
+    occlusion: QueryChunks,
 }
 
 impl StatisticsQueries {
@@ -205,7 +244,9 @@ impl StatisticsQueries {
             24,
         );
         chunks.chunk(gpu, 0);
-        Some(StatisticsQueries { chunks })
+        let occlusion = QueryChunks::new("pass samples passed", wgpu::QueryType::Occlusion, 1, 8);
+        occlusion.chunk(gpu, 0);
+        Some(StatisticsQueries { chunks, occlusion })
     }
 }
 
@@ -213,6 +254,7 @@ impl StatisticsQueries {
 pub struct RecordedRenderPass<'p> {
     pass: wgpu::RenderPass<'p>,
     statistics: bool,
+    occlusion: bool,
 }
 
 impl<'p> std::ops::Deref for RecordedRenderPass<'p> {
@@ -230,6 +272,9 @@ impl std::ops::DerefMut for RecordedRenderPass<'_> {
 
 impl Drop for RecordedRenderPass<'_> {
     fn drop(&mut self) {
+        if self.occlusion {
+            self.pass.end_occlusion_query();
+        }
         if self.statistics {
             self.pass.end_pipeline_statistics_query();
         }
@@ -271,6 +316,18 @@ struct NextPass {
     statistics: Option<(wgpu::QuerySet, u32)>,
 }
 
+/// Occlusion queries of one frame's render passes: each render pass takes the next query, so
+/// only written queries are resolved.
+#[derive(Default)]
+struct OcclusionSlots {
+    /// Chunks this frame has used, in order.
+    chunks: Vec<QueryChunk>,
+    /// Each pass's query, in pass order (`None`: a compute pass, or one with its own set).
+    of_pass: Vec<Option<u32>>,
+    /// Queries taken.
+    used: u32,
+}
+
 /// Opens the passes of one frame and times them.
 pub struct PassRecorder<'a> {
     gpu: &'a GpuContext,
@@ -283,6 +340,7 @@ pub struct PassRecorder<'a> {
     /// Chunks this frame has used, in order.
     timestamp_chunks: Vec<QueryChunk>,
     statistics_chunks: Vec<QueryChunk>,
+    occlusion: OcclusionSlots,
     /// Whether a render pass was recorded since the last compute pass.
     rendered: bool,
 }
@@ -300,6 +358,7 @@ impl<'a> PassRecorder<'a> {
             cpu_times: Vec::new(),
             timestamp_chunks: Vec::new(),
             statistics_chunks: Vec::new(),
+            occlusion: OcclusionSlots::default(),
             rendered: false,
         }
     }
@@ -395,12 +454,21 @@ impl<'a> PassRecorder<'a> {
                     beginning_of_pass_write_index: Some(*begin),
                     end_of_pass_write_index: Some(begin + 1),
                 });
+        let occlusion = match desc.occlusion_query_set {
+            None => self.next_occlusion_query(),
+            Some(_) => None,
+        };
+        self.occlusion
+            .of_pass
+            .push(occlusion.as_ref().map(|(_, i)| *i));
         let desc = wgpu::RenderPassDescriptor {
             label: desc.label,
             color_attachments: desc.color_attachments,
             depth_stencil_attachment: desc.depth_stencil_attachment.clone(),
             timestamp_writes,
-            occlusion_query_set: desc.occlusion_query_set,
+            occlusion_query_set: desc
+                .occlusion_query_set
+                .or(occlusion.as_ref().map(|(set, _)| set)),
             multiview_mask: desc.multiview_mask,
         };
         self.rendered = true;
@@ -408,15 +476,33 @@ impl<'a> PassRecorder<'a> {
         if let Some((set, index)) = &next.statistics {
             pass.begin_pipeline_statistics_query(set, *index);
         }
+        if let Some((_, index)) = &occlusion {
+            pass.begin_occlusion_query(index % PASSES_PER_CHUNK);
+        }
         RecordedRenderPass {
             pass,
             statistics: next.statistics.is_some(),
+            occlusion: occlusion.is_some(),
         }
+    }
+
+    /// The next render pass's occlusion query (its chunk's set and the frame's query index),
+    /// when statistics are on.
+    fn next_occlusion_query(&mut self) -> Option<(wgpu::QuerySet, u32)> {
+        let statistics = self.statistics?;
+        let index = self.occlusion.used;
+        self.occlusion.used += 1;
+        let chunk = (index / PASSES_PER_CHUNK) as usize;
+        if self.occlusion.chunks.len() <= chunk {
+            (self.occlusion.chunks).push(statistics.occlusion.chunk(self.gpu, chunk));
+        }
+        Some((self.occlusion.chunks[chunk].set.clone(), index))
     }
 
     /// Opens a compute pass named `label`.
     pub fn compute_pass(&mut self, label: &str) -> RecordedComputePass<'_> {
         let next = self.next_pass(label);
+        self.occlusion.of_pass.push(None);
         let timestamp_writes =
             next.timestamps
                 .as_ref()
@@ -444,9 +530,15 @@ impl<'a> PassRecorder<'a> {
         }
     }
 
-    /// Resolves the used part of every chunk into its readback buffer.
-    fn resolve_chunks(&mut self, chunks: &[QueryChunk], queries_per_pass: u32, bytes: u64) {
-        let passes = self.names.len() as u32;
+    /// Resolves the used part of every chunk (`passes` passes' queries) into its readback
+    /// buffer.
+    fn resolve_chunks(
+        &mut self,
+        chunks: &[QueryChunk],
+        passes: u32,
+        queries_per_pass: u32,
+        bytes: u64,
+    ) {
         for (k, chunk) in chunks.iter().enumerate() {
             let used = (passes - k as u32 * PASSES_PER_CHUNK).min(PASSES_PER_CHUNK);
             let queries = used * queries_per_pass;
@@ -463,26 +555,48 @@ impl<'a> PassRecorder<'a> {
     }
 
     /// The resolved results of every chunk, in pass order (`bytes_per_pass` each).
-    fn read_chunks(&self, chunks: &[QueryChunk], bytes_per_pass: usize) -> Vec<u8> {
+    fn read_chunks(&self, chunks: &[QueryChunk], passes: usize, bytes_per_pass: usize) -> Vec<u8> {
         let mut all = Vec::new();
         for chunk in chunks {
             all.extend(super::readback::map_buffer(self.gpu, &chunk.readback));
         }
-        all.truncate(self.names.len() * bytes_per_pass);
+        all.truncate(passes * bytes_per_pass);
         all
+    }
+
+    /// Each pass's counts, where statistics were on.
+    fn read_counts(&self, statistics: &[QueryChunk], occlusion: &[QueryChunk]) -> Vec<PassCounts> {
+        let words = |bytes: Vec<u8>| -> Vec<u64> {
+            (bytes.chunks_exact(8))
+                .map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")))
+                .collect()
+        };
+        let invocations = words(self.read_chunks(statistics, self.names.len(), 24));
+        let samples = words(self.read_chunks(occlusion, self.occlusion.used as usize, 8));
+        (invocations.chunks_exact(3).zip(&self.occlusion.of_pass))
+            .map(|(i, query)| PassCounts {
+                vertex_invocations: i[0],
+                fragment_invocations: i[1],
+                compute_invocations: i[2],
+                samples_passed: query.map_or(0, |q| samples[q as usize]),
+            })
+            .collect()
     }
 
     /// Submits the frame, waits for it and returns the pass times.
     pub fn finish(mut self) -> FrameTimings {
         let timestamp_chunks = std::mem::take(&mut self.timestamp_chunks);
         let statistics_chunks = std::mem::take(&mut self.statistics_chunks);
-        self.resolve_chunks(&timestamp_chunks, 2, 8);
-        self.resolve_chunks(&statistics_chunks, 1, 24);
+        let occlusion_chunks = std::mem::take(&mut self.occlusion.chunks);
+        let passes = self.names.len() as u32;
+        self.resolve_chunks(&timestamp_chunks, passes, 2, 8);
+        self.resolve_chunks(&statistics_chunks, passes, 1, 24);
+        self.resolve_chunks(&occlusion_chunks, self.occlusion.used, 1, 8);
         self.flush();
         self.gpu.wait_idle();
         let (source, times) = match self.queries {
             Some(_) => {
-                let bytes = self.read_chunks(&timestamp_chunks, 16);
+                let bytes = self.read_chunks(&timestamp_chunks, self.names.len(), 16);
                 let period_ms = self.gpu.queue.get_timestamp_period() as f64 * 1e-6;
                 let times = bytes
                     .chunks_exact(16)
@@ -500,15 +614,7 @@ impl<'a> PassRecorder<'a> {
                 std::mem::take(&mut self.cpu_times),
             ),
         };
-        let invocations: Vec<[u64; 3]> = self
-            .read_chunks(&statistics_chunks, 24)
-            .chunks_exact(24)
-            .map(|b| {
-                let word =
-                    |k: usize| u64::from_le_bytes(b[8 * k..8 * k + 8].try_into().expect("8 bytes"));
-                [word(0), word(1), word(2)]
-            })
-            .collect();
+        let counts = self.read_counts(&statistics_chunks, &occlusion_chunks);
         FrameTimings {
             source,
             passes: self
@@ -520,7 +626,7 @@ impl<'a> PassRecorder<'a> {
                     name,
                     owner,
                     milliseconds,
-                    invocations: invocations.get(i).copied(),
+                    counts: counts.get(i).copied(),
                 })
                 .collect(),
         }
