@@ -1,5 +1,6 @@
 // Hybrid shadows, coverage maps: every caster triangle rendered conservatively from one
-// shadow-map layer, into every texel it touches, writing its id. The depth map samples texel
+// shadow-map layer, into every texel it touches, writing its id (of a closed opaque caster,
+// only the triangles facing the light). The depth map samples texel
 // centres and misses casters thinner than a texel; the band pass tests a pixel's own light
 // ray against the plane of the triangle stored in its texel here (`coverage_blocked` in
 // `hybrid-edge/band.wgsl`).
@@ -12,6 +13,35 @@
 
 #import "common/conservative.wgsl"
 #import "hybrid-edge/casters.wgsl"
+// Each scene object's box and, for a closed opaque caster, its orientation (`ClosedCaster` in
+// the plugin's Rust).
+#import "hybrid-edge/closed_caster.wgsl"
+
+@group(2) @binding(2) var<storage, read> closed_casters: array<ClosedCaster>;
+
+// Whether a triangle (world corners `p`) of `object` may be left out: its object is closed and
+// opaque, the light lies outside its box, and the triangle faces away from the light (a ray
+// that crosses a closed caster enters it through a triangle facing the light, nearer the
+// light; `plugins/hybrid-edge/src/closed.rs`).
+fn faces_away_inside_closed(object: u32, p: array<vec3<f32>, 3>) -> bool {
+    let caster = closed_casters[object];
+    let orientation = caster.low.w;
+    if orientation == 0.0 {
+        return false;
+    }
+    var to_light: vec3<f32>;
+    if layer_camera.eye.w > 0.0 {
+        let eye = layer_camera.eye.xyz;
+        if all(eye >= caster.low.xyz) && all(eye <= caster.high.xyz) {
+            return false;
+        }
+        to_light = eye - p[0];
+    } else {
+        // An orthographic layer: away from the direction its depth grows along.
+        to_light = -(layer_camera.inv_view_proj * vec4<f32>(0.0, 0.0, 1.0, 0.0)).xyz;
+    }
+    return dot(cross(p[1] - p[0], p[2] - p[0]), to_light) * orientation < 0.0;
+}
 
 struct CoverageVertex {
     @builtin(position) clip: vec4<f32>,
@@ -36,9 +66,14 @@ fn vs_coverage(@builtin(vertex_index) vertex: u32, @builtin(instance_index) obje
     let triangle = vertex / 3u;
     out.triangle = drawn_triangle_id(object, triangle);
     let corner = vertex % 3u;
+    var world: array<vec3<f32>, 3>;
     var clip: array<vec4<f32>, 3>;
     for (var k = 0u; k < 3u; k++) {
-        clip[k] = layer_camera.view_proj * vec4<f32>(triangle_corner(object, triangle, k), 1.0);
+        world[k] = triangle_corner(object, triangle, k);
+        clip[k] = layer_camera.view_proj * vec4<f32>(world[k], 1.0);
+    }
+    if faces_away_inside_closed(object, world) {
+        return out;
     }
     // A triangle that reaches behind a perspective layer's eye is drawn as it is (clipped by
     // the rasteriser, not grown).

@@ -52,7 +52,7 @@ fn a_tiny_run_writes_well_formed_csv_markdown_and_plots() {
 }
 
 /// bench.csv of the tiny run: the header, ordered statistics, three frames, the lighting
-/// pass's invocations, and a row per pass and total.
+/// pass's invocations and samples passed, and a row per pass and total.
 fn assert_tiny_csv(out: &std::path::Path) {
     let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
     let mut lines = csv.lines();
@@ -76,7 +76,8 @@ fn assert_tiny_csv(out: &std::path::Path) {
             "frames",
             "vertex_invocations",
             "fragment_invocations",
-            "compute_invocations"
+            "compute_invocations",
+            "samples_passed"
         ]
     );
     let mut rows = 0;
@@ -108,6 +109,8 @@ fn assert_tiny_csv(out: &std::path::Path) {
                 "{line}"
             );
             assert_eq!(fields[14], "3", "a full-screen triangle: {line}");
+            // Every pixel's one sample passes (no depth or stencil test): exactly the pixels.
+            assert_eq!(fields[17], pixels.to_string(), "samples passed: {line}");
         }
         rows += 1;
     }

@@ -194,7 +194,7 @@ impl DepthPass {
     /// Records one pass per tile of `passes` (named by [`TilePass::name`] with `base`), into
     /// the depth pages of `depth` and, for a pass with a [`ColorOutput`], the colour pages of
     /// `color` (`depth` is then one scratch page, cleared with each page's first tile). Each
-    /// draws the casters `reaches(light, object)` accepts.
+    /// draws the casters `casts_into(pass, object)` accepts.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -204,7 +204,7 @@ impl DepthPass {
         depth: &MapArray,
         passes: &[TilePass<'_>],
         base: &str,
-        reaches: &dyn Fn(usize, usize) -> bool,
+        casts_into: &dyn Fn(&TilePass<'_>, usize) -> bool,
     ) -> Result<(), TechniqueError> {
         if !self.written {
             return Err(TechniqueError::not_prepared());
@@ -227,11 +227,11 @@ impl DepthPass {
                 tile_pass.begin(recorder, base, &colors, depth_view, tile_pass.load_op(1.0));
             let camera = [&self.camera(tile_pass.layer) as &dyn SharedGroup];
             self.stage.set_on(ctx, &mut pass, &[], &camera)?;
-            let (opaque_only, light) = (self.opaque_only, tile_pass.maps.light);
+            let opaque_only = self.opaque_only;
             let casts = |i: usize, o: &zoo_host::scene::SceneObject| {
                 o.casts_shadows
                     && !(opaque_only && o.transmittance().is_some())
-                    && reaches(light, i)
+                    && casts_into(tile_pass, i)
             };
             let buffers = ctx.scene_buffers;
             buffers.draw_objects_masked(&mut pass, ctx.scene, false, casts);

@@ -3,7 +3,8 @@
 //! faces and what the camera sees ([`light_space`]), the per-light layer plan with screen
 //! scissors ([`planning`]), the shadow atlas that gives every layer a tile at its light's
 //! tier within the device's limits and a memory budget ([`atlas`], [`maps`]), the depth pass
-//! that fills it, optionally with a colour map such as moments ([`depth`]), and a separable
+//! that fills it with the casters whose boxes meet each layer's frustum ([`culling`]),
+//! optionally with a colour map such as moments ([`depth`]), and a separable
 //! blur of colour map layers ([`blur`]). [`ShadowMapSet`] keeps them up to date for a
 //! technique in one call per frame.
 //!

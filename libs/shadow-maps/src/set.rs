@@ -9,6 +9,7 @@ use zoo_host::{Changes, RenderContext, TechniqueResult, wgpu};
 
 use crate::atlas::Allocation;
 use crate::atlas_pages::{AtlasLimits, MapTile};
+use crate::culling::box_meets_sides;
 use crate::depth::{ColorOutput, DepthPass, DepthState};
 use crate::light_space::Aabb;
 use crate::lookup::LookupGroup;
@@ -455,8 +456,25 @@ impl ShadowMapSet {
             .ok_or_else(zoo_host::TechniqueError::not_prepared)?;
         let color = self.color.as_ref();
         let passes = self.tile_passes();
-        let reaches = |light, object| self.reaches(&ctx.lights[light], object);
-        (self.depth_pass).record(ctx, recorder, color, depth, &passes, base, &reaches)
+        let casts = |pass: &TilePass<'_>, object| {
+            self.casts_into(&ctx.lights[pass.maps.light], pass, object)
+        };
+        (self.depth_pass).record(ctx, recorder, color, depth, &passes, base, &casts)
+    }
+
+    /// Whether scene object `object` can cast into the tile of `pass`: it reaches the pass's
+    /// light ([`Self::reaches`]) and its box meets the sides of the layer's frustum, widened by
+    /// two texels (for rasterisation grown by up to that much). Warped layers (their clip
+    /// space is not the light's) test the light only.
+    pub fn casts_into(&self, light: &zoo_host::Light, pass: &TilePass<'_>, object: usize) -> bool {
+        if !self.reaches(light, object) {
+            return false;
+        }
+        let frustum = &pass.maps.frustums[pass.face];
+        let margin = 4.0 / pass.tile.size.max(1) as f32;
+        let warped = matches!(frustum.projection, crate::light_space::Projection::Warped);
+        let bounds = self.object_boxes.get(object).copied().flatten();
+        warped || bounds.is_none_or(|b| box_meets_sides(frustum.view_proj, margin, b))
     }
 
     /// Whether scene object `object` can cast into `light`'s maps: it meets the light's range

@@ -11,13 +11,14 @@
 //!   caster thinner than a texel may cross the ray, the pixel joins the edge band and the
 //!   exact pass decides.
 
-use zoo_host::gpu::PassRecorder;
+use zoo_host::gpu::{PassRecorder, gpu_bytes};
 use zoo_host::kit::{SharedGroup, Stage, StageBindGroup};
 use zoo_host::render::drawn_runs;
 use zoo_host::{RenderContext, TechniqueError, TechniqueResult, wgpu};
 use zoo_shadow_maps::{DepthState, MAP_FORMAT, MapArray, ShadowMapSet, TilePass};
 
 use crate::NO_TRIANGLE;
+use crate::closed::{ClosedCaster, closed_casters};
 
 /// What a kind of caster id map is drawn with.
 pub(crate) struct CasterIds<'a> {
@@ -30,6 +31,9 @@ pub(crate) struct CasterIds<'a> {
     pub(crate) state: DepthState,
     /// Whether the maps have depth maps of their own (coverage), or render into the set's.
     pub(crate) own_depth: bool,
+    /// Whether the shader culls the faces of closed casters turned from the light
+    /// ([`crate::closed`]): it binds their boxes and orientations.
+    pub(crate) closed_casters: bool,
 }
 
 /// The maps made for one set of depth maps and scene.
@@ -39,12 +43,15 @@ struct Bound {
     ids: MapArray,
     depth: Option<MapArray>,
     scene: StageBindGroup,
+    /// The scene objects' [`ClosedCaster`]s, where the shader reads them.
+    _closed: Option<wgpu::Buffer>,
 }
 
 /// A kind of caster id map: its stage and, once prepared, its maps.
 pub(crate) struct CasterIdMaps {
     label: String,
     own_depth: bool,
+    closed_casters: bool,
     stage: Stage,
     bound: Option<Bound>,
 }
@@ -81,6 +88,7 @@ impl CasterIdMaps {
         Ok(CasterIdMaps {
             label: ids.label.to_string(),
             own_depth: ids.own_depth,
+            closed_casters: ids.closed_casters,
             stage,
             bound: None,
         })
@@ -110,22 +118,37 @@ impl CasterIdMaps {
             layers,
             wgpu::TextureFormat::R32Uint,
         );
-        let scene = self.stage.bind(
-            ctx,
-            &format!("{label} scene triangles"),
-            &[
-                ("scene_vertices", vertices.as_entire_binding()),
-                (
-                    "scene_indices",
-                    ctx.scene_buffers.indices.as_entire_binding(),
-                ),
-            ],
-        )?;
+        let closed = (self.closed_casters).then(|| {
+            // At least one element: a scene without objects binds a buffer too.
+            let mut casters = closed_casters(ctx.scene);
+            casters.resize(casters.len().max(1), ClosedCaster::default());
+            let device = &ctx.gpu.device;
+            wgpu::util::DeviceExt::create_buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some(&format!("{label} closed casters")),
+                    contents: &gpu_bytes(&casters),
+                    usage: wgpu::BufferUsages::STORAGE,
+                },
+            )
+        });
+        let mut entries = vec![
+            ("scene_vertices", vertices.as_entire_binding()),
+            (
+                "scene_indices",
+                ctx.scene_buffers.indices.as_entire_binding(),
+            ),
+        ];
+        if let Some(closed) = &closed {
+            entries.push(("closed_casters", closed.as_entire_binding()));
+        }
+        let scene = (self.stage).bind(ctx, &format!("{label} scene triangles"), &entries)?;
         self.bound = Some(Bound {
             made_for: (depth.texture.clone(), vertices.clone()),
             ids,
             depth: own_depth,
             scene,
+            _closed: closed,
         });
         Ok(true)
     }
@@ -137,14 +160,13 @@ impl CasterIdMaps {
 
     /// Renders the tile of each of `passes` into the id maps and the depth maps (their own,
     /// or `set`'s), one pass each named by [`TilePass::name`] with `base`, drawing the casters
-    /// `reaches(light, object)` accepts.
+    /// that can reach the tile ([`ShadowMapSet::casts_into`]).
     pub(crate) fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         set: &ShadowMapSet,
         (passes, base): (&[TilePass<'_>], &str),
-        reaches: &dyn Fn(usize, usize) -> bool,
     ) -> TechniqueResult {
         let bound = self
             .bound
@@ -169,8 +191,10 @@ impl CasterIdMaps {
             let camera = [&set.layer_camera(tile_pass.layer) as &dyn SharedGroup];
             self.stage
                 .set_on(ctx, &mut pass, &[&bound.scene], &camera)?;
-            let light = tile_pass.maps.light;
-            let drawn = |i, o: &zoo_host::scene::SceneObject| o.casts_shadows && reaches(light, i);
+            let light = &ctx.lights[tile_pass.maps.light];
+            let drawn = |i, o: &zoo_host::scene::SceneObject| {
+                o.casts_shadows && set.casts_into(light, tile_pass, i)
+            };
             for (indices, objects) in drawn_runs(ctx.scene, drawn) {
                 pass.draw(indices, objects);
             }

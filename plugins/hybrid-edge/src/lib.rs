@@ -25,6 +25,7 @@
 //!   measure what the restriction saves.
 
 mod casters;
+mod closed;
 mod tiles;
 
 use zoo_host::gpu::PassRecorder;
@@ -185,9 +186,11 @@ impl Gpu {
             label: "hybrid coverage",
             shader: "hybrid-edge/coverage.wgsl",
             entries: ("vs_coverage", "fs_coverage"),
-            // Both faces, no bias: a caster's every triangle counts, whichever way it faces.
+            // Both faces, no bias: an open caster's every triangle counts, whichever way it
+            // faces; closed casters need only the faces turned to the light.
             state: DepthState::default(),
             own_depth: true,
+            closed_casters: true,
         };
         let ids = CasterIds {
             label: "hybrid triangle ids",
@@ -195,6 +198,7 @@ impl Gpu {
             entries: ("vs_ids", "fs_ids"),
             state,
             own_depth: false,
+            closed_casters: false,
         };
         let source = ctx.shaders.compose(SHADER)?.source;
         let restriction_codes = ChoiceCodes::read(&source, "RESTRICTION", Restriction::NAMES)
@@ -453,13 +457,12 @@ impl ShadowTechnique for Hybrid {
             gpu.maps.record(ctx, recorder, MAP_PASS)?;
         }
         let maps = &gpu.maps;
-        let reaches = |light, object| maps.reaches(&ctx.lights[light], object);
         let passes = maps.tile_passes();
         if exact {
-            (gpu.ids).record(ctx, recorder, maps, (&passes, IDS_PASS), &reaches)?;
+            (gpu.ids).record(ctx, recorder, maps, (&passes, IDS_PASS))?;
         }
         if p.coverage {
-            (gpu.coverage).record(ctx, recorder, maps, (&passes, COVERAGE_PASS), &reaches)?;
+            (gpu.coverage).record(ctx, recorder, maps, (&passes, COVERAGE_PASS))?;
         }
         let restriction = gpu.restriction_codes.code(p.restriction.index());
         let uniform = |l: &LightMaps, _| Some(edge_light(p, l, restriction));

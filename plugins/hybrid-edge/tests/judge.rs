@@ -7,7 +7,7 @@ use zoo_plugin_hybrid_edge as _;
 use zoo_host::glam::UVec2;
 use zoo_host::judging::{DEFAULT_SAMPLES, SceneReference};
 use zoo_host::params::{ParamValues, apply_assignments, defaults};
-use zoo_host::test_support::{JudgeRun, Metric, gpu, judge, scene_path};
+use zoo_host::test_support::{JudgeRun, Metric, gpu, judge, judge_scene, scene_path};
 use zoo_host::wgpu::Features;
 use zoo_host::{Renderer, Scene, View};
 
@@ -243,5 +243,80 @@ fn coverage_maps_widen_the_band_where_casters_are_thinner_than_a_texel() {
         );
         eprintln!("{scene}: light 0's band {band:.4} of pixels ({band_without:.4} without)");
         assert!(band > band_without, "{scene}: {band} <= {band_without}");
+    }
+}
+
+/// Closed casters thinner than a texel (posts 3 cm wide, spheres 5 cm across, under texels of
+/// about 16 cm: 256² maps over a 40 m floor and from a lamp 20 m up), the lamp inside the box
+/// of a closed torus around it, and a sun: the coverage maps draw only the faces of closed
+/// casters turned to a light outside their box, and still send every pixel whose ray crosses
+/// one to the exact pass.
+const CLOSED_THIN_CASTERS: &str = r#"(
+    name: "closed-thin-casters",
+    camera: (position: (0.4, 1.6, 2.6), target: (0, 0.1, 0), fov_y_degrees: 50),
+    lights: [
+        Point(position: (0.8, 20, 0.5), intensity: 600, range: 60),
+        Directional(direction: (-0.5, -1, -0.35), intensity: 1),
+    ],
+    objects: [
+        (mesh: Plane(size: 40), receiver: true),
+        (mesh: Torus(major_radius: 0.6, minor_radius: 0.08, segments: 24, rings: 8),
+         transform: (translation: (0.8, 20, 0.5))),
+        (
+            mesh: Box(size: (0.03, 0.4, 0.03)),
+            transform: (translation: (0, 0.5, 0)),
+            instances: [
+            (translation: (-1.10, 0.0, -1.00)), (translation: (-1.10, 0.1, -0.50)),
+            (translation: (-1.10, 0.2, 0.00)), (translation: (-1.10, 0.0, 0.50)),
+            (translation: (-1.10, 0.1, 1.00)), (translation: (-0.55, 0.2, -1.00)),
+            (translation: (-0.55, 0.0, -0.50)), (translation: (-0.55, 0.1, 0.00)),
+            (translation: (-0.55, 0.2, 0.50)), (translation: (-0.55, 0.0, 1.00)),
+            (translation: (0.00, 0.1, -1.00)), (translation: (0.00, 0.2, -0.50)),
+            (translation: (0.00, 0.0, 0.00)), (translation: (0.00, 0.1, 0.50)),
+            (translation: (0.00, 0.2, 1.00)), (translation: (0.55, 0.0, -1.00)),
+            (translation: (0.55, 0.1, -0.50)), (translation: (0.55, 0.2, 0.00)),
+            (translation: (0.55, 0.0, 0.50)), (translation: (0.55, 0.1, 1.00)),
+            (translation: (1.10, 0.2, -1.00)), (translation: (1.10, 0.0, -0.50)),
+            (translation: (1.10, 0.1, 0.00)), (translation: (1.10, 0.2, 0.50)),
+            (translation: (1.10, 0.0, 1.00)),
+            ],
+        ),
+        (
+            mesh: Sphere(radius: 0.025, segments: 8, rings: 4),
+            instances: [
+            (translation: (-0.83, 0.3, -0.75)), (translation: (-0.83, 0.4, -0.25)),
+            (translation: (-0.83, 0.5, 0.25)), (translation: (-0.83, 0.6, 0.75)),
+            (translation: (-0.28, 0.3, -0.75)), (translation: (-0.28, 0.4, -0.25)),
+            (translation: (-0.28, 0.5, 0.25)), (translation: (-0.28, 0.6, 0.75)),
+            (translation: (0.27, 0.3, -0.75)), (translation: (0.27, 0.4, -0.25)),
+            (translation: (0.27, 0.5, 0.25)), (translation: (0.27, 0.6, 0.75)),
+            (translation: (0.82, 0.3, -0.75)), (translation: (0.82, 0.4, -0.25)),
+            (translation: (0.82, 0.5, 0.25)), (translation: (0.82, 0.6, 0.75)),
+            ],
+        ),
+    ],
+)"#;
+
+#[test]
+fn closed_casters_thinner_than_a_texel_are_caught_by_their_faces_towards_the_light() {
+    let scene = zoo_host::test_support::scene_from_ron("closed-thin-casters", CLOSED_THIN_CASTERS);
+    let small_maps = [("map_size", "256"), ("restriction", "DepthBand")];
+    let with = judge_scene(scene.clone(), "hybrid-edge", &small_maps, SIZE);
+    let without = [small_maps[0], ("coverage", "false")];
+    let without = judge_scene(scene, "hybrid-edge", &without, SIZE);
+    for light in 0..with.loaded.lights.len() {
+        let (m, missed) = (with.metrics(light), without.metrics(light).false_lit_core);
+        eprintln!("light {light}: {m:?}; without coverage, false lit core {missed:.5}");
+        // The scene is of the class: the map's samples alone miss some of the shadows...
+        assert!(
+            missed > 0.0002,
+            "light {light}: without coverage, false lit {missed}"
+        );
+        // ...which the coverage maps send to the exact pass, every one.
+        let core = m.false_lit_core + m.false_shadow_core;
+        assert!(
+            core < 0.00002,
+            "light {light}: core error {core} with coverage"
+        );
     }
 }
