@@ -90,8 +90,11 @@ impl ShadowTechnique for Levels {
                 ("offsets", buffer.as_entire_binding()),
                 ("levels", buffer.as_entire_binding()),
             ];
-            let group = stage.bind(ctx, "test", &shared_list)?;
-            self.passes.push((stage, group));
+            // Lists of groups the stage has not (`camera` is the host's) are skipped.
+            let host = [("camera", buffer.as_entire_binding())];
+            let mut groups = stage.bind_own(ctx, "test", &[&host, &shared_list])?;
+            errors.push(format!("own groups: {}", groups.len()));
+            self.passes.push((stage, groups.remove(0)));
         }
         let mixed = Stage::compute("test/mixed.wgsl", "cs_mixed")
             .text(MIXED)
@@ -138,7 +141,11 @@ fn stages_bind_by_name_and_say_which_names_and_groups_are_wrong() {
         assert_eq!(off.count(), 0, "light {light} should read {level}");
     }
     let errors = ERRORS.lock().unwrap().clone();
-    assert_eq!(errors.len(), LEVELS.len() + 1, "{errors:?}");
+    assert_eq!(errors.len(), 2 * LEVELS.len() + 1, "{errors:?}");
+    assert!(
+        (errors.iter()).filter(|e| *e == "own groups: 1").count() == LEVELS.len(),
+        "{errors:?}"
+    );
     assert!(
         errors[0].contains("test/levels.wgsl fullscreen_vs/fs_level")
             && errors[0].contains("`levls` is not a variable of the stage's own groups")

@@ -445,6 +445,28 @@ impl Stage {
         Ok(StageBindGroup { index, group })
     }
 
+    /// A bind group of each of the stage's own groups, from the first of `lists` whose first
+    /// variable the group declares ([`Self::bind`]); lists of groups the stage does not use
+    /// are skipped, so one set of lists serves every stage of a shader whose entries use
+    /// different groups.
+    pub fn bind_own(
+        &self,
+        ctx: &RenderContext<'_>,
+        label: &str,
+        lists: &[&[(&str, wgpu::BindingResource<'_>)]],
+    ) -> Result<Vec<StageBindGroup>, TechniqueError> {
+        let declares = |name: &str| {
+            (self.groups.iter()).any(|group| match group {
+                StageGroup::Own { declared, .. } => declared.iter().any(|d| d == name),
+                _ => false,
+            })
+        };
+        (lists.iter())
+            .filter(|list| list.first().is_some_and(|(name, _)| declares(name)))
+            .map(|list| self.bind(ctx, label, list))
+            .collect()
+    }
+
     fn own_names(&self) -> String {
         let own: Vec<String> = (self.groups.iter())
             .filter_map(|g| match g {

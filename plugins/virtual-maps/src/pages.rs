@@ -1,0 +1,447 @@
+//! The page table, the physical pool and the passes that keep them: the GPU side of virtual
+//! shadow maps (`shaders/virtual-maps/`). Nothing is read back but the counters, a frame or
+//! two late: which pages are needed, allocated, evicted and drawn is decided on the GPU.
+
+use std::sync::Mutex;
+
+use zoo_host::gpu::GpuType;
+use zoo_host::gpu::readback::ReadbackRing;
+use zoo_host::gpu::{PassRecorder, gpu_bytes};
+use zoo_host::kit::{self, Stage, StageBindGroup, UniformSlots};
+use zoo_host::render::drawn_runs;
+use zoo_host::wgpu::util::DeviceExt;
+use zoo_host::{RenderContext, TechniqueResult, wgpu};
+
+use crate::layers::Layout;
+use crate::{CasterRun, VirtualFrame, VirtualLayer, VirtualLight};
+
+/// The bookkeeping and drawing shaders.
+pub const BOOKKEEPING: &str = "virtual-maps/bookkeeping.wgsl";
+pub const DRAW: &str = "virtual-maps/draw.wgsl";
+/// Texels around each page that filters may read (`gutter` in the shaders' frame).
+pub const GUTTER: u32 = 2;
+/// Candidate lists of the allocation (`CANDIDATE_LISTS` in the shaders).
+pub const CANDIDATE_LISTS: u64 = 5;
+/// Counters of the bookkeeping (`COUNTS` and `COUNT_*` in `bookkeeping.wgsl`).
+pub const COUNTS: u64 = 16;
+pub const COUNT_DRAWN: usize = 6;
+pub const COUNT_NEEDED: usize = 7;
+pub const COUNT_HITS: usize = 8;
+pub const COUNT_EVICTED: usize = 9;
+pub const COUNT_NO_ROOM: usize = 10;
+pub const COUNT_FALLBACK_PIXELS: usize = 11;
+pub const COUNT_RESIDENT_BEFORE: usize = 12;
+/// The depth format of the pool.
+pub const POOL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// The bookkeeping's compute entries, in the order they run (`count_fallback` after the
+/// draws).
+const BOOKKEEPING_ENTRIES: [&str; 8] = [
+    "cs_invalidate",
+    "cs_mark",
+    "cs_age",
+    "cs_gather",
+    "cs_allocate_fallback",
+    "cs_allocate_finer",
+    "cs_draw_args",
+    "cs_count_fallback",
+];
+
+/// The compute and render stages, built once.
+pub struct Stages {
+    /// One per [`BOOKKEEPING_ENTRIES`].
+    bookkeeping: Vec<Stage>,
+    clear: Stage,
+    caster: Stage,
+    runs: UniformSlots<CasterRun>,
+}
+
+impl Stages {
+    pub fn new(ctx: &RenderContext<'_>, slope_bias: f32) -> TechniqueResult<Stages> {
+        let compute = |entry| Stage::compute(BOOKKEEPING, entry).build(ctx);
+        let runs = UniformSlots::new(
+            ctx.gpu,
+            "virtual-maps caster runs",
+            1,
+            wgpu::ShaderStages::VERTEX,
+        );
+        let depth = |compare, bias: f32| wgpu::DepthStencilState {
+            format: POOL_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: wgpu::DepthBiasState {
+                constant: 0,
+                slope_scale: bias,
+                clamp: 0.0,
+            },
+        };
+        Ok(Stages {
+            bookkeeping: BOOKKEEPING_ENTRIES
+                .map(compute)
+                .into_iter()
+                .collect::<Result<_, _>>()?,
+            clear: Stage::render(DRAW, "vs_clear")
+                .depth_stencil(depth(wgpu::CompareFunction::Always, 0.0))
+                .build(ctx)?,
+            caster: Stage::render(DRAW, "vs_caster")
+                .shared(&[&runs.at(0)])
+                .depth_stencil(depth(wgpu::CompareFunction::LessEqual, slope_bias))
+                .build(ctx)?,
+            runs,
+        })
+    }
+}
+
+/// The buffers and pool of one layout, and every stage's bind groups over them.
+pub struct Pages {
+    pub layout: Layout,
+    pub pool_side: u32,
+    pub pool: wgpu::Texture,
+    pub pool_view: wgpu::TextureView,
+    pub page_table: wgpu::Buffer,
+    needed: wgpu::Buffer,
+    counts: wgpu::Buffer,
+    frame: wgpu::Buffer,
+    layers: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    draw_args: wgpu::Buffer,
+    /// Caster runs: (index range, object range) of the scene's casters.
+    runs: Vec<(std::ops::Range<u32>, std::ops::Range<u32>)>,
+    /// Each bookkeeping stage's groups, the clear's and the casters' draws', and the lookup's
+    /// tables.
+    bookkeeping: Vec<Vec<StageBindGroup>>,
+    draw: [Vec<StageBindGroup>; 2],
+    pub lookup_tables: Vec<StageBindGroup>,
+    stats: Mutex<ReadbackRing>,
+    /// The layers' matrices of the last frame, to find the layers that moved.
+    pub last_layers: Vec<zoo_host::glam::Mat4>,
+}
+
+/// A storage buffer of `bytes` (at least 16), initialised to `contents` where given.
+fn storage(
+    ctx: &RenderContext<'_>,
+    label: &str,
+    bytes: u64,
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+        mapped_at_creation: false,
+    })
+}
+
+fn init(
+    ctx: &RenderContext<'_>,
+    label: &str,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let mut bytes = contents.to_vec();
+    bytes.resize(bytes.len().max(16), 0);
+    ctx.gpu
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: &bytes,
+            usage,
+        })
+}
+
+impl Pages {
+    /// Buffers, pool and bind groups for `layout` with a pool of about `pool_pages` pages.
+    pub fn new(
+        ctx: &RenderContext<'_>,
+        stages: &Stages,
+        lookup: &Stage,
+        layout: Layout,
+        pool_pages: u32,
+    ) -> TechniqueResult<Pages> {
+        let slot = layout.sizes.page_size + 2 * GUTTER;
+        let largest = ctx.gpu.device.limits().max_texture_dimension_2d / slot;
+        let pool_side = (f64::from(pool_pages).sqrt().ceil() as u32).clamp(1, largest.max(1));
+        let texels = pool_side * slot;
+        let pool = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("virtual-maps physical pool"),
+            size: wgpu::Extent3d {
+                width: texels,
+                height: texels,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: POOL_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let pool_view = pool.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("virtual-maps physical pool"),
+            ..Default::default()
+        });
+        let entries = u64::from(layout.entries());
+        let pages = u64::from(pool_side * pool_side);
+        let none = wgpu::BufferUsages::empty();
+        let storage_init = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let page_table = init(
+            ctx,
+            "virtual-maps page table",
+            &vec![0xff; (4 * entries) as usize],
+            storage_init,
+        );
+        let needed = storage(ctx, "virtual-maps needed pages", 4 * entries, none);
+        let pool_pages_buffer = init(
+            ctx,
+            "virtual-maps physical pages",
+            &vec![0xff; (8 * pages) as usize],
+            storage_init,
+        );
+        let lists = storage(
+            ctx,
+            "virtual-maps page lists",
+            4 * pages * (CANDIDATE_LISTS + 1),
+            none,
+        );
+        let counts = storage(
+            ctx,
+            "virtual-maps counts",
+            4 * COUNTS,
+            wgpu::BufferUsages::COPY_SRC,
+        );
+        let entry_layers = init(
+            ctx,
+            "virtual-maps entry layers",
+            zoo_host::bytemuck::cast_slice(&layout.entry_layers),
+            storage_init,
+        );
+        let frame = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("virtual-maps frame"),
+            size: VirtualFrame::SIZE as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let layers = storage(
+            ctx,
+            "virtual-maps layers",
+            (VirtualLayer::SIZE * layout.layers.len()) as u64,
+            none,
+        );
+        let virtual_lights = storage(
+            ctx,
+            "virtual-maps lights",
+            (VirtualLight::SIZE * layout.lights.len()) as u64,
+            none,
+        );
+        let runs = drawn_runs(ctx.scene, |_, o| o.casts_shadows);
+        let run_words: Vec<u32> = (runs.iter())
+            .flat_map(|(indices, objects)| {
+                [indices.len() as u32, indices.start, objects.len() as u32, 0]
+            })
+            .collect();
+        let caster_runs = init(
+            ctx,
+            "virtual-maps caster runs",
+            zoo_host::bytemuck::cast_slice(&run_words),
+            storage_init,
+        );
+        let draw_args = storage(
+            ctx,
+            "virtual-maps draw arguments",
+            16 * (runs.len() as u64 + 1),
+            wgpu::BufferUsages::INDIRECT,
+        );
+        let tables = [
+            ("virtual_frame", frame.as_entire_binding()),
+            ("virtual_layers", layers.as_entire_binding()),
+            ("virtual_lights", virtual_lights.as_entire_binding()),
+        ];
+        let own = [
+            ("page_table", page_table.as_entire_binding()),
+            ("needed", needed.as_entire_binding()),
+            ("pool_pages", pool_pages_buffer.as_entire_binding()),
+            ("lists", lists.as_entire_binding()),
+            ("counts", counts.as_entire_binding()),
+            ("entry_layers", entry_layers.as_entire_binding()),
+            ("draw_args", draw_args.as_entire_binding()),
+            ("caster_runs", caster_runs.as_entire_binding()),
+        ];
+        let draw_own = [
+            ("page_table", page_table.as_entire_binding()),
+            ("entry_layers", entry_layers.as_entire_binding()),
+            ("lists", lists.as_entire_binding()),
+            (
+                "scene_vertices",
+                ctx.scene_buffers.vertices.as_entire_binding(),
+            ),
+            (
+                "scene_indices",
+                ctx.scene_buffers.indices.as_entire_binding(),
+            ),
+        ];
+        let compare = ctx.gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("virtual-maps pool comparison"),
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let stats = ReadbackRing::new(&ctx.gpu.device, "virtual-maps counters", 4 * COUNTS, 3);
+        let bookkeeping = (stages.bookkeeping.iter())
+            .map(|stage| stage.bind_own(ctx, "virtual-maps bookkeeping", &[&tables, &own]))
+            .collect::<Result<_, _>>()?;
+        let draw_lists: [&[(&str, wgpu::BindingResource<'_>)]; 2] = [&tables, &draw_own];
+        Ok(Pages {
+            bookkeeping,
+            draw: [
+                stages
+                    .clear
+                    .bind_own(ctx, "virtual-maps clear", &draw_lists)?,
+                stages
+                    .caster
+                    .bind_own(ctx, "virtual-maps draw", &draw_lists)?,
+            ],
+            lookup_tables: lookup.bind_own(
+                ctx,
+                "virtual-maps lookup",
+                &[
+                    &tables,
+                    &[
+                        ("page_table", page_table.as_entire_binding()),
+                        ("pool", wgpu::BindingResource::TextureView(&pool_view)),
+                        ("pool_compare", wgpu::BindingResource::Sampler(&compare)),
+                    ],
+                ],
+            )?,
+            layout,
+            pool_side,
+            pool,
+            pool_view,
+            page_table,
+            needed,
+            counts,
+            frame,
+            layers,
+            lights: virtual_lights,
+            draw_args,
+            runs,
+            stats: Mutex::new(stats),
+            last_layers: Vec::new(),
+        })
+    }
+
+    /// Writes this frame's settings, layers and lights.
+    pub fn write(
+        &self,
+        ctx: &RenderContext<'_>,
+        frame: &VirtualFrame,
+        layers: &[VirtualLayer],
+        lights: &[VirtualLight],
+    ) {
+        let queue = &ctx.gpu.queue;
+        queue.write_buffer(&self.frame, 0, &gpu_bytes(std::slice::from_ref(frame)));
+        queue.write_buffer(&self.layers, 0, &gpu_bytes(layers));
+        queue.write_buffer(&self.lights, 0, &gpu_bytes(lights));
+    }
+
+    /// Records the frame's bookkeeping, the page draws and the fallback count.
+    pub fn record(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        stages: &mut Stages,
+    ) -> TechniqueResult {
+        let runs: Vec<CasterRun> = (self.runs.iter())
+            .map(|(_, objects)| CasterRun {
+                first_object: objects.start,
+                objects: objects.len() as u32,
+            })
+            .collect();
+        stages.runs.write(ctx.gpu, &runs);
+        let stages = &*stages;
+        let encoder = recorder.encoder();
+        encoder.clear_buffer(&self.needed, 0, None);
+        encoder.clear_buffer(&self.counts, 0, None);
+        let entries = [self.layout.entries(), 1, 1];
+        let pool = [self.pool_side * self.pool_side, 1, 1];
+        let pixels = [ctx.size.x, ctx.size.y, 1];
+        // Each entry's extent, in `BOOKKEEPING_ENTRIES` order.
+        let extents = [
+            entries,
+            pixels,
+            entries,
+            pool,
+            entries,
+            entries,
+            [1, 1, 1],
+            pixels,
+        ];
+        let dispatch = |pass: &mut wgpu::ComputePass<'_>, k: usize| {
+            let own: Vec<&StageBindGroup> = self.bookkeeping[k].iter().collect();
+            let groups = (&own[..], &[] as &[&dyn kit::SharedGroup]);
+            stages.bookkeeping[k].dispatch_in(ctx, pass, groups, extents[k])
+        };
+        {
+            let mut pass = recorder.compute_pass("Virtual pages: bookkeeping");
+            for k in 0..BOOKKEEPING_ENTRIES.len() - 1 {
+                dispatch(&mut pass, k)?;
+            }
+        }
+        self.draw(ctx, recorder, stages)?;
+        let mut pass = recorder.compute_pass("Virtual pages: fallback count");
+        dispatch(&mut pass, BOOKKEEPING_ENTRIES.len() - 1)?;
+        drop(pass);
+        let ring = self.stats.lock().ok();
+        if let Some(target) = ring.and_then(|mut ring| ring.target().cloned()) {
+            recorder
+                .encoder()
+                .copy_buffer_to_buffer(&self.counts, 0, &target, 0, 4 * COUNTS);
+        }
+        Ok(())
+    }
+
+    /// Clears the pages allocated this frame and draws every caster run into them.
+    fn draw(
+        &self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        stages: &Stages,
+    ) -> TechniqueResult {
+        let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("Virtual pages: draw"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.pool_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let clear: Vec<&StageBindGroup> = self.draw[0].iter().collect();
+        stages.clear.set_on(ctx, &mut pass, &clear, &[])?;
+        pass.draw_indirect(&self.draw_args, 0);
+        let casters: Vec<&StageBindGroup> = self.draw[1].iter().collect();
+        for run in 0..self.runs.len() {
+            let slot = stages.runs.at(run);
+            stages.caster.set_on(ctx, &mut pass, &casters, &[&slot])?;
+            pass.draw_indirect(&self.draw_args, 16 * (run as u64 + 1));
+        }
+        Ok(())
+    }
+
+    /// The newest counters that have arrived (none until one has; never waits).
+    pub fn counts(&self, device: &wgpu::Device) -> Option<Vec<u32>> {
+        let mut ring = self.stats.lock().ok()?;
+        let (_, bytes) = ring.latest(device)?;
+        Some(
+            bytes
+                .chunks_exact(4)
+                .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+                .collect(),
+        )
+    }
+}
