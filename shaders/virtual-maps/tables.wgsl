@@ -93,11 +93,11 @@ fn towards_light(light: u32, p: vec3<f32>) -> vec3<f32> {
 
 // How far towards the light a receiver's lookup moves, in texels of the level it reads: half a
 // texel, and the depth its surface spans across one texel (tan of the light's incidence,
-// at most 8), times the normal offset. Moving along the light's ray leaves the point's place in
+// at most 32), times the normal offset. Moving along the light's ray leaves the point's place in
 // the map where it was, so the shadow does not shift, only its depth is biased.
 fn offset_texels(light: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let c = clamp(dot(n, towards_light(light, p)), 0.05, 1.0);
-    let slope = min(sqrt(1.0 - c * c) / c, 8.0);
+    let c = clamp(dot(n, towards_light(light, p)), 0.02, 1.0);
+    let slope = min(sqrt(1.0 - c * c) / c, 32.0);
     return virtual_frame.normal_offset * (0.5 + slope);
 }
 
