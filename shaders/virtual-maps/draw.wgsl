@@ -2,13 +2,16 @@
 // from indirect arguments (`cs_draw_args`): `vs_clear` clears each page's slot (its gutter
 // included) to the far plane, `vs_caster` draws every caster run into every drawn page, an
 // instance per (page, object): the layer's projection carried onto the page's slot of the pool,
-// clipped by clip distances to the page and its gutter (the texels filters read beside it).
+// clipped by clip distances to the page and its gutter (the texels filters read beside it);
+// `vs_caster_masked` and `fs_caster_masked` draw alpha-tested casters, whose holes write no
+// depth (`covered`, the judge's rule).
 
 enable clip_distances;
 
 #import "virtual-maps/tables.wgsl"
 #import "virtual-maps/caster_run.wgsl"
 #import "common/vertices.wgsl"
+#import "common/materials.wgsl"
 
 @group(2) @binding(0) var<uniform> caster_run: CasterRun;
 @group(4) @binding(0) var<storage, read> page_table: array<u32>;
@@ -45,8 +48,8 @@ fn scene_position(index: u32) -> vec3<f32> {
     return vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
 }
 
-@vertex
-fn vs_caster(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> PageVertex {
+// The scene vertex `vertex` of a caster run's instance `instance`, on its page's slot.
+fn page_vertex(vertex: u32, instance: u32) -> PageVertex {
     let entry = drawn_entry(instance / caster_run.objects);
     let object = caster_run.first_object + instance % caster_run.objects;
     let layer = virtual_layers[entry_layers[entry]];
@@ -70,4 +73,41 @@ fn vs_caster(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instan
     let g = gutter / size * clip.w;
     out.distances = array<f32, 4>(u + g, clip.w + g - u, v + g, clip.w + g - v);
     return out;
+}
+
+@vertex
+fn vs_caster(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> PageVertex {
+    return page_vertex(vertex, instance);
+}
+
+struct MaskedVertex {
+    @builtin(position) clip: vec4<f32>,
+    @builtin(clip_distances) distances: array<f32, 4>,
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) object: u32,
+}
+
+@vertex
+fn vs_caster_masked(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> MaskedVertex {
+    let placed = page_vertex(vertex, instance);
+    let base = scene_indices[vertex] * VERTEX_FLOATS;
+    var out: MaskedVertex;
+    out.clip = placed.clip;
+    out.distances = placed.distances;
+    out.uv = vec2<f32>(scene_vertices[base + 6u], scene_vertices[base + 7u]);
+    out.object = caster_run.first_object + instance % caster_run.objects;
+    return out;
+}
+
+// What the masked fragment reads of `MaskedVertex`.
+struct MaskedFragment {
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) object: u32,
+}
+
+@fragment
+fn fs_caster_masked(in: MaskedFragment) {
+    if !covered(in.object, in.uv) {
+        discard;
+    }
 }

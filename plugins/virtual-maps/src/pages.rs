@@ -52,7 +52,8 @@ pub struct Stages {
     /// One per [`BOOKKEEPING_ENTRIES`].
     bookkeeping: Vec<Stage>,
     clear: Stage,
-    caster: Stage,
+    /// Opaque casters, and alpha-tested ones.
+    casters: [Stage; 2],
     runs: UniformSlots<CasterRun>,
 }
 
@@ -84,10 +85,17 @@ impl Stages {
             clear: Stage::render(DRAW, "vs_clear")
                 .depth_stencil(depth(wgpu::CompareFunction::Always, 0.0))
                 .build(ctx)?,
-            caster: Stage::render(DRAW, "vs_caster")
-                .shared(&[&runs.at(0)])
-                .depth_stencil(depth(wgpu::CompareFunction::LessEqual, slope_bias))
-                .build(ctx)?,
+            casters: [
+                Stage::render(DRAW, "vs_caster")
+                    .shared(&[&runs.at(0)])
+                    .depth_stencil(depth(wgpu::CompareFunction::LessEqual, slope_bias))
+                    .build(ctx)?,
+                Stage::render(DRAW, "vs_caster_masked")
+                    .fragment("fs_caster_masked")
+                    .shared(&[&runs.at(0)])
+                    .depth_stencil(depth(wgpu::CompareFunction::LessEqual, slope_bias))
+                    .build(ctx)?,
+            ],
             runs,
         })
     }
@@ -106,12 +114,12 @@ pub struct Pages {
     layers: wgpu::Buffer,
     lights: wgpu::Buffer,
     draw_args: wgpu::Buffer,
-    /// Caster runs: (index range, object range) of the scene's casters.
-    runs: Vec<(std::ops::Range<u32>, std::ops::Range<u32>)>,
+    /// Caster runs: (index range, object range, alpha-tested) of the scene's casters.
+    runs: Vec<(std::ops::Range<u32>, std::ops::Range<u32>, bool)>,
     /// Each bookkeeping stage's groups, the clear's and the casters' draws', and the lookup's
     /// tables.
     bookkeeping: Vec<Vec<StageBindGroup>>,
-    draw: [Vec<StageBindGroup>; 2],
+    draw: [Vec<StageBindGroup>; 3],
     pub lookup_tables: Vec<StageBindGroup>,
     stats: Mutex<ReadbackRing>,
     /// The layers' matrices of the last frame, to find the layers that moved.
@@ -234,9 +242,18 @@ impl Pages {
             (VirtualLight::SIZE * layout.lights.len()) as u64,
             none,
         );
-        let runs = drawn_runs(ctx.scene, |_, o| o.casts_shadows);
+        let runs: Vec<_> = [false, true]
+            .into_iter()
+            .flat_map(|masked| {
+                let kind = |_: usize, o: &zoo_host::scene::SceneObject| {
+                    o.casts_shadows && o.alpha_mask.is_some() == masked
+                };
+                let runs = drawn_runs(ctx.scene, kind).into_iter();
+                runs.map(move |(indices, objects)| (indices, objects, masked))
+            })
+            .collect();
         let run_words: Vec<u32> = (runs.iter())
-            .flat_map(|(indices, objects)| {
+            .flat_map(|(indices, objects, _)| {
                 [indices.len() as u32, indices.start, objects.len() as u32, 0]
             })
             .collect();
@@ -296,9 +313,8 @@ impl Pages {
                 stages
                     .clear
                     .bind_own(ctx, "virtual-maps clear", &draw_lists)?,
-                stages
-                    .caster
-                    .bind_own(ctx, "virtual-maps draw", &draw_lists)?,
+                stages.casters[0].bind_own(ctx, "virtual-maps draw", &draw_lists)?,
+                stages.casters[1].bind_own(ctx, "virtual-maps masked draw", &draw_lists)?,
             ],
             lookup_tables: lookup.bind_own(
                 ctx,
@@ -351,7 +367,7 @@ impl Pages {
         stages: &mut Stages,
     ) -> TechniqueResult {
         let runs: Vec<CasterRun> = (self.runs.iter())
-            .map(|(_, objects)| CasterRun {
+            .map(|(_, objects, _)| CasterRun {
                 first_object: objects.start,
                 objects: objects.len() as u32,
             })
@@ -424,10 +440,11 @@ impl Pages {
         let clear: Vec<&StageBindGroup> = self.draw[0].iter().collect();
         stages.clear.set_on(ctx, &mut pass, &clear, &[])?;
         pass.draw_indirect(&self.draw_args, 0);
-        let casters: Vec<&StageBindGroup> = self.draw[1].iter().collect();
-        for run in 0..self.runs.len() {
+        for (run, (_, _, masked)) in self.runs.iter().enumerate() {
+            let kind = usize::from(*masked);
+            let own: Vec<&StageBindGroup> = self.draw[1 + kind].iter().collect();
             let slot = stages.runs.at(run);
-            stages.caster.set_on(ctx, &mut pass, &casters, &[&slot])?;
+            stages.casters[kind].set_on(ctx, &mut pass, &own, &[&slot])?;
             pass.draw_indirect(&self.draw_args, 16 * (run as u64 + 1));
         }
         Ok(())

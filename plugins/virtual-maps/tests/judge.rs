@@ -44,7 +44,12 @@ fn kilometre_scale_scenes_keep_the_hard_bounds() {
 /// 256 local lights (spot and point) in one pool.
 #[test]
 fn many_local_lights_keep_the_hard_bounds() {
-    assert_hard_bounds(&judge("lights-256.ron", "virtual-maps", &HARD, UVec2::new(256, 256)));
+    assert_hard_bounds(&judge(
+        "lights-256.ron",
+        "virtual-maps",
+        &HARD,
+        UVec2::new(256, 256),
+    ));
 }
 
 /// Wires thinner than a pixel at 256²: their shadows fall a pixel either way of the
