@@ -83,8 +83,32 @@ fn cs_mark(@builtin(global_invocation_id) id: vec3<u32>) {
             continue;
         }
         let level = wanted_level(light, s.position, footprint);
-        mark(find_page(light, s.position, s.normal, level));
+        let found = find_page(light, s.position, s.normal, level);
+        mark(found);
         mark(find_page(light, s.position, s.normal, virtual_lights[light].fallback_level));
+        if found.found {
+            mark_reach(light, found.level, s.position, s.normal);
+        }
+    }
+}
+
+// Marks the pages under the corners of the square the filter's taps reach around the pixel's
+// lookup point (at most the reach in texels, under a page: corners suffice).
+fn mark_reach(light: u32, level: u32, p: vec3<f32>, n: vec3<f32>) {
+    let texel = texel_size(light, level, p);
+    let towards = towards_light(light, p);
+    let q = p + towards * (offset_texels(light, p, n) * texel);
+    let frame = tangent_frame(-towards);
+    let reach = virtual_frame.reach_texels * texel;
+    let v = virtual_lights[light];
+    for (var corner = 0u; corner < 4u; corner++) {
+        let sign = vec2<f32>(f32(corner & 1u), f32(corner >> 1u)) * 2.0 - 1.0;
+        let c = q + (frame[0] * sign.x + frame[1] * sign.y) * reach;
+        var face = 0u;
+        if v.faces == 6u {
+            face = cube_face(c - lights[light].position);
+        }
+        mark(page_point(layer_of(light, face, level), c));
     }
 }
 

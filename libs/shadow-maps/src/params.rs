@@ -33,3 +33,50 @@ zoo_host::technique_params! {
         pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
     }
 }
+
+impl FilterParams {
+    /// How far from the receiver, in texels, the filter's taps read (the largest grid offset,
+    /// disc radius or PCSS search, and one more texel for bilinear taps): the reach of the map
+    /// around a receiver that must be present (virtual maps mark the pages within it).
+    pub fn reach_texels(&self) -> f32 {
+        let grid = |n: u32| 0.5 * (n - 1) as f32 + 1.0;
+        match self.filter {
+            Filter::None | Filter::Hardware2x2 => 1.0,
+            Filter::Pcf3x3 => grid(3),
+            Filter::Pcf4x4 => grid(4),
+            Filter::Pcf5x5 => grid(5),
+            Filter::Pcf7x7 => grid(7),
+            Filter::Pcf8x8 => grid(8),
+            Filter::Pcf9x9 => grid(9),
+            Filter::Pcf11x11 => grid(11),
+            Filter::Pcf16x16 => grid(16),
+            Filter::Pcf23x23 => grid(23),
+            Filter::Poisson | Filter::Stochastic => self.kernel_radius + 1.0,
+            Filter::Pcss => self.pcss_max_texels + 1.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use zoo_host::params::TechniqueParams;
+
+    #[test]
+    fn the_reach_covers_every_tap() {
+        let mut p = FilterParams::from_values(&zoo_host::params::defaults(&FilterParams::schema()))
+            .unwrap();
+        assert_eq!(p.reach_texels(), 2.0);
+        p.filter = Filter::Pcf4x4;
+        // Taps at -1.5 .. 1.5 texels, bilinear: 2.5.
+        assert_eq!(p.reach_texels(), 2.5);
+        p.filter = Filter::Pcf23x23;
+        assert_eq!(p.reach_texels(), 12.0);
+        p.filter = Filter::Pcss;
+        p.pcss_max_texels = 24.0;
+        assert_eq!(p.reach_texels(), 25.0);
+        p.filter = Filter::Poisson;
+        p.kernel_radius = 3.0;
+        assert_eq!(p.reach_texels(), 4.0);
+    }
+}

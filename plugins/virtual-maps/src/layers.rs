@@ -102,7 +102,7 @@ impl Layout {
 
 /// Depth range along a directional light's direction holding every caster: the scene's box
 /// seen along it, widened a little.
-fn depth_range(direction: Vec3, bounds: (Vec3, Vec3)) -> (f32, f32) {
+pub fn depth_range(direction: Vec3, bounds: (Vec3, Vec3)) -> (f32, f32) {
     let (lo, hi) = bounds;
     let corners = (0..8).map(|i| {
         Vec3::new(
@@ -138,6 +138,7 @@ pub fn clip_level(
     let (x, y) = (snap(centre.x), snap(centre.y));
     let (near, far) = depth_range(direction, bounds);
     let h = extent * 0.5;
+    debug_assert!(near < far);
     directx::orthographic(x - h, x + h, y - h, y + h, near, far) * rotation
 }
 

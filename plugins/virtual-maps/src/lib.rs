@@ -21,12 +21,15 @@ use zoo_host::kit::FullscreenLightPass;
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 
-use layers::{Layout, Sizes, fallback_level, light_layers};
+use layers::{Layout, Sizes, depth_range, fallback_level, light_layers};
 use pages::{GUTTER, Pages, Stages};
+use zoo_shadow_maps::light_space::perspective_near;
+use zoo_shadow_maps::{FilterParams, MapFilter, MapFilters, light_size};
 
 zoo_host::technique_params! {
     /// Parameters of virtual shadow maps.
     pub struct VirtualParams {
+        use filtering: FilterParams;
         /// Texels a page side (rounded down to a power of two).
         page_size: u32 = 128, range(32, 512), step(32), flags(rebuild);
         /// Pages a side of a clipmap level, and of a spot or point light's finest mip level
@@ -39,8 +42,6 @@ zoo_host::technique_params! {
         /// Physical pages in the pool (rounded up to a square, within the device's texture
         /// size).
         pool_pages: u32 = 1024, range(16, 16384), step(16), flags(rebuild);
-        /// PCF radius r in texels: (2r + 1)² comparisons (0: one, hard).
-        pcf_radius: u32 = 1, range(0, 2), step(1);
         /// Multiplies the pixel footprint a level's texels must match (below 1: finer pages,
         /// more of them; 0.5 keeps shadows a pixel wide, of wires, on the right pixels).
         level_bias: f32 = 0.5, range(0.125, 16.0), step(0.125);
@@ -70,7 +71,9 @@ zoo_host::gpu_struct! {
         pub(crate) level_bias: f32,
         pub(crate) normal_offset: f32,
         pub(crate) light_count: u32,
-        pub(crate) pcf_radius: u32,
+        /// How far the filter's taps reach around a receiver, in texels: the pages within it
+        /// are marked.
+        pub(crate) reach_texels: f32,
     }
 }
 
@@ -106,6 +109,9 @@ zoo_host::gpu_struct! {
         /// The level every pixel reads when the pool has no room for its own (a mip chain's
         /// last, the clipmap level whose pages are as wide as the scene): allocated first.
         pub(crate) fallback_level: u32,
+        /// The layers' depth range along their axis (for PCSS's blocker distances).
+        pub(crate) near: f32,
+        pub(crate) far: f32,
     }
 }
 
@@ -121,9 +127,10 @@ zoo_host::gpu_struct! {
 
 zoo_host::gpu_struct! {
     "virtual-maps/virtual_lookup.wgsl" =>
-    /// One light's lookup.
+    /// One light's lookup: its light and filter.
     #[derive(Debug, Clone, Copy, PartialEq)]
     pub(crate) struct VirtualLookup {
+        pub(crate) map_filter: MapFilter,
         pub(crate) light: u32,
     }
 }
@@ -149,6 +156,7 @@ impl VirtualParams {
 struct Gpu {
     stages: Stages,
     lookup: FullscreenLightPass<VirtualLookup>,
+    filters: MapFilters,
     pages: Option<Pages>,
     /// Frames recorded.
     frame: u32,
@@ -177,6 +185,10 @@ fn virtual_lights(
                 true => fallback_level(light.direction, s, camera, bounds),
                 false => l.levels - 1,
             };
+            let (near, far) = match l.clipmap {
+                true => depth_range(light.direction.normalize(), bounds),
+                false => (perspective_near(light.range), light.range),
+            };
             VirtualLight {
                 first_layer: l.first_layer,
                 faces: l.faces,
@@ -184,6 +196,8 @@ fn virtual_lights(
                 clipmap: u32::from(l.clipmap),
                 first_texel,
                 fallback_level,
+                near,
+                far,
             }
         })
         .collect()
@@ -252,6 +266,7 @@ impl ShadowTechnique for VirtualMaps {
             Ok(Gpu {
                 stages: Stages::new(ctx, p.slope_bias)?,
                 lookup: FullscreenLightPass::new(ctx, LOOKUP_SHADER, "fs_lookup", &[])?,
+                filters: MapFilters::read(ctx.shaders)?,
                 pages: None,
                 frame: 0,
                 device: ctx.gpu.device.clone(),
@@ -290,7 +305,7 @@ impl ShadowTechnique for VirtualMaps {
             level_bias: p.level_bias,
             normal_offset: p.normal_offset,
             light_count: ctx.lights.len() as u32,
-            pcf_radius: p.pcf_radius.min(GUTTER),
+            reach_texels: p.filtering.reach_texels(),
         };
         let lights = virtual_lights(
             &pages.layout,
@@ -301,8 +316,10 @@ impl ShadowTechnique for VirtualMaps {
         pages.write(ctx, &frame, &layers, &lights);
         let result = pages.record(ctx, recorder, &mut gpu.stages).and_then(|()| {
             let own: Vec<&zoo_host::kit::StageBindGroup> = pages.lookup_tables.iter().collect();
-            let per_light = |light| VirtualLookup {
+            let filters = &gpu.filters;
+            let per_light = |light: usize| VirtualLookup {
                 light: light as u32,
+                map_filter: filters.filter(&p.filtering, light_size(&ctx.lights[light])),
             };
             gpu.lookup
                 .record_with(ctx, recorder, LOOKUP_PASS, per_light, &own, &[])

@@ -297,9 +297,23 @@ impl Pages {
                 ctx.scene_buffers.indices.as_entire_binding(),
             ),
         ];
-        let compare = ctx.gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("virtual-maps pool comparison"),
-            compare: Some(wgpu::CompareFunction::LessEqual),
+        let sampler = |label, filter| {
+            ctx.gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(label),
+                mag_filter: filter,
+                min_filter: filter,
+                compare: Some(wgpu::CompareFunction::LessEqual),
+                ..Default::default()
+            })
+        };
+        let compare = sampler("virtual-maps pool comparison", wgpu::FilterMode::Nearest);
+        let linear = sampler(
+            "virtual-maps pool bilinear comparison",
+            wgpu::FilterMode::Linear,
+        );
+        let values_view = pool.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("virtual-maps physical pool depths"),
+            aspect: wgpu::TextureAspect::DepthOnly,
             ..Default::default()
         });
         let stats = ReadbackRing::new(&ctx.gpu.device, "virtual-maps counters", 4 * COUNTS, 3);
@@ -324,7 +338,16 @@ impl Pages {
                     &[
                         ("page_table", page_table.as_entire_binding()),
                         ("pool", wgpu::BindingResource::TextureView(&pool_view)),
+                        ("pool_linear", wgpu::BindingResource::Sampler(&linear)),
+                        (
+                            "pool_nearest",
+                            wgpu::BindingResource::TextureView(&pool_view),
+                        ),
                         ("pool_compare", wgpu::BindingResource::Sampler(&compare)),
+                        (
+                            "pool_values",
+                            wgpu::BindingResource::TextureView(&values_view),
+                        ),
                     ],
                 ],
             )?,

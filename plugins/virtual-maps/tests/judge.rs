@@ -27,14 +27,17 @@ fn assert_hard_bounds(run: &JudgeRun) {
     }
 }
 
-const HARD: [(&str, &str); 1] = [("pcf_radius", "0")];
+const HARD: [(&str, &str); 1] = [("filter", "None")];
 
+/// Kilometre-scale scenes with near detail, alpha-tested foliage (masks drawn into the pages)
+/// and the survey's room.
 #[test]
-fn kilometre_scale_scenes_keep_the_hard_bounds() {
+fn hard_shadows_keep_the_bounds_where_one_map_fails() {
     for scene in [
         "kilometre.ron",
         "vista.ron",
         "power-lines.ron",
+        "foliage.ron",
         "planar-room.ron",
     ] {
         assert_hard_bounds(&judge(scene, "virtual-maps", &HARD, UVec2::new(256, 256)));
@@ -108,7 +111,7 @@ fn a_static_view_draws_its_pages_once_and_keeps_them() {
 #[test]
 fn a_pool_too_small_falls_back_to_coarser_pages_and_keeps_the_shadows() {
     // 16 pages for three lights' pages: the finer ones find no room.
-    let small = [("pool_pages", "16"), ("pcf_radius", "0")];
+    let small = [("pool_pages", "16"), ("filter", "None")];
     let run = judge(
         "planar-room.ron",
         "virtual-maps",
