@@ -43,13 +43,19 @@ const COUNT_FALLBACK_PIXELS: u32 = 11u;
 const COUNT_RESIDENT_BEFORE: u32 = 12u;
 const COUNTS: u32 = 16u;
 
+// The item of a 64-wide invocation of a dispatch spread over rows of workgroups (more than a
+// dispatch takes along one axis: `spread` in the plugin's Rust).
+fn item(id: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return id.x + id.y * groups.x * 64u;
+}
+
 fn pool_pages_count() -> u32 {
     return virtual_frame.pool_side * virtual_frame.pool_side;
 }
 
 @compute @workgroup_size(64)
-fn cs_invalidate(@builtin(global_invocation_id) id: vec3<u32>) {
-    let e = id.x;
+fn cs_invalidate(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = item(id, groups);
     if e >= arrayLength(&entry_layers) {
         return;
     }
@@ -113,8 +119,8 @@ fn mark_reach(light: u32, level: u32, p: vec3<f32>, n: vec3<f32>) {
 }
 
 @compute @workgroup_size(64)
-fn cs_age(@builtin(global_invocation_id) id: vec3<u32>) {
-    let e = id.x;
+fn cs_age(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let e = item(id, groups);
     if e >= arrayLength(&entry_layers) || atomicLoad(&needed[e]) == 0u {
         return;
     }
@@ -190,13 +196,13 @@ fn allocate(e: u32, fallback: bool) {
 }
 
 @compute @workgroup_size(64)
-fn cs_allocate_fallback(@builtin(global_invocation_id) id: vec3<u32>) {
-    allocate(id.x, true);
+fn cs_allocate_fallback(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    allocate(item(id, groups), true);
 }
 
 @compute @workgroup_size(64)
-fn cs_allocate_finer(@builtin(global_invocation_id) id: vec3<u32>) {
-    allocate(id.x, false);
+fn cs_allocate_finer(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    allocate(item(id, groups), false);
 }
 
 @compute @workgroup_size(1)

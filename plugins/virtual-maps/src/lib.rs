@@ -24,7 +24,7 @@ use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use layers::{Layout, Sizes, depth_range, fallback_level, light_layers};
 use pages::{GUTTER, Pages, Stages};
 use zoo_shadow_maps::light_space::perspective_near;
-use zoo_shadow_maps::{FilterParams, MapFilter, MapFilters, light_size};
+use zoo_shadow_maps::{FilterParams, MapFilter, MapFilters, light_scissor, light_size};
 
 zoo_host::technique_params! {
     /// Parameters of virtual shadow maps.
@@ -321,8 +321,20 @@ impl ShadowTechnique for VirtualMaps {
                 light: light as u32,
                 map_filter: filters.filter(&p.filtering, light_size(&ctx.lights[light])),
             };
+            // Each light's pass covers the pixels its range can reach.
+            let view_proj = ctx
+                .camera
+                .projection(ctx.size.x as f32 / ctx.size.y.max(1) as f32)
+                * ctx.camera.view();
+            let scissor =
+                |light: usize| Some(light_scissor(&ctx.lights[light], view_proj, ctx.size));
+            let passes = (
+                LOOKUP_PASS,
+                per_light,
+                &scissor as &dyn Fn(usize) -> Option<[u32; 4]>,
+            );
             gpu.lookup
-                .record_with(ctx, recorder, LOOKUP_PASS, per_light, &own, &[])
+                .record_scissored(ctx, recorder, passes, &own, &[])
         });
         gpu.pages = Some(pages);
         result

@@ -31,6 +31,18 @@ pub const COUNT_EVICTED: usize = 9;
 pub const COUNT_NO_ROOM: usize = 10;
 pub const COUNT_FALLBACK_PIXELS: usize = 11;
 pub const COUNT_RESIDENT_BEFORE: usize = 12;
+/// Invocations a row of a spread dispatch holds: as many 64-wide workgroups as a dispatch
+/// takes along one axis (`item` in `bookkeeping.wgsl`).
+const ROW: u32 = 65535 * 64;
+
+/// The extent of a dispatch over `items` 64-wide items: one row, or rows of [`ROW`].
+fn spread(items: u32) -> [u32; 3] {
+    match items <= ROW {
+        true => [items, 1, 1],
+        false => [ROW, items.div_ceil(ROW), 1],
+    }
+}
+
 /// The depth format of the pool.
 pub const POOL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -400,7 +412,7 @@ impl Pages {
         let encoder = recorder.encoder();
         encoder.clear_buffer(&self.needed, 0, None);
         encoder.clear_buffer(&self.counts, 0, None);
-        let entries = [self.layout.entries(), 1, 1];
+        let entries = spread(self.layout.entries());
         let pool = [self.pool_side * self.pool_side, 1, 1];
         let pixels = [ctx.size.x, ctx.size.y, 1];
         // Each entry's extent, in `BOOKKEEPING_ENTRIES` order.
@@ -483,5 +495,33 @@ impl Pages {
                 .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
                 .collect(),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dispatches_past_one_axis_spread_over_rows() {
+        assert_eq!(spread(100), [100, 1, 1]);
+        assert_eq!(spread(ROW), [ROW, 1, 1]);
+        assert_eq!(spread(ROW + 1), [ROW, 2, 1]);
+        // The shader's rows are 64-wide workgroups, as many as one axis takes.
+        let source = zoo_host::ShaderLibrary::embedded()
+            .compose(BOOKKEEPING)
+            .unwrap()
+            .source;
+        for entry in [
+            "cs_invalidate",
+            "cs_age",
+            "cs_allocate_fallback",
+            "cs_allocate_finer",
+        ] {
+            let size = zoo_host::gpu::layout::wgsl_workgroup_size(&source, entry);
+            assert_eq!(size, Ok([64, 1, 1]), "{entry}");
+        }
+        let limits = wgpu::Limits::downlevel_defaults();
+        assert_eq!(ROW / 64, limits.max_compute_workgroups_per_dimension);
     }
 }

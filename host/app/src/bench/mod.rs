@@ -170,7 +170,7 @@ fn suite_run_plan(
         techniques,
         flicker: !args.no_flicker,
         cpu_timing: args.cpu_timing,
-        reuse_unchanged: args.reuse_unchanged,
+        reuse_unchanged: args.reuse_unchanged || run.reuse_unchanged,
     })
 }
 

@@ -47,6 +47,10 @@ pub struct SuiteRun {
     /// and listed as such.
     #[serde(default)]
     pub needs: Option<String>,
+    /// Let frames keep work whose inputs did not change, as `--reuse-unchanged` does for the
+    /// whole suite: a run that measures a cache (virtual maps' pages along a camera path).
+    #[serde(default)]
+    pub reuse_unchanged: bool,
 }
 
 impl SuiteRun {

@@ -103,11 +103,37 @@ impl<T: UniformValue> FullscreenLightPass<T> {
         own: &[&StageBindGroup],
         shared: &[&dyn SharedGroup],
     ) -> Result<(), TechniqueError> {
+        let whole = |_| None;
+        self.record_scissored(ctx, recorder, (base, per_light, &whole), own, shared)
+    }
+
+    /// As [`Self::record_with`], each light's pass restricted to `scissor(light)` where it
+    /// gives a rectangle (x, y, width, height: the pixels the light can reach); a light whose
+    /// rectangle is empty records no pass (its slot stays as the frame cleared it, lit).
+    pub fn record_scissored(
+        &mut self,
+        ctx: &RenderContext<'_>,
+        recorder: &mut PassRecorder<'_>,
+        (base, per_light, scissor): (
+            &str,
+            impl Fn(usize) -> T,
+            &dyn Fn(usize) -> Option<[u32; 4]>,
+        ),
+        own: &[&StageBindGroup],
+        shared: &[&dyn SharedGroup],
+    ) -> Result<(), TechniqueError> {
         let values: Vec<T> = (0..ctx.lights.len()).map(per_light).collect();
         self.uniforms.write(ctx.gpu, &values);
         for light in 0..values.len() {
+            let rect = scissor(light);
+            if rect.is_some_and(|[_, _, w, h]| w == 0 || h == 0) {
+                continue;
+            }
             let name = light_pass_name(base, light);
             let mut pass = ctx.light_pass(recorder, &name, light, None);
+            if let Some([x, y, w, h]) = rect {
+                pass.set_scissor_rect(x, y, w, h);
+            }
             let slot = self.uniforms.at(light);
             let mut all: Vec<&dyn SharedGroup> = vec![&slot];
             all.extend_from_slice(shared);
