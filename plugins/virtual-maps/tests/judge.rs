@@ -136,3 +136,33 @@ fn a_pool_too_small_falls_back_to_coarser_pages_and_keeps_the_shadows() {
         assert!(m.false_lit_core < 0.01, "light {light}: {m:?}");
     }
 }
+
+/// The pages drawn in the frame after `renderer`'s last, its counters waited for.
+fn pages_drawn(renderer: &mut Renderer) -> f64 {
+    renderer.render(&View::Final).unwrap();
+    let counters = renderer.wait_for_counters();
+    counter(&counters, "pages drawn").unwrap()
+}
+
+#[test]
+fn a_light_that_turns_redraws_its_own_pages_and_no_other_light_s() {
+    let size = UVec2::new(128, 128);
+    let mut all = renderer("planar-room.ron", &[], size);
+    pages_drawn(&mut all);
+    assert_eq!(pages_drawn(&mut all), 0.0, "a still frame draws nothing");
+    // Turn the spot light (light 1) a little.
+    let mut lights = all.lights().to_vec();
+    let spot = 1;
+    assert_eq!(lights[spot].kind, zoo_host::LightKind::Spot);
+    let turned = zoo_host::glam::Quat::from_rotation_y(0.1) * lights[spot].direction;
+    lights[spot].direction = turned;
+    all.set_lights(lights.clone());
+    let redrawn = pages_drawn(&mut all);
+    // Exactly the pages the turned spot needs alone: those of a scene lit by it only.
+    let mut alone = renderer("planar-room.ron", &[], size);
+    alone.set_lights(vec![lights[spot]]);
+    let own = pages_drawn(&mut alone);
+    assert!(own > 0.0);
+    assert_eq!(redrawn, own, "the other lights' pages were kept");
+    assert_eq!(pages_drawn(&mut all), 0.0, "and kept again after the turn");
+}
