@@ -98,8 +98,9 @@ fn cs_mark(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Marks the pages under the corners of the square the filter's taps reach around the pixel's
-// lookup point (at most the reach in texels, under a page: corners suffice).
+// Marks the pages the filter's taps can read around the pixel's lookup point: every page of
+// the layer between those under the corners of the square of the filter's reach (at most a
+// page: 2x2 pages), or, where the corners fall in other cube faces, each corner's page.
 fn mark_reach(light: u32, level: u32, p: vec3<f32>, n: vec3<f32>) {
     let texel = texel_size(light, level, p);
     let towards = towards_light(light, p);
@@ -107,6 +108,8 @@ fn mark_reach(light: u32, level: u32, p: vec3<f32>, n: vec3<f32>) {
     let frame = tangent_frame(-towards);
     let reach = virtual_frame.reach_texels * texel;
     let v = virtual_lights[light];
+    var corners: array<PagePoint, 4>;
+    var same = true;
     for (var corner = 0u; corner < 4u; corner++) {
         let sign = vec2<f32>(f32(corner & 1u), f32(corner >> 1u)) * 2.0 - 1.0;
         let c = q + (frame[0] * sign.x + frame[1] * sign.y) * reach;
@@ -114,7 +117,28 @@ fn mark_reach(light: u32, level: u32, p: vec3<f32>, n: vec3<f32>) {
         if v.faces == 6u {
             face = cube_face(c - lights[light].position);
         }
-        mark(page_point(layer_of(light, face, level), c));
+        corners[corner] = page_point(layer_of(light, face, level), c);
+        mark(corners[corner]);
+        same = same && corners[corner].found && corners[corner].layer == corners[0].layer;
+    }
+    if !same {
+        return;
+    }
+    // The page range the corners span (a square turned against the map's axes reaches into
+    // pages no corner lies in).
+    let l = virtual_layers[corners[0].layer];
+    var lo = vec2<u32>(l.pages);
+    var hi = vec2<u32>(0u);
+    for (var corner = 0u; corner < 4u; corner++) {
+        let index = corners[corner].entry - l.first_entry;
+        let page = vec2<u32>(index % l.pages, index / l.pages);
+        lo = min(lo, page);
+        hi = max(hi, page);
+    }
+    for (var y = lo.y; y <= hi.y; y++) {
+        for (var x = lo.x; x <= hi.x; x++) {
+            atomicStore(&needed[l.first_entry + y * l.pages + x], 1u);
+        }
     }
 }
 

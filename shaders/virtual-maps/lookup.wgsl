@@ -106,12 +106,16 @@ fn fs_lookup(in: FullscreenOut) -> @location(0) vec4<f32> {
     // The level of the page read: the wanted one, or the first coarser one resident.
     tap_light = light;
     tap_level = found.level;
-    let lookup = s.position + towards_light(light, s.position) * (offset_texels(light, s.position, s.normal) * texel_size(light, found.level, s.position));
+    let towards = towards_light(light, s.position) * offset_texels(light, s.position, s.normal);
+    var lookup = s.position + towards * texel_size(light, found.level, s.position);
     let first = resident(lookup);
     if !first.found {
         return vec4<f32>(1.0);
     }
+    // A coarser page read in its place: the offset in its texels (along the light's ray, so
+    // the same page).
     tap_level = first.at.level;
+    lookup = s.position + towards * texel_size(light, tap_level, s.position);
     let l = lights[light];
     let parallel = l.kind == LIGHT_DIRECTIONAL;
     let ray = select(normalize(lookup - l.position), l.direction, parallel);

@@ -36,6 +36,7 @@ impl Sizes {
 /// One light's layers: `faces` x `levels`, face by face, finest level first.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LightLayers {
+    pub kind: LightKind,
     pub first_layer: u32,
     pub faces: u32,
     pub levels: u32,
@@ -69,6 +70,7 @@ impl Layout {
                 LightKind::Point => (6, sizes.mip_levels(), false),
             };
             layout.lights.push(LightLayers {
+                kind: light.kind,
                 first_layer: layout.layers.len() as u32,
                 faces,
                 levels,
@@ -92,6 +94,11 @@ impl Layout {
             }
         }
         layout
+    }
+
+    /// The light kinds it was laid out for.
+    pub fn kinds(&self) -> Vec<LightKind> {
+        self.lights.iter().map(|l| l.kind).collect()
     }
 
     /// Page-table entries in all.

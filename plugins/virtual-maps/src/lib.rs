@@ -272,9 +272,11 @@ impl ShadowTechnique for VirtualMaps {
                 device: ctx.gpu.device.clone(),
             })
         })?;
-        let layout = Layout::new(ctx.lights, p.sizes());
-        let current = (gpu.pages.as_ref()).is_some_and(|pages| pages.layout == layout);
+        let kinds: Vec<LightKind> = ctx.lights.iter().map(|l| l.kind).collect();
+        let current = (gpu.pages.as_ref())
+            .is_some_and(|pages| pages.layout.sizes == p.sizes() && pages.layout.kinds() == kinds);
         if changes.scene || !current {
+            let layout = Layout::new(ctx.lights, p.sizes());
             let pages = Pages::new(ctx, &gpu.stages, gpu.lookup.stage(), layout, p.pool_pages)?;
             gpu.pages = Some(pages);
         }
@@ -305,7 +307,8 @@ impl ShadowTechnique for VirtualMaps {
             level_bias: p.level_bias,
             normal_offset: p.normal_offset,
             light_count: ctx.lights.len() as u32,
-            reach_texels: p.filtering.reach_texels(),
+            // Marking assumes a reach under a page (corners then span at most 2x2 pages).
+            reach_texels: p.filtering.reach_texels().min(sizes.page_size as f32),
         };
         let lights = virtual_lights(
             &pages.layout,
@@ -359,6 +362,10 @@ impl ShadowTechnique for VirtualMaps {
         let Some(pages) = &gpu.pages else {
             return Vec::new();
         };
+        // Nothing until a frame's counts have arrived (callers that wait retry on empty).
+        let Some(c) = pages.counts(&gpu.device) else {
+            return Vec::new();
+        };
         let slot = f64::from(pages.layout.sizes.page_size + 2 * GUTTER);
         let pool_pages = f64::from(pages.pool_side * pages.pool_side);
         let mut counters = vec![
@@ -372,7 +379,7 @@ impl ShadowTechnique for VirtualMaps {
                 f64::from(pages.layout.entries()),
             ),
         ];
-        if let Some(c) = pages.counts(&gpu.device) {
+        {
             let value = |k: usize| f64::from(c[k]);
             let needed = value(pages::COUNT_NEEDED);
             counters.extend([

@@ -203,6 +203,17 @@ impl Pages {
         });
         let entries = u64::from(layout.entries());
         let pages = u64::from(pool_side * pool_side);
+        let limits = ctx.gpu.device.limits();
+        let largest = u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+        if 4 * entries > largest {
+            return Err(zoo_host::TechniqueError::Other(format!(
+                "virtual-maps: {} lights need a page table of {entries} entries ({} MiB), more \
+                 than the device binds ({} MiB); lower `pages`",
+                layout.lights.len(),
+                4 * entries >> 20,
+                largest >> 20
+            )));
+        }
         let none = wgpu::BufferUsages::empty();
         let storage_init = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let page_table = init(
@@ -275,10 +286,12 @@ impl Pages {
             zoo_host::bytemuck::cast_slice(&run_words),
             storage_init,
         );
+        // The clear's arguments and one run's at least (an empty run list is read as one
+        // empty run).
         let draw_args = storage(
             ctx,
             "virtual-maps draw arguments",
-            16 * (runs.len() as u64 + 1),
+            16 * (runs.len().max(1) as u64 + 1),
             wgpu::BufferUsages::INDIRECT,
         );
         let tables = [

@@ -129,11 +129,13 @@ fn a_pool_too_small_falls_back_to_coarser_pages_and_keeps_the_shadows() {
         counter(&counters, "fallback pixels").unwrap() > 0.0,
         "{counters:?}"
     );
-    // Coarser pages blur edges, never drop a shadow: few pixels the reference shadows are lit.
+    // Coarser pages blur edges, never drop a shadow (few pixels the reference shadows are
+    // lit) nor shadow themselves (their offset is in their own texels).
     for light in 0..run.loaded.lights.len() {
         let m = run.metrics(light);
         eprintln!("small pool, light {light}: {m:?}");
         assert!(m.false_lit_core < 0.01, "light {light}: {m:?}");
+        assert!(m.false_shadow_core < 0.005, "light {light}: {m:?}");
     }
 }
 
