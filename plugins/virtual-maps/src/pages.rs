@@ -204,13 +204,13 @@ impl Pages {
         let entries = u64::from(layout.entries());
         let pages = u64::from(pool_side * pool_side);
         let limits = ctx.gpu.device.limits();
-        let largest = u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+        let largest = (limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
         if 4 * entries > largest {
             return Err(zoo_host::TechniqueError::Other(format!(
                 "virtual-maps: {} lights need a page table of {entries} entries ({} MiB), more \
                  than the device binds ({} MiB); lower `pages`",
                 layout.lights.len(),
-                4 * entries >> 20,
+                (4 * entries) >> 20,
                 largest >> 20
             )));
         }
