@@ -62,3 +62,23 @@ fn caps_off_cracks_the_shadows() {
 fn a_finite_extrusion_cuts_shadows_off() {
     assert_artifact("planar-room.ron", "extrusion", ("1.0", "0.0"), 0.01);
 }
+
+/// Capless z-pass (seed 000 section 8, Heidmann's original): counting where camera rays enter
+/// and leave volumes needs no caps while the camera stands outside every volume, since a ray
+/// stops at the first surface before any open end; exact then, and wrong once the camera is
+/// inside a shadow (`camera_inside_a_shadow_volume_is_exact_with_z_fail_and_wrong_with_z_pass`).
+#[test]
+fn capless_z_pass_is_exact_with_the_camera_outside_every_volume() {
+    let capless = [("counting", "ZPass"), ("caps", "false")];
+    for scene in ["planar-room.ron", "curved.ron"] {
+        let errors = core_errors(&judge(scene, "sv-zfail", &capless, SIZE), "capless z-pass");
+        for (light, error) in errors.iter().enumerate() {
+            assert!(
+                *error <= EXACT,
+                "{scene} light {light}: core errors {error}"
+            );
+        }
+    }
+    // The same volumes without caps counted by z-fail crack (`caps_off_cracks_the_shadows`):
+    // the caps serve z-fail only.
+}
