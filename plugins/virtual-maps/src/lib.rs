@@ -428,7 +428,20 @@ zoo_host::register_technique! {
     readme: include_str!("../README.md"),
     light_kinds: &[LightKind::Directional, LightKind::Point, LightKind::Spot],
     required_features: || wgpu::Features::CLIP_DISTANCES,
-    required_downlevel: || wgpu::DownlevelFlags::COMPUTE_SHADERS | wgpu::DownlevelFlags::INDIRECT_EXECUTION,
+    required_limits: || wgpu::Limits {
+        // The page draws read the page table, the drawn list, the layers, the lights and the
+        // scene's vertices, indices and objects in the vertex stage; stages bind the frame,
+        // the G-buffer or materials, a per-light or per-run slot, the tables and their own.
+        max_storage_buffers_per_shader_stage: 10,
+        max_bind_groups: 5,
+        ..wgpu::Limits::downlevel_defaults()
+    },
+    // Bookkeeping in compute, page draws from indirect arguments, vertices pulled from storage.
+    required_downlevel: || {
+        wgpu::DownlevelFlags::COMPUTE_SHADERS
+            | wgpu::DownlevelFlags::INDIRECT_EXECUTION
+            | wgpu::DownlevelFlags::VERTEX_STORAGE
+    },
     params: VirtualParams::schema,
     create: create,
 }
