@@ -1,7 +1,7 @@
 //! The virtual layers of every light and where their pages lie in the page table.
 //!
 //! A directional light's virtual map is a clipmap: `levels` square levels centred on the
-//! camera, level k covering `first_level_size` · 2^k metres with `pages` pages a side, each
+//! camera, level k covering `first_level_size` · 2^k with `pages` pages a side, each
 //! level's centre snapped to its page grid (so a level moves, and its pages are redrawn, only
 //! when the camera crosses a page of it). A spot light's virtual map is one frustum around its
 //! cone with mip levels (level k: `pages` >> k pages a side), a point light's six cube faces

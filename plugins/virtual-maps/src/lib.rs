@@ -37,8 +37,9 @@ zoo_host::technique_params! {
         pages: u32 = 32, range(2, 128), step(2), flags(rebuild);
         /// Clipmap levels of a directional light, each twice the size of the one before.
         clip_levels: u32 = 14, range(1, 24), step(1), flags(rebuild);
-        /// Metres the finest clipmap level covers.
-        first_level_size: f32 = 4.0, range(0.01, 100000.0), step(0.5);
+        /// The finest clipmap level's size as a fraction of the scene's diagonal (so a scene
+        /// scaled by any factor is shadowed alike; 1/512 of a 1.6 km scene is about 3 m).
+        first_level_fraction: f32 = 0.002, range(0.0001, 1.0), step(0.0005);
         /// Physical pages in the pool (rounded up to a square, within the device's texture
         /// size).
         pool_pages: u32 = 1024, range(16, 16384), step(16), flags(rebuild);
@@ -141,15 +142,23 @@ const LOOKUP_PASS: &str = "Virtual map lookup";
 const POOL_VIEW: &str = "physical pool";
 
 impl VirtualParams {
-    fn sizes(&self) -> Sizes {
+    /// The layers' sizes for a scene of diagonal `diagonal`.
+    fn sizes(&self, diagonal: f32) -> Sizes {
         let power = |v: u32| 1 << v.max(1).ilog2();
         Sizes {
             pages: power(self.pages),
             clip_levels: self.clip_levels,
-            first_level_size: self.first_level_size,
+            first_level_size: (self.first_level_fraction * diagonal).max(f32::MIN_POSITIVE),
             page_size: power(self.page_size),
         }
     }
+}
+
+/// The diagonal of the scene's box (1 for a scene without geometry).
+fn scene_diagonal(scene: &zoo_host::Scene) -> f32 {
+    let (lo, hi) = scene.bounds();
+    let d = lo.distance(hi);
+    if d.is_finite() && d > 0.0 { d } else { 1.0 }
 }
 
 /// The stages, and the page table and pool of the current layout.
@@ -273,10 +282,11 @@ impl ShadowTechnique for VirtualMaps {
             })
         })?;
         let kinds: Vec<LightKind> = ctx.lights.iter().map(|l| l.kind).collect();
+        let sizes = p.sizes(scene_diagonal(ctx.scene));
         let current = (gpu.pages.as_ref())
-            .is_some_and(|pages| pages.layout.sizes == p.sizes() && pages.layout.kinds() == kinds);
+            .is_some_and(|pages| pages.layout.sizes == sizes && pages.layout.kinds() == kinds);
         if changes.scene || !current {
-            let layout = Layout::new(ctx.lights, p.sizes());
+            let layout = Layout::new(ctx.lights, sizes);
             let pages = Pages::new(ctx, &gpu.stages, gpu.lookup.stage(), layout, p.pool_pages)?;
             gpu.pages = Some(pages);
         }
