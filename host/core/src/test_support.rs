@@ -363,6 +363,16 @@ impl JudgeRun {
         )
     }
 
+    /// [`Self::assert_bounds`] for every light of the scene, each light's metrics printed.
+    pub fn assert_every_light(&self, bounds: &[(Metric, f64)]) {
+        for light in 0..self.loaded.lights.len() {
+            let m = self.metrics(light);
+            let kind = self.loaded.lights[light].kind.name();
+            eprintln!("{} light {light} ({kind}): {m:?}", self.scene);
+            self.assert_bounds(light, &m, bounds);
+        }
+    }
+
     /// Asserts `metric <= bound` for each pair. On failure, writes the light's error map and
     /// panics naming the metric, the measured value, the bound and the image.
     pub fn assert_bounds(

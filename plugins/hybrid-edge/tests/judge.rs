@@ -16,19 +16,10 @@ const CLIP_DISTANCES: Features = Features::CLIP_DISTANCES;
 const SIZE: UVec2 = UVec2::new(256, 256);
 
 fn assert_volume_bounds(run: &JudgeRun) {
-    for light in 0..run.loaded.lights.len() {
-        let m = run.metrics(light);
-        let kind = run.loaded.lights[light].kind.name();
-        eprintln!("{} light {light} ({kind}): {m:?}", run.scene);
-        run.assert_bounds(
-            light,
-            &m,
-            &[
-                (Metric::FalseShadowCore, 0.001),
-                (Metric::FalseLitCore, 0.001),
-            ],
-        );
-    }
+    run.assert_every_light(&[
+        (Metric::FalseShadowCore, 0.001),
+        (Metric::FalseLitCore, 0.001),
+    ]);
 }
 
 const SCENES: [&str; 4] = [

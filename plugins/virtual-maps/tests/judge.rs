@@ -12,19 +12,10 @@ use zoo_host::{Renderer, Scene, View};
 
 /// One tap (hard), the judge's bounds.
 fn assert_hard_bounds(run: &JudgeRun) {
-    for light in 0..run.loaded.lights.len() {
-        let m = run.metrics(light);
-        let kind = run.loaded.lights[light].kind.name();
-        eprintln!("{} light {light} ({kind}): {m:?}", run.scene);
-        run.assert_bounds(
-            light,
-            &m,
-            &[
-                (Metric::FalseShadowCore, 0.002),
-                (Metric::FalseLitCore, 0.005),
-            ],
-        );
-    }
+    run.assert_every_light(&[
+        (Metric::FalseShadowCore, 0.002),
+        (Metric::FalseLitCore, 0.005),
+    ]);
 }
 
 const HARD: [(&str, &str); 1] = [("filter", "None")];
