@@ -83,10 +83,12 @@ fn rotation(pixel: vec2<f32>) -> mat2x2<f32> {
     return mat2x2<f32>(c, s, -s, c);
 }
 
-// A pixel's filter noise: the Poisson discs' rotation, the same every frame (so still frames
-// do not flicker), and for stochastic filters a point of [0, 1)^2 that moves every frame.
+// A pixel's filter noise: the Poisson discs' rotation and a point of [0, 1)^2, the same every
+// frame (so still frames do not flicker), and for stochastic filters a point that moves every
+// frame.
 struct FilterNoise {
     rotation: mat2x2<f32>,
+    still: vec2<f32>,
     moving: vec2<f32>,
 }
 
@@ -98,7 +100,7 @@ const R2_STEP: vec2<f32> = vec2<f32>(0.7548777, 0.5698403);
 // point starts at two decorrelated interleaved-gradient values and walks the R2 sequence.
 fn filter_noise(pixel: vec2<f32>, frame: u32) -> FilterNoise {
     let start = vec2<f32>(interleaved_gradient_noise(pixel), interleaved_gradient_noise(pixel.yx + vec2<f32>(47.0, 17.0)));
-    return FilterNoise(rotation(pixel), fract(start + f32(frame % 4096u) * R2_STEP));
+    return FilterNoise(rotation(pixel), start, fract(start + f32(frame % 4096u) * R2_STEP));
 }
 
 // The receiver's tangent plane and the light's rays, for placing filter taps.
@@ -225,6 +227,132 @@ fn pcss(plane: TapPlane, frame: mat2x3<f32>, texel: f32, r: mat2x2<f32>, light: 
     return poisson_pcf(plane, frame, clamp(penumbra, texel, light.max_texels * texel), r);
 }
 
+// What shadow-map ray tracing needs beyond PCSS's light: rays, samples a ray, where samples
+// start and their depth slack (texels of the map at the receiver; `MapFilter`'s fields).
+struct SmrtRays {
+    rays: u32,
+    samples: u32,
+    start_texels: f32,
+    bias_texels: f32,
+}
+
+// The golden angle, in radians: consecutive points of a Vogel disc turn by it.
+const GOLDEN_ANGLE: f32 = 2.3999632;
+
+// Halvings of the step where an SMRT ray comes out from under a surface, to find where.
+const SMRT_REFINEMENTS: u32 = 4u;
+
+// A point of an SMRT ray against the map: whether the map holds it, and its distance and the
+// stored surface's from the light along its light ray (axis depths of a perspective map turned
+// into distances, so samples in different cube faces compare alike).
+struct RayPoint {
+    known: bool,
+    ray: f32,
+    stored: f32,
+}
+
+fn ray_point(plane: TapPlane, x: vec3<f32>) -> RayPoint {
+    let d = shadow_depths(x);
+    var per_depth = 1.0;
+    if !plane.parallel {
+        per_depth = distance(x, plane.apex) / max(d.y, 1e-30);
+    }
+    return RayPoint(d.x > 0.0, d.y * per_depth, d.z * per_depth);
+}
+
+// Shadow-map ray tracing: rays from the receiver to points of the light's area (a Vogel disc
+// across the rays, turned and jittered per pixel), each marched towards the light through the
+// map as a height field. A sample behind the stored depth lies under a surface the map sees;
+// the ray is blocked where it comes out above that surface (through it), and not where it
+// comes out beside it (still behind that surface's depth, in front of a farther one: it passed
+// under a caster's edge), so a receiver in the shadow of the light's centre still sees the
+// light's edge past a caster's rim. Where a ray comes out is found by halving the step
+// (`SMRT_REFINEMENTS`). Samples crowd towards the receiver (quadratically), where contact
+// shadows need them. Visibility is the fraction of rays that reach the light: penumbrae come
+// from every caster each ray meets, not from one average blocker depth as in PCSS, so
+// overlapping casters at different distances soften each by its own distance.
+fn smrt(plane: TapPlane, frame: mat2x3<f32>, texel: f32, noise: FilterNoise, light: PcssLight, rays: SmrtRays) -> f32 {
+    let start = shadow_depths(plane.point);
+    if start.x == 0.0 {
+        return 1.0;
+    }
+    // Depth slack: a texel of a receiver tilted from the light spans `slope` texels of depth.
+    var towards = -normalize(plane.apex);
+    if !plane.parallel {
+        towards = normalize(plane.apex - plane.point);
+    }
+    let c = clamp(dot(plane.normal, towards), 0.02, 1.0);
+    let slope = min(sqrt(1.0 - c * c) / c, 32.0);
+    let bias = rays.bias_texels * texel * (1.0 + slope);
+    let first = rays.start_texels * texel;
+    let count = max(rays.rays, 1u);
+    let samples = max(rays.samples, 1u);
+    var reached = 0.0;
+    for (var k = 0u; k < count; k++) {
+        // A point of the light's disc (radius `size` across the rays).
+        let ring = sqrt((f32(k) + noise.still.x) / f32(count)) * light.size;
+        let angle = f32(k) * GOLDEN_ANGLE + 6.2831853 * noise.still.y;
+        let across = (frame[0] * cos(angle) + frame[1] * sin(angle)) * ring;
+        var dir: vec3<f32>;
+        var last: f32;
+        if plane.parallel {
+            // Against the light's travel, tilted within its angular radius, until the ray's
+            // depth reaches the map's near plane.
+            dir = normalize(towards + across);
+            last = (start.y - light.near) / max(dot(dir, towards), 0.05);
+        } else {
+            // To the point of the light's sphere, stopping at the map's near plane.
+            let to = plane.apex + across - plane.point;
+            let length = length(to);
+            dir = to / max(length, 1e-30);
+            last = length - light.near;
+        }
+        let jitter = fract(noise.still.x + f32(k) * 0.7548777);
+        // The distance from the light of the surface the ray is under (negative: none), and
+        // where along the ray it was last seen under it.
+        var under = -1.0;
+        var under_at = 0.0;
+        var blocked = false;
+        for (var j = 0u; j < samples && !blocked; j++) {
+            let f = (f32(j) + jitter) / f32(samples);
+            var t = first + max(last - first, 0.0) * f * f;
+            var p = ray_point(plane, plane.point + dir * t);
+            if !p.known {
+                // Outside the map (or a virtual map's resident pages): nothing learnt.
+                continue;
+            }
+            if p.ray > p.stored + bias {
+                under = p.stored;
+                under_at = t;
+                continue;
+            }
+            if under >= 0.0 {
+                // Out from under a surface between `under_at` and `t`: find where.
+                var out_at = t;
+                for (var r = 0u; r < SMRT_REFINEMENTS; r++) {
+                    let middle = 0.5 * (under_at + out_at);
+                    let q = ray_point(plane, plane.point + dir * middle);
+                    if q.known && q.ray > q.stored + bias {
+                        under = q.stored;
+                        under_at = middle;
+                    } else if q.known {
+                        out_at = middle;
+                        p = q;
+                    }
+                }
+                // Through the surface (the ray now as near the light as it), or beside it.
+                blocked = p.ray < under + 2.0 * bias;
+                under = -1.0;
+            }
+        }
+        // A ray still under a surface at its last sample comes out above it on its way to
+        // the light.
+        blocked = blocked || under >= 0.0;
+        reached += select(1.0, 0.0, blocked);
+    }
+    return reached / f32(count);
+}
+
 // Filters, one per variant of the library's Rust `Filter` choice (`FILTER_` and its name in
 // capitals); the library reads their values from here, so no number is kept twice.
 const FILTER_NONE: u32 = 0u;
@@ -241,6 +369,7 @@ const FILTER_PCF8X8: u32 = 10u;
 const FILTER_PCF11X11: u32 = 11u;
 const FILTER_PCF16X16: u32 = 12u;
 const FILTER_PCF23X23: u32 = 13u;
+const FILTER_SMRT: u32 = 14u;
 
 // One light's filter (`MapFilter` in the library's Rust, written by `MapFilters::filter`).
 #import "shadow-maps/map_filter.wgsl"
@@ -266,6 +395,11 @@ fn filter_map(f: MapFilter, plane: TapPlane, frame: mat2x3<f32>, texel: f32, noi
         case FILTER_PCF23X23: { visibility = grid_pcf(plane, frame, texel, 23); }
         case FILTER_POISSON: { visibility = poisson_pcf(plane, frame, f.kernel_texels * texel, r); }
         case FILTER_STOCHASTIC: { visibility = stochastic_pcf(plane, frame, f.kernel_texels * texel, noise.moving); }
+        case FILTER_SMRT: {
+            let light = PcssLight(f.light_size, near, perspective, f.search_texels);
+            let rays = SmrtRays(f.rays, f.ray_samples, f.ray_start_texels, f.ray_bias_texels);
+            visibility = smrt(plane, frame, texel, noise, light, rays);
+        }
         default: {
             let light = PcssLight(f.light_size, near, perspective, f.search_texels);
             visibility = pcss(plane, frame, texel, r, light);

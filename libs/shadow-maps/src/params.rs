@@ -31,13 +31,19 @@ zoo_host::technique_params! {
         kernel_radius: f32 = 2.0, range(0.5, 16.0), step(0.5);
         /// Largest PCSS blocker search and penumbra radius, in texels.
         pcss_max_texels: f32 = 24.0, range(2.0, 64.0), step(1.0);
+        /// SMRT: rays from each receiver to points of the light's area (more: less noise).
+        smrt_rays: u32 = 16, range(1, 64), step(1);
+        /// SMRT: samples along each ray, denser near the receiver.
+        smrt_samples: u32 = 8, range(2, 32), step(1);
     }
 }
 
 impl FilterParams {
     /// How far from the receiver, in texels, the filter's taps read (the largest grid offset,
     /// disc radius or PCSS search, and one more texel for bilinear taps): the reach of the map
-    /// around a receiver that must be present (virtual maps mark the pages within it).
+    /// around a receiver that must be present (virtual maps mark the pages within it). SMRT's
+    /// rays reach as far as their light's size takes them; PCSS's reach bounds the part of them
+    /// read at the receiver's resolution (past it, a virtual map's coarser levels).
     pub fn reach_texels(&self) -> f32 {
         let grid = |n: u32| 0.5 * (n - 1) as f32 + 1.0;
         match self.filter {
@@ -52,7 +58,7 @@ impl FilterParams {
             Filter::Pcf16x16 => grid(16),
             Filter::Pcf23x23 => grid(23),
             Filter::Poisson | Filter::Stochastic => self.kernel_radius + 1.0,
-            Filter::Pcss => self.pcss_max_texels + 1.0,
+            Filter::Pcss | Filter::Smrt => self.pcss_max_texels + 1.0,
         }
     }
 }
@@ -74,6 +80,8 @@ mod tests {
         assert_eq!(p.reach_texels(), 12.0);
         p.filter = Filter::Pcss;
         p.pcss_max_texels = 24.0;
+        assert_eq!(p.reach_texels(), 25.0);
+        p.filter = Filter::Smrt;
         assert_eq!(p.reach_texels(), 25.0);
         p.filter = Filter::Poisson;
         p.kernel_radius = 3.0;
