@@ -9,7 +9,8 @@
 // 5. `cs_allocate_fallback`, then `cs_allocate_finer`: every needed page without one takes
 //    the next candidate (evicting its owner), fallback levels first, so a full pool leaves a
 //    pixel a coarser page, never none; the pages taken are listed to be drawn;
-// 6. `cs_draw_args`: the indirect arguments of the clear and caster draws;
+// 6. `cs_draw_args`: the indirect arguments of the clear and caster draws (the casters'
+//    instances counted by `cull.wgsl`, which runs next);
 // 7. `cs_count_fallback` (after the draws): the pixels whose wanted page found no room.
 
 #import "virtual-maps/tables.wgsl"
@@ -27,11 +28,9 @@
 @group(4) @binding(5) var<storage, read> entry_layers: array<u32>;
 // The clear draw's arguments, then one caster draw's per run.
 @group(4) @binding(6) var<storage, read_write> draw_args: array<u32>;
-// Per caster run: its vertex count, first vertex and object count.
+// Per caster run: its vertex count, first vertex, object count and first instance.
 @group(4) @binding(7) var<storage, read> caster_runs: array<vec4<u32>>;
 
-// Candidate lists: free pages, then pages unused for at least 64, 16, 4 and 1 frames.
-const CANDIDATE_LISTS: u32 = 5u;
 // `counts`: the candidate lists' lengths, then these (`Counts` in the plugin's Rust).
 const COUNT_CURSOR: u32 = 5u;
 const COUNT_DRAWN: u32 = 6u;
@@ -42,12 +41,6 @@ const COUNT_NO_ROOM: u32 = 10u;
 const COUNT_FALLBACK_PIXELS: u32 = 11u;
 const COUNT_RESIDENT_BEFORE: u32 = 12u;
 const COUNTS: u32 = 16u;
-
-// The item of a 64-wide invocation of a dispatch spread over rows of workgroups (more than a
-// dispatch takes along one axis: `spread` in the plugin's Rust).
-fn item(id: vec3<u32>, groups: vec3<u32>) -> u32 {
-    return id.x + id.y * groups.x * 64u;
-}
 
 fn pool_pages_count() -> u32 {
     return virtual_frame.pool_side * virtual_frame.pool_side;
@@ -216,7 +209,7 @@ fn allocate(e: u32, fallback: bool) {
     pool_pages[page] = vec2<u32>(e, virtual_frame.frame);
     page_table[e] = page;
     let drawn = atomicAdd(&counts[COUNT_DRAWN], 1u);
-    lists[CANDIDATE_LISTS * pool_pages_count() + drawn] = e;
+    lists[drawn_place(drawn)] = e;
 }
 
 @compute @workgroup_size(64)
@@ -241,7 +234,8 @@ fn cs_draw_args() {
         let r = caster_runs[run];
         let at = 4u * (run + 1u);
         draw_args[at] = r.x;
-        draw_args[at + 1u] = drawn * r.z;
+        // Counted by the culling of casters per page.
+        draw_args[at + 1u] = 0u;
         draw_args[at + 2u] = r.y;
         draw_args[at + 3u] = 0u;
     }

@@ -1,7 +1,8 @@
 // Virtual shadow maps, drawing the pages allocated this frame into the physical pool, all
 // from indirect arguments (`cs_draw_args`): `vs_clear` clears each page's slot (its gutter
-// included) to the far plane, `vs_caster` draws every caster run into every drawn page, an
-// instance per (page, object): the layer's projection carried onto the page's slot of the pool,
+// included) to the far plane, `vs_caster` draws each caster run's instances, one per (page,
+// object) whose object meets the page (`cull.wgsl`): the layer's projection carried onto the
+// page's slot of the pool,
 // clipped by clip distances to the page and its gutter (the texels filters read beside it);
 // `vs_caster_masked` and `fs_caster_masked` draw alpha-tested casters, whose holes write no
 // depth (`covered`, the judge's rule).
@@ -20,18 +21,12 @@ enable clip_distances;
 @group(4) @binding(2) var<storage, read> lists: array<u32>;
 @group(4) @binding(3) var<storage, read> scene_vertices: array<f32>;
 @group(4) @binding(4) var<storage, read> scene_indices: array<u32>;
-
-const CANDIDATE_LISTS: u32 = 5u;
-
-// The `slot`-th entry drawn this frame.
-fn drawn_entry(slot: u32) -> u32 {
-    let pool = virtual_frame.pool_side * virtual_frame.pool_side;
-    return lists[CANDIDATE_LISTS * pool + slot];
-}
+// Each run's instances from its `instances_at`: drawn slot times its objects, plus the object.
+@group(4) @binding(5) var<storage, read> instances: array<u32>;
 
 @vertex
 fn vs_clear(@builtin(vertex_index) vertex: u32, @builtin(instance_index) slot: u32) -> @builtin(position) vec4<f32> {
-    let origin = vec2<f32>(slot_origin(page_table[drawn_entry(slot)]));
+    let origin = vec2<f32>(slot_origin(page_table[lists[drawn_place(slot)]]));
     let corner = vec2<f32>(f32((0x32u >> vertex) & 1u), f32((0x2cu >> vertex) & 1u));
     let texel = origin + corner * f32(virtual_frame.slot_size);
     let ndc = texel / f32(virtual_frame.pool_texels) * vec2<f32>(2.0, -2.0) + vec2<f32>(-1.0, 1.0);
@@ -48,10 +43,18 @@ fn scene_position(index: u32) -> vec3<f32> {
     return vec3<f32>(scene_vertices[base], scene_vertices[base + 1u], scene_vertices[base + 2u]);
 }
 
+// The entry and scene object of a caster run's instance `instance`.
+fn drawn_pair(instance: u32) -> vec2<u32> {
+    let pair = instances[caster_run.instances_at + instance];
+    let entry = lists[drawn_place(pair / caster_run.objects)];
+    return vec2<u32>(entry, caster_run.first_object + pair % caster_run.objects);
+}
+
 // The scene vertex `vertex` of a caster run's instance `instance`, on its page's slot.
 fn page_vertex(vertex: u32, instance: u32) -> PageVertex {
-    let entry = drawn_entry(instance / caster_run.objects);
-    let object = caster_run.first_object + instance % caster_run.objects;
+    let pair = drawn_pair(instance);
+    let entry = pair.x;
+    let object = pair.y;
     let layer = virtual_layers[entry_layers[entry]];
     let world = object_world(object, scene_position(scene_indices[vertex]));
     let clip = layer.view_proj * vec4<f32>(world, 1.0);
@@ -95,7 +98,7 @@ fn vs_caster_masked(@builtin(vertex_index) vertex: u32, @builtin(instance_index)
     out.clip = placed.clip;
     out.distances = placed.distances;
     out.uv = vec2<f32>(scene_vertices[base + 6u], scene_vertices[base + 7u]);
-    out.object = caster_run.first_object + instance % caster_run.objects;
+    out.object = drawn_pair(instance).y;
     return out;
 }
 

@@ -20,6 +20,21 @@
 // A page-table entry or physical page that holds nothing.
 const NO_PAGE: u32 = 0xffffffffu;
 
+// Candidate lists of the allocation: free pages, then pages unused for at least 64, 16, 4
+// and 1 frames (`pool_side`² places each); the entries drawn this frame follow them.
+const CANDIDATE_LISTS: u32 = 5u;
+
+// Where the page lists keep the `slot`-th entry drawn this frame.
+fn drawn_place(slot: u32) -> u32 {
+    return CANDIDATE_LISTS * virtual_frame.pool_side * virtual_frame.pool_side + slot;
+}
+
+// The item of a 64-wide invocation of a dispatch spread over rows of workgroups (more than a
+// dispatch takes along one axis: `spread` in the plugin's Rust).
+fn item(id: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return id.x + id.y * groups.x * 64u;
+}
+
 // Where a point falls in one layer.
 struct PagePoint {
     // False outside the layer (beside it, nearer than its near plane or past its far one).

@@ -123,6 +123,21 @@ zoo_host::gpu_struct! {
     pub(crate) struct CasterRun {
         pub(crate) first_object: u32,
         pub(crate) objects: u32,
+        /// Where its instances start in the instance list (`virtual-maps/cull.wgsl`).
+        pub(crate) instances_at: u32,
+    }
+}
+
+zoo_host::gpu_struct! {
+    "virtual-maps/caster_box.wgsl" =>
+    /// One caster object's world box, its run and its place among the run's objects, culled
+    /// against every page drawn (`virtual-maps/cull.wgsl`).
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub(crate) struct CasterBox {
+        pub(crate) lo: Vec3,
+        pub(crate) run: u32,
+        pub(crate) hi: Vec3,
+        pub(crate) local: u32,
     }
 }
 
@@ -395,6 +410,10 @@ impl ShadowTechnique for VirtualMaps {
             counters.extend([
                 ("pages needed".to_string(), needed),
                 ("pages drawn".to_string(), value(pages::COUNT_DRAWN)),
+                (
+                    "caster instances".to_string(),
+                    value(pages::COUNT_INSTANCES),
+                ),
                 ("pages evicted".to_string(), value(pages::COUNT_EVICTED)),
                 (
                     "pages without room".to_string(),
@@ -482,6 +501,11 @@ mod tests {
         ] {
             assert_eq!(constant(name), Ok(index as i64), "{name}");
         }
+        let cull = library.compose(pages::CULL).unwrap().source;
+        assert_eq!(
+            wgsl_integer_constant(&cull, "COUNT_INSTANCES"),
+            Ok(pages::COUNT_INSTANCES as i64)
+        );
         let draw = library.compose(pages::DRAW).unwrap().source;
         assert_eq!(
             wgsl_integer_constant(&draw, "CANDIDATE_LISTS"),

@@ -13,11 +13,13 @@ use zoo_host::wgpu::util::DeviceExt;
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
 
 use crate::layers::Layout;
-use crate::{CasterRun, VirtualFrame, VirtualLayer, VirtualLight};
+use crate::{CasterBox, CasterRun, VirtualFrame, VirtualLayer, VirtualLight};
 
 /// The bookkeeping and drawing shaders.
 pub const BOOKKEEPING: &str = "virtual-maps/bookkeeping.wgsl";
 pub const DRAW: &str = "virtual-maps/draw.wgsl";
+/// The culling of casters per page.
+pub const CULL: &str = "virtual-maps/cull.wgsl";
 /// Texels around each page that filters may read (`gutter` in the shaders' frame).
 pub const GUTTER: u32 = 2;
 /// Candidate lists of the allocation (`CANDIDATE_LISTS` in the shaders).
@@ -31,6 +33,7 @@ pub const COUNT_EVICTED: usize = 9;
 pub const COUNT_NO_ROOM: usize = 10;
 pub const COUNT_FALLBACK_PIXELS: usize = 11;
 pub const COUNT_RESIDENT_BEFORE: usize = 12;
+pub const COUNT_INSTANCES: usize = 13;
 /// Invocations a row of a spread dispatch holds: as many 64-wide workgroups as a dispatch
 /// takes along one axis (`item` in `bookkeeping.wgsl`).
 const ROW: u32 = 65535 * 64;
@@ -63,6 +66,7 @@ const BOOKKEEPING_ENTRIES: [&str; 8] = [
 pub struct Stages {
     /// One per [`BOOKKEEPING_ENTRIES`].
     bookkeeping: Vec<Stage>,
+    cull: Stage,
     clear: Stage,
     /// Opaque casters, and alpha-tested ones.
     casters: [Stage; 2],
@@ -94,6 +98,7 @@ impl Stages {
                 .map(compute)
                 .into_iter()
                 .collect::<Result<_, _>>()?,
+            cull: Stage::compute(CULL, "cs_cull").build(ctx)?,
             clear: Stage::render(DRAW, "vs_clear")
                 .depth_stencil(depth(wgpu::CompareFunction::Always, 0.0))
                 .build(ctx)?,
@@ -126,11 +131,16 @@ pub struct Pages {
     layers: wgpu::Buffer,
     lights: wgpu::Buffer,
     draw_args: wgpu::Buffer,
-    /// Caster runs: (index range, object range, alpha-tested) of the scene's casters.
+    /// Caster runs: (index range, object range, alpha-tested) of the scene's casters, and
+    /// where each one's instances start.
     runs: Vec<(std::ops::Range<u32>, std::ops::Range<u32>, bool)>,
+    instances_at: Vec<u32>,
+    /// Caster objects: a dispatch over every (pool page, object) pair culls them.
+    casters: u32,
     /// Each bookkeeping stage's groups, the clear's and the casters' draws', and the lookup's
     /// tables.
     bookkeeping: Vec<Vec<StageBindGroup>>,
+    cull: Vec<StageBindGroup>,
     draw: [Vec<StageBindGroup>; 3],
     pub lookup_tables: Vec<StageBindGroup>,
     stats: Mutex<ReadbackRing>,
@@ -138,7 +148,7 @@ pub struct Pages {
     pub last_layers: Vec<zoo_host::glam::Mat4>,
 }
 
-/// A storage buffer of `bytes` (at least 16), initialised to `contents` where given.
+/// A storage buffer of `bytes` (at least 16, uninitialised).
 fn storage(
     ctx: &RenderContext<'_>,
     label: &str,
@@ -159,8 +169,9 @@ fn init(
     contents: &[u8],
     usage: wgpu::BufferUsages,
 ) -> wgpu::Buffer {
+    // At least one element of the largest struct a binding reads (an empty list binds).
     let mut bytes = contents.to_vec();
-    bytes.resize(bytes.len().max(16), 0);
+    bytes.resize(bytes.len().max(CasterBox::SIZE), 0);
     ctx.gpu
         .device
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -275,11 +286,64 @@ impl Pages {
                 runs.map(move |(indices, objects)| (indices, objects, masked))
             })
             .collect();
-        let run_words: Vec<u32> = (runs.iter())
-            .flat_map(|(indices, objects, _)| {
-                [indices.len() as u32, indices.start, objects.len() as u32, 0]
+        // Each run's instances: room for every pool page times its objects.
+        let instances_at: Vec<u32> = (runs.iter())
+            .scan(0u64, |at, (_, objects, _)| {
+                let first = *at;
+                *at += pages * objects.len() as u64;
+                Some(first as u32)
             })
             .collect();
+        let casters: u64 = runs
+            .iter()
+            .map(|(_, objects, _)| objects.len() as u64)
+            .sum();
+        if 4 * pages * casters > largest {
+            return Err(zoo_host::TechniqueError::Other(format!(
+                "virtual-maps: {casters} caster objects in each of {pages} pool pages need an \
+                 instance list of {} MiB, more than the device binds ({} MiB); lower \
+                 `pool_pages`",
+                (4 * pages * casters) >> 20,
+                largest >> 20
+            )));
+        }
+        let run_words: Vec<u32> = (runs.iter().zip(&instances_at))
+            .flat_map(|((indices, objects, _), &at)| {
+                [
+                    indices.len() as u32,
+                    indices.start,
+                    objects.len() as u32,
+                    at,
+                ]
+            })
+            .collect();
+        let boxes: Vec<CasterBox> = (runs.iter().enumerate())
+            .flat_map(|(run, (_, objects, _))| {
+                objects.clone().enumerate().map(move |(local, object)| {
+                    let (lo, hi) = ctx.scene.objects[object as usize]
+                        .bounds
+                        .unwrap_or_default();
+                    CasterBox {
+                        lo,
+                        run: run as u32,
+                        hi,
+                        local: local as u32,
+                    }
+                })
+            })
+            .collect();
+        let caster_boxes = init(
+            ctx,
+            "virtual-maps caster boxes",
+            &gpu_bytes(&boxes),
+            storage_init,
+        );
+        let instances = storage(
+            ctx,
+            "virtual-maps caster instances",
+            4 * pages * casters,
+            none,
+        );
         let caster_runs = init(
             ctx,
             "virtual-maps caster runs",
@@ -321,6 +385,16 @@ impl Pages {
                 "scene_indices",
                 ctx.scene_buffers.indices.as_entire_binding(),
             ),
+            ("instances", instances.as_entire_binding()),
+        ];
+        let cull_own = [
+            ("entry_layers", entry_layers.as_entire_binding()),
+            ("lists", lists.as_entire_binding()),
+            ("draw_args", draw_args.as_entire_binding()),
+            ("caster_runs", caster_runs.as_entire_binding()),
+            ("caster_boxes", caster_boxes.as_entire_binding()),
+            ("instances", instances.as_entire_binding()),
+            ("counts", counts.as_entire_binding()),
         ];
         let sampler = |label, filter| {
             ctx.gpu.device.create_sampler(&wgpu::SamplerDescriptor {
@@ -346,8 +420,10 @@ impl Pages {
             .map(|stage| stage.bind_own(ctx, "virtual-maps bookkeeping", &[&tables, &own]))
             .collect::<Result<_, _>>()?;
         let draw_lists: [&[(&str, wgpu::BindingResource<'_>)]; 2] = [&tables, &draw_own];
+        let cull = (stages.cull).bind_own(ctx, "virtual-maps culling", &[&tables, &cull_own])?;
         Ok(Pages {
             bookkeeping,
+            cull,
             draw: [
                 stages
                     .clear
@@ -388,6 +464,8 @@ impl Pages {
             lights: virtual_lights,
             draw_args,
             runs,
+            instances_at,
+            casters: casters as u32,
             stats: Mutex::new(stats),
             last_layers: Vec::new(),
         })
@@ -414,10 +492,11 @@ impl Pages {
         recorder: &mut PassRecorder<'_>,
         stages: &mut Stages,
     ) -> TechniqueResult {
-        let runs: Vec<CasterRun> = (self.runs.iter())
-            .map(|(_, objects, _)| CasterRun {
+        let runs: Vec<CasterRun> = (self.runs.iter().zip(&self.instances_at))
+            .map(|((_, objects, _), &instances_at)| CasterRun {
                 first_object: objects.start,
                 objects: objects.len() as u32,
+                instances_at,
             })
             .collect();
         stages.runs.write(ctx.gpu, &runs);
@@ -449,6 +528,10 @@ impl Pages {
             for k in 0..BOOKKEEPING_ENTRIES.len() - 1 {
                 dispatch(&mut pass, k)?;
             }
+            let own: Vec<&StageBindGroup> = self.cull.iter().collect();
+            let groups = (&own[..], &[] as &[&dyn kit::SharedGroup]);
+            let pairs = spread(self.pool_side * self.pool_side * self.casters);
+            stages.cull.dispatch_in(ctx, &mut pass, groups, pairs)?;
         }
         self.draw(ctx, recorder, stages)?;
         let mut pass = recorder.compute_pass("Virtual pages: fallback count");

@@ -124,6 +124,25 @@ fn a_static_view_draws_its_pages_once_and_keeps_them() {
     );
 }
 
+/// Pages draw only the casters whose boxes meet them: on `vista` (284 objects: a town near the
+/// camera, hills to the horizon) a fifth of the (page, caster) pairs are drawn, and every page
+/// at least its receiver's caster; the shadows keep their bounds (the judge tests above).
+#[test]
+fn pages_draw_only_the_casters_that_meet_them() {
+    let mut r = renderer("vista.ron", &[], UVec2::new(128, 128));
+    r.render(&View::Final).unwrap();
+    let counters = r.wait_for_counters();
+    let drawn = counter(&counters, "pages drawn").unwrap();
+    let instances = counter(&counters, "caster instances").unwrap();
+    let scene = Scene::load(&scene_path("vista.ron")).unwrap();
+    let casters = scene.objects.iter().filter(|o| o.casts_shadows).count() as f64;
+    assert!(drawn > 0.0, "{counters:?}");
+    assert!(
+        instances >= drawn && instances <= 0.3 * drawn * casters,
+        "{instances} instances for {drawn} pages of {casters} casters"
+    );
+}
+
 #[test]
 fn a_pool_too_small_falls_back_to_coarser_pages_and_keeps_the_shadows() {
     // 16 pages for three lights' pages: the finer ones find no room.
