@@ -19,8 +19,9 @@
 @group(4) @binding(0) var<storage, read_write> page_table: array<u32>;
 // Per entry: 1 when a pixel needs its page this frame.
 @group(4) @binding(1) var<storage, read_write> needed: array<atomic<u32>>;
-// Per physical page: its owning entry (NO_PAGE when free) and the last frame it was needed.
-@group(4) @binding(2) var<storage, read_write> pool_pages: array<vec2<u32>>;
+// Per physical page: its owning entry (NO_PAGE when free), the last frame it was needed, the
+// last frame it was drawn and the last frame it was taken from another entry (the debug views).
+@group(4) @binding(2) var<storage, read_write> pool_pages: array<vec4<u32>>;
 // CANDIDATE_LISTS lists of candidate pages (`pool_side`² places each), then the entries
 // whose pages are drawn this frame.
 @group(4) @binding(3) var<storage, read_write> lists: array<u32>;
@@ -206,7 +207,9 @@ fn allocate(e: u32, fallback: bool) {
         page_table[owner] = NO_PAGE;
         atomicAdd(&counts[COUNT_EVICTED], 1u);
     }
-    pool_pages[page] = vec2<u32>(e, virtual_frame.frame);
+    let frame = virtual_frame.frame;
+    let evicted = select(pool_pages[page].w, frame, owner != NO_PAGE);
+    pool_pages[page] = vec4<u32>(e, frame, frame, evicted);
     page_table[e] = page;
     let drawn = atomicAdd(&counts[COUNT_DRAWN], 1u);
     lists[drawn_place(drawn)] = e;

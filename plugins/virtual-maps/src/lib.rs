@@ -50,6 +50,10 @@ zoo_host::technique_params! {
         normal_offset: f32 = 0.5, range(0.0, 8.0), step(0.25);
         /// Slope-scaled depth bias of the page draws.
         slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.25), flags(rebuild);
+        /// The light whose page table the "page table" debug view shows.
+        debug_light: u32 = 0, range(0, 1023), step(1);
+        /// The level (within each face) the "page table" debug view shows.
+        debug_level: u32 = 0, range(0, 23), step(1);
     }
 }
 
@@ -75,6 +79,9 @@ zoo_host::gpu_struct! {
         /// How far the filter's taps reach around a receiver, in texels: the pages within it
         /// are marked.
         pub(crate) reach_texels: f32,
+        /// The light and level the page-table debug view shows.
+        pub(crate) debug_light: u32,
+        pub(crate) debug_level: u32,
     }
 }
 
@@ -155,6 +162,10 @@ const LOOKUP_SHADER: &str = "virtual-maps/lookup.wgsl";
 const LOOKUP_PASS: &str = "Virtual map lookup";
 /// The debug view of the physical pool: every page's depths in its slot.
 const POOL_VIEW: &str = "physical pool";
+/// The debug views of the bookkeeping (`virtual-maps/debug.wgsl`): the page table of the
+/// light and level the `debug_` parameters choose, and the state of every physical page.
+const PAGE_TABLE_VIEW: &str = "page table";
+const CACHE_VIEW: &str = "page cache";
 
 impl VirtualParams {
     /// The layers' sizes for a scene of diagonal `diagonal`.
@@ -280,6 +291,8 @@ impl ShadowTechnique for VirtualMaps {
         };
         vec![
             ResourceInfo::texture(POOL_VIEW, &pages.pool, true),
+            ResourceInfo::texture(PAGE_TABLE_VIEW, &pages.debug.page_table, true),
+            ResourceInfo::texture(CACHE_VIEW, &pages.debug.pool, true),
             ResourceInfo::buffer("page table", &pages.page_table, "u32"),
         ]
     }
@@ -334,6 +347,8 @@ impl ShadowTechnique for VirtualMaps {
             light_count: ctx.lights.len() as u32,
             // Marking assumes a reach under a page (corners then span at most 2x2 pages).
             reach_texels: p.filtering.reach_texels().min(sizes.page_size as f32),
+            debug_light: p.debug_light,
+            debug_level: p.debug_level,
         };
         let lights = virtual_lights(
             &pages.layout,
@@ -342,28 +357,35 @@ impl ShadowTechnique for VirtualMaps {
             ctx.scene.bounds(),
         );
         pages.write(ctx, &frame, &layers, &lights);
-        let result = pages.record(ctx, recorder, &mut gpu.stages).and_then(|()| {
-            let own: Vec<&zoo_host::kit::StageBindGroup> = pages.lookup_tables.iter().collect();
-            let filters = &gpu.filters;
-            let per_light = |light: usize| VirtualLookup {
-                light: light as u32,
-                map_filter: filters.filter(&p.filtering, light_size(&ctx.lights[light])),
-            };
-            // Each light's pass covers the pixels its range can reach.
-            let view_proj = ctx
-                .camera
-                .projection(ctx.size.x as f32 / ctx.size.y.max(1) as f32)
-                * ctx.camera.view();
-            let scissor =
-                |light: usize| Some(light_scissor(&ctx.lights[light], view_proj, ctx.size));
-            let passes = (
-                LOOKUP_PASS,
-                per_light,
-                &scissor as &dyn Fn(usize) -> Option<[u32; 4]>,
-            );
-            gpu.lookup
-                .record_scissored(ctx, recorder, passes, &own, &[])
-        });
+        let shown = match ctx.debug_view {
+            Some(PAGE_TABLE_VIEW) => Some(pages::DebugView::PageTable),
+            Some(CACHE_VIEW) => Some(pages::DebugView::Cache),
+            _ => None,
+        };
+        let result = pages
+            .record(ctx, recorder, &mut gpu.stages, shown)
+            .and_then(|()| {
+                let own: Vec<&zoo_host::kit::StageBindGroup> = pages.lookup_tables.iter().collect();
+                let filters = &gpu.filters;
+                let per_light = |light: usize| VirtualLookup {
+                    light: light as u32,
+                    map_filter: filters.filter(&p.filtering, light_size(&ctx.lights[light])),
+                };
+                // Each light's pass covers the pixels its range can reach.
+                let view_proj = ctx
+                    .camera
+                    .projection(ctx.size.x as f32 / ctx.size.y.max(1) as f32)
+                    * ctx.camera.view();
+                let scissor =
+                    |light: usize| Some(light_scissor(&ctx.lights[light], view_proj, ctx.size));
+                let passes = (
+                    LOOKUP_PASS,
+                    per_light,
+                    &scissor as &dyn Fn(usize) -> Option<[u32; 4]>,
+                );
+                gpu.lookup
+                    .record_scissored(ctx, recorder, passes, &own, &[])
+            });
         gpu.pages = Some(pages);
         result
     }
@@ -374,10 +396,22 @@ impl ShadowTechnique for VirtualMaps {
 
     fn debug_view(&self, resource: &str) -> Option<DebugImage<'_>> {
         let pages = self.gpu.built()?.pages.as_ref()?;
-        (resource == POOL_VIEW).then_some(DebugImage {
-            view: &pages.pool_view,
-            mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
-        })
+        let colors = ViewMapping::Color { min: 0.0, max: 1.0 };
+        match resource {
+            POOL_VIEW => Some(DebugImage {
+                view: &pages.pool_view,
+                mapping: ViewMapping::Depth { min: 0.0, max: 1.0 },
+            }),
+            PAGE_TABLE_VIEW => Some(DebugImage {
+                view: &pages.debug.page_table_view,
+                mapping: colors,
+            }),
+            CACHE_VIEW => Some(DebugImage {
+                view: &pages.debug.pool_view,
+                mapping: colors,
+            }),
+            _ => None,
+        }
     }
 
     fn counters(&self) -> Vec<(String, f64)> {

@@ -20,6 +20,10 @@ pub const BOOKKEEPING: &str = "virtual-maps/bookkeeping.wgsl";
 pub const DRAW: &str = "virtual-maps/draw.wgsl";
 /// The culling of casters per page.
 pub const CULL: &str = "virtual-maps/cull.wgsl";
+/// The bookkeeping's debug views.
+const DEBUG: &str = "virtual-maps/debug.wgsl";
+/// The format of the debug views' images.
+const DEBUG_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Texels around each page that filters may read (`gutter` in the shaders' frame).
 pub const GUTTER: u32 = 2;
 /// Candidate lists of the allocation (`CANDIDATE_LISTS` in the shaders).
@@ -67,6 +71,8 @@ pub struct Stages {
     /// One per [`BOOKKEEPING_ENTRIES`].
     bookkeeping: Vec<Stage>,
     cull: Stage,
+    /// The page table's debug view, and the pool's.
+    debug: [Stage; 2],
     clear: Stage,
     /// Opaque casters, and alpha-tested ones.
     casters: [Stage; 2],
@@ -99,6 +105,10 @@ impl Stages {
                 .into_iter()
                 .collect::<Result<_, _>>()?,
             cull: Stage::compute(CULL, "cs_cull").build(ctx)?,
+            debug: [
+                Stage::compute(DEBUG, "cs_page_table").build(ctx)?,
+                Stage::compute(DEBUG, "cs_pool").build(ctx)?,
+            ],
             clear: Stage::render(DRAW, "vs_clear")
                 .depth_stencil(depth(wgpu::CompareFunction::Always, 0.0))
                 .build(ctx)?,
@@ -116,6 +126,51 @@ impl Stages {
             runs,
         })
     }
+}
+
+/// A debug view of the bookkeeping, drawn when shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DebugView {
+    PageTable,
+    Cache,
+}
+
+/// The debug views' images (a texel per page-table entry of one level, and per physical
+/// page) and each view's bind group.
+pub struct DebugImages {
+    pub page_table: wgpu::Texture,
+    pub page_table_view: wgpu::TextureView,
+    pub pool: wgpu::Texture,
+    pub pool_view: wgpu::TextureView,
+    groups: [Vec<StageBindGroup>; 2],
+}
+
+/// A debug image of `width` x `height` texels that compute stages write.
+fn debug_image(
+    ctx: &RenderContext<'_>,
+    label: &str,
+    width: u32,
+    height: u32,
+) -> (wgpu::Texture, wgpu::TextureView) {
+    let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEBUG_FORMAT,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some(label),
+        ..Default::default()
+    });
+    (texture, view)
 }
 
 /// The buffers and pool of one layout, and every stage's bind groups over them.
@@ -141,6 +196,7 @@ pub struct Pages {
     /// tables.
     bookkeeping: Vec<Vec<StageBindGroup>>,
     cull: Vec<StageBindGroup>,
+    pub debug: DebugImages,
     draw: [Vec<StageBindGroup>; 3],
     pub lookup_tables: Vec<StageBindGroup>,
     stats: Mutex<ReadbackRing>,
@@ -237,7 +293,7 @@ impl Pages {
         let pool_pages_buffer = init(
             ctx,
             "virtual-maps physical pages",
-            &vec![0xff; (8 * pages) as usize],
+            &vec![0xff; (16 * pages) as usize],
             storage_init,
         );
         let lists = storage(
@@ -421,9 +477,41 @@ impl Pages {
             .collect::<Result<_, _>>()?;
         let draw_lists: [&[(&str, wgpu::BindingResource<'_>)]; 2] = [&tables, &draw_own];
         let cull = (stages.cull).bind_own(ctx, "virtual-maps culling", &[&tables, &cull_own])?;
+        // Faces side by side, a texel per page of a face's finest level.
+        let side = layout.sizes.pages;
+        let (table_image, table_view) =
+            debug_image(ctx, "virtual-maps page table view", 6 * side, side);
+        let (pool_image, pool_image_view) =
+            debug_image(ctx, "virtual-maps page cache view", pool_side, pool_side);
+        let debug_own = [
+            ("page_table", page_table.as_entire_binding()),
+            ("needed", needed.as_entire_binding()),
+            ("pool_pages", pool_pages_buffer.as_entire_binding()),
+            (
+                "page_table_image",
+                wgpu::BindingResource::TextureView(&table_view),
+            ),
+            (
+                "pool_image",
+                wgpu::BindingResource::TextureView(&pool_image_view),
+            ),
+        ];
+        let debug_group =
+            |stage: &Stage| stage.bind_own(ctx, "virtual-maps debug view", &[&tables, &debug_own]);
+        let debug = DebugImages {
+            groups: [
+                debug_group(&stages.debug[0])?,
+                debug_group(&stages.debug[1])?,
+            ],
+            page_table: table_image,
+            page_table_view: table_view,
+            pool: pool_image,
+            pool_view: pool_image_view,
+        };
         Ok(Pages {
             bookkeeping,
             cull,
+            debug,
             draw: [
                 stages
                     .clear
@@ -491,6 +579,7 @@ impl Pages {
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         stages: &mut Stages,
+        shown: Option<DebugView>,
     ) -> TechniqueResult {
         let runs: Vec<CasterRun> = (self.runs.iter().zip(&self.instances_at))
             .map(|((_, objects, _), &instances_at)| CasterRun {
@@ -537,6 +626,21 @@ impl Pages {
         let mut pass = recorder.compute_pass("Virtual pages: fallback count");
         dispatch(&mut pass, BOOKKEEPING_ENTRIES.len() - 1)?;
         drop(pass);
+        if let Some(view) = shown {
+            let (k, extent) = match view {
+                DebugView::PageTable => (0, self.debug.page_table.size()),
+                DebugView::Cache => (1, self.debug.pool.size()),
+            };
+            let own: Vec<&StageBindGroup> = self.debug.groups[k].iter().collect();
+            (stages.debug[k]).dispatch(
+                ctx,
+                recorder,
+                "Virtual pages: debug view",
+                &own,
+                &[],
+                [extent.width, extent.height, 1],
+            )?;
+        }
         let ring = self.stats.lock().ok();
         if let Some(target) = ring.and_then(|mut ring| ring.target().cloned()) {
             recorder

@@ -143,6 +143,54 @@ fn pages_draw_only_the_casters_that_meet_them() {
     );
 }
 
+/// Cells of the "page cache" view (`side` x `side` pages over `size`), counted by colour:
+/// drawn this frame (yellow or orange), needed and cached (green), other.
+fn cache_view_cells(r: &mut Renderer, side: u32, size: u32) -> [usize; 3] {
+    r.render(&View::Resource("page cache".into())).unwrap();
+    let image = r.read_output();
+    let cell = size / side;
+    let mut counts = [0; 3];
+    for y in 0..side {
+        for x in 0..side {
+            let [red, green, _, _] = image.get_pixel(x * cell + cell / 2, y * cell + cell / 2).0;
+            let class = match (red > 200, green > 150) {
+                (true, _) => 0,
+                (false, true) => 1,
+                _ => 2,
+            };
+            counts[class] += 1;
+        }
+    }
+    counts
+}
+
+/// The cache view shows what the counters count: after the first frame every resident page
+/// was drawn in it; when the view is still, none is drawn and the needed ones are cached.
+#[test]
+fn the_cache_view_shows_pages_drawn_and_kept() {
+    let mut r = renderer(
+        "planar-room.ron",
+        &[("pool_pages", "64")],
+        UVec2::new(128, 128),
+    );
+    let first = cache_view_cells(&mut r, 8, 128);
+    let counters = r.wait_for_counters();
+    let drawn = counter(&counters, "pages drawn").unwrap();
+    assert!(drawn > 0.0, "{counters:?}");
+    assert_eq!(first[0] as f64, drawn, "{first:?} {counters:?}");
+    assert_eq!(first[1], 0, "{first:?}");
+    cache_view_cells(&mut r, 8, 128);
+    let still = cache_view_cells(&mut r, 8, 128);
+    let counters = r.wait_for_counters();
+    assert_eq!(counter(&counters, "pages drawn"), Some(0.0), "{counters:?}");
+    let resident = counter(&counters, "pages resident").unwrap();
+    assert_eq!(
+        (still[0], still[1] as f64),
+        (0, resident),
+        "{still:?} {counters:?}"
+    );
+}
+
 #[test]
 fn a_pool_too_small_falls_back_to_coarser_pages_and_keeps_the_shadows() {
     // 16 pages for three lights' pages: the finer ones find no room.
