@@ -41,7 +41,7 @@ zoo_host::technique_params! {
         /// scaled by any factor is shadowed alike; 1/512 of a 1.6 km scene is about 3 m).
         first_level_fraction: f32 = 0.002, range(0.0001, 1.0), step(0.0005);
         /// Physical pages in the pool (rounded up to a square, within the device's texture
-        /// size).
+        /// size and the 1 GiB that shadow maps keep to).
         pool_pages: u32 = 1024, range(16, 16384), step(16), flags(rebuild);
         /// Multiplies the pixel footprint a level's texels must match (below 1: finer pages,
         /// more of them; 0.5 keeps shadows a pixel wide, of wires, on the right pixels).

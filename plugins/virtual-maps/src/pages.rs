@@ -11,6 +11,7 @@ use zoo_host::kit::{self, Stage, StageBindGroup, UniformSlots};
 use zoo_host::render::drawn_runs;
 use zoo_host::wgpu::util::DeviceExt;
 use zoo_host::{RenderContext, TechniqueResult, wgpu};
+use zoo_shadow_maps::MEMORY_BUDGET;
 
 use crate::layers::Layout;
 use crate::{CasterBox, CasterRun, VirtualFrame, VirtualLayer, VirtualLight};
@@ -48,6 +49,16 @@ fn spread(items: u32) -> [u32; 3] {
         true => [items, 1, 1],
         false => [ROW, items.div_ceil(ROW), 1],
     }
+}
+
+/// Slots a side of a pool of about `pool_pages` slots of `slot` texels a side: a square,
+/// within the device's largest texture (`largest` texels a side) and the memory budget the
+/// shadow-map atlas keeps to ([`MEMORY_BUDGET`]).
+fn pool_side(pool_pages: u32, slot: u32, largest: u32) -> u32 {
+    let slot_bytes = u64::from(slot).pow(2) * POOL_FORMAT.block_copy_size(None).unwrap_or(4) as u64;
+    let budget = ((MEMORY_BUDGET / slot_bytes) as f64).sqrt() as u32;
+    let side = f64::from(pool_pages).sqrt().ceil() as u32;
+    side.min(largest / slot).min(budget).max(1)
 }
 
 /// The depth format of the pool.
@@ -247,8 +258,11 @@ impl Pages {
         pool_pages: u32,
     ) -> TechniqueResult<Pages> {
         let slot = layout.sizes.page_size + 2 * GUTTER;
-        let largest = ctx.gpu.device.limits().max_texture_dimension_2d / slot;
-        let pool_side = (f64::from(pool_pages).sqrt().ceil() as u32).clamp(1, largest.max(1));
+        let pool_side = pool_side(
+            pool_pages,
+            slot,
+            ctx.gpu.device.limits().max_texture_dimension_2d,
+        );
         let texels = pool_side * slot;
         let pool = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("virtual-maps physical pool"),
@@ -701,6 +715,19 @@ impl Pages {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_pool_keeps_to_the_texture_size_and_the_shadow_map_budget() {
+        // 1024 slots of 132² texels: 32 a side, 68 MiB.
+        assert_eq!(pool_side(1024, 132, 16384), 32);
+        assert_eq!(pool_side(1000, 132, 16384), 32);
+        // The device's largest texture: 8192 / 132 slots a side.
+        assert_eq!(pool_side(16384, 132, 8192), 62);
+        // 16384 slots of 516² texels would be 16 GiB: the 1 GiB budget leaves 31 a side.
+        let side = pool_side(16384, 516, 1 << 20);
+        assert_eq!(side, 31);
+        assert!(u64::from(side * 516).pow(2) * 4 <= MEMORY_BUDGET);
+    }
 
     #[test]
     fn dispatches_past_one_axis_spread_over_rows() {
