@@ -1,6 +1,6 @@
 // Virtual shadow maps, the page bookkeeping of a frame, all on the GPU (nothing read back):
-// 1. `cs_invalidate`: the pages of layers that moved (a light that moved or turned, a clipmap
-//    level that scrolled) are freed;
+// 1. `cs_invalidate`: the pages of layers that moved (a light that moved or turned) are
+//    freed, and of a clipmap level that scrolled with the camera, those that left its window;
 // 2. `cs_mark`: every pixel marks the page each light needs there, and its light's fallback
 //    level's page too;
 // 3. `cs_age`: needed pages already resident are kept (their last use is this frame);
@@ -53,12 +53,29 @@ fn cs_invalidate(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_work
     if e >= arrayLength(&entry_layers) {
         return;
     }
-    let layer = entry_layers[e];
+    let l = virtual_layers[entry_layers[e]];
     let page = page_table[e];
-    if virtual_layers[layer].invalidate != 0u && page != NO_PAGE {
-        pool_pages[page].x = NO_PAGE;
-        page_table[e] = NO_PAGE;
+    if page == NO_PAGE || l.invalidate == INVALIDATE_NONE {
+        return;
     }
+    if l.invalidate == INVALIDATE_SCROLLED {
+        // The grid page the entry held in the last window stays if the new window holds it.
+        let n = i32(l.pages);
+        let last = l.origin - l.scrolled;
+        let held = last + vec2<i32>(window_page_at(l, e, last));
+        if all(held >= l.origin) && all(held < l.origin + n) {
+            return;
+        }
+    }
+    pool_pages[page].x = NO_PAGE;
+    page_table[e] = NO_PAGE;
+}
+
+// The page of a window at `origin` over layer `l`'s grid that entry `e` holds.
+fn window_page_at(l: VirtualLayer, e: u32, origin: vec2<i32>) -> vec2<u32> {
+    var at = l;
+    at.origin = origin;
+    return window_page(at, e);
 }
 
 fn mark(found: PagePoint) {
@@ -124,14 +141,12 @@ fn mark_reach(light: u32, level: u32, p: vec3<f32>, n: vec3<f32>) {
     var lo = vec2<u32>(l.pages);
     var hi = vec2<u32>(0u);
     for (var corner = 0u; corner < 4u; corner++) {
-        let index = corners[corner].entry - l.first_entry;
-        let page = vec2<u32>(index % l.pages, index / l.pages);
-        lo = min(lo, page);
-        hi = max(hi, page);
+        lo = min(lo, corners[corner].page);
+        hi = max(hi, corners[corner].page);
     }
     for (var y = lo.y; y <= hi.y; y++) {
         for (var x = lo.x; x <= hi.x; x++) {
-            atomicStore(&needed[l.first_entry + y * l.pages + x], 1u);
+            atomicStore(&needed[layer_entry(l, vec2<u32>(x, y))], 1u);
         }
     }
 }

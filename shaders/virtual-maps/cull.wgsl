@@ -39,9 +39,8 @@ fn page_meets(entry: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
         low = min(low, at);
         high = max(high, at);
     }
-    let index = entry - layer.first_entry;
     let pages = f32(layer.pages);
-    let page = vec2<f32>(f32(index % layer.pages), f32(index / layer.pages));
+    let page = vec2<f32>(window_page(layer, entry));
     let gutter = f32(virtual_frame.gutter) / f32(virtual_frame.page_size);
     let page_lo = vec3<f32>((page - gutter) / pages, 0.0);
     let page_hi = vec3<f32>((page + 1.0 + gutter) / pages, 1.0);

@@ -53,7 +53,7 @@ fn cs_page_table(@builtin(global_invocation_id) id: vec3<u32>) {
             let layer = virtual_layers[layer_of(light, face, virtual_frame.debug_level)];
             let page = vec2<u32>(id.x % side, id.y);
             if all(page < vec2<u32>(layer.pages)) {
-                let entry = layer.first_entry + page.y * layer.pages + page.x;
+                let entry = layer_entry(layer, page);
                 let physical = page_table[entry];
                 let wanted = needed[entry] != 0u;
                 if physical != NO_PAGE {

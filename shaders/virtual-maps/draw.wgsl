@@ -59,8 +59,7 @@ fn page_vertex(vertex: u32, instance: u32) -> PageVertex {
     let world = object_world(object, scene_position(scene_indices[vertex]));
     let clip = layer.view_proj * vec4<f32>(world, 1.0);
     // The page's position in its layer, and the point's in the page times w (v from the top).
-    let index = entry - layer.first_entry;
-    let page = vec2<f32>(f32(index % layer.pages), f32(index / layer.pages));
+    let page = vec2<f32>(window_page(layer, entry));
     let pages = f32(layer.pages);
     let u = (clip.x + clip.w) * 0.5 * pages - page.x * clip.w;
     let v = (clip.w - clip.y) * 0.5 * pages - page.y * clip.w;

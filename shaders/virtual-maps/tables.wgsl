@@ -20,6 +20,12 @@
 // A page-table entry or physical page that holds nothing.
 const NO_PAGE: u32 = 0xffffffffu;
 
+// Which pages of a layer a frame frees first (`Invalidate` in the plugin's Rust): none, every
+// one (the layer moved), or those that left its window (a clipmap level that scrolled).
+const INVALIDATE_NONE: u32 = 0u;
+const INVALIDATE_ALL: u32 = 1u;
+const INVALIDATE_SCROLLED: u32 = 2u;
+
 // Candidate lists of the allocation: free pages, then pages unused for at least 64, 16, 4
 // and 1 frames (`pool_side`² places each); the entries drawn this frame follow them.
 const CANDIDATE_LISTS: u32 = 5u;
@@ -41,7 +47,9 @@ struct PagePoint {
     found: bool,
     layer: u32,
     level: u32,
-    // Its page's page-table entry, and the point's position in the page in [0, 1).
+    // Its page in the layer's window, that page's page-table entry, and the point's position
+    // in the page in [0, 1).
+    page: vec2<u32>,
     entry: u32,
     local: vec2<f32>,
     // Its depth in the layer.
@@ -52,6 +60,26 @@ struct PagePoint {
 fn layer_of(light: u32, face: u32, level: u32) -> u32 {
     let v = virtual_lights[light];
     return v.first_layer + face * v.levels + level;
+}
+
+// `v` modulo `n`, in [0, n).
+fn wrap(v: vec2<i32>, n: i32) -> vec2<i32> {
+    return ((v % n) + n) % n;
+}
+
+// The page-table entry of page `page` of layer `l`'s window. A layer's entries hold the pages
+// of its endless page grid modulo its size: a clipmap level whose window scrolls (its `origin`)
+// keeps the entries of the pages still inside it.
+fn layer_entry(l: VirtualLayer, page: vec2<u32>) -> u32 {
+    let at = wrap(vec2<i32>(page) + l.origin, i32(l.pages));
+    return l.first_entry + u32(at.y) * l.pages + u32(at.x);
+}
+
+// The page of layer `l`'s window that entry `entry` holds.
+fn window_page(l: VirtualLayer, entry: u32) -> vec2<u32> {
+    let index = entry - l.first_entry;
+    let at = vec2<i32>(vec2<u32>(index % l.pages, index / l.pages));
+    return vec2<u32>(wrap(at - l.origin, i32(l.pages)));
 }
 
 // Where `p` falls in layer `layer`.
@@ -72,7 +100,8 @@ fn page_point(layer: u32, p: vec3<f32>) -> PagePoint {
     out.found = true;
     out.layer = layer;
     out.level = l.level;
-    out.entry = l.first_entry + page.y * l.pages + page.x;
+    out.page = page;
+    out.entry = layer_entry(l, page);
     out.local = uv * pages - vec2<f32>(page);
     out.depth = ndc.z;
     return out;

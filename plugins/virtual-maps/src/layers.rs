@@ -2,14 +2,15 @@
 //!
 //! A directional light's virtual map is a clipmap: `levels` square levels centred on the
 //! camera, level k covering `first_level_size` · 2^k with `pages` pages a side, each
-//! level's centre snapped to its page grid (so a level moves, and its pages are redrawn, only
-//! when the camera crosses a page of it). A spot light's virtual map is one frustum around its
-//! cone with mip levels (level k: `pages` >> k pages a side), a point light's six cube faces
-//! with mip levels each. The page table holds one entry per page of every layer, layer after
-//! layer.
+//! level's centre snapped to its page grid: a level scrolls by whole pages as the camera
+//! crosses them, and its page table is a window over the level's endless page grid, addressed
+//! modulo its size, so the pages still inside the window keep their entries. A spot light's
+//! virtual map is one frustum around its cone with mip levels (level k: `pages` >> k pages a
+//! side), a point light's six cube faces with mip levels each. The page table holds one entry
+//! per page of every layer, layer after layer.
 
 use zoo_host::glam::camera::rh::{proj::directx, view::look_to_mat4};
-use zoo_host::glam::{Mat4, Vec3};
+use zoo_host::glam::{IVec2, Mat4, Vec3};
 use zoo_host::scene::{Camera, Light, LightKind};
 use zoo_shadow_maps::light_space::{CUBE_FACES, perspective_near, resolvable, spot_frustum};
 
@@ -127,26 +128,56 @@ pub fn depth_range(direction: Vec3, bounds: (Vec3, Vec3)) -> (f32, f32) {
     (near - margin, far + margin)
 }
 
-/// The view and projection of clipmap level `level` of a light along `direction`, centred on
-/// `camera` snapped to the level's page grid, over the depth range of `bounds`.
+/// Where a layer lies this frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LayerView {
+    /// Its view and projection.
+    pub view_proj: Mat4,
+    /// The same with its window centred on the light's axis: what stays while a clipmap level
+    /// only scrolls.
+    pub unscrolled: Mat4,
+    /// Its window's first page (left, top) on the level's page grid, whose pages keep their
+    /// page-table entries (modulo the window's size) as it scrolls; 0 for mip levels.
+    pub origin: IVec2,
+}
+
+impl LayerView {
+    /// A layer that does not scroll.
+    fn fixed(view_proj: Mat4) -> LayerView {
+        LayerView {
+            view_proj,
+            unscrolled: view_proj,
+            origin: IVec2::ZERO,
+        }
+    }
+}
+
+/// Clipmap level `level` of a light along `direction`, centred on `camera` snapped to the
+/// level's page grid, over the depth range of `bounds`.
 pub fn clip_level(
     direction: Vec3,
     sizes: &Sizes,
     level: u32,
     camera: Vec3,
     bounds: (Vec3, Vec3),
-) -> Mat4 {
+) -> LayerView {
     let direction = direction.normalize();
     let rotation = look_to_mat4(Vec3::ZERO, direction, up_for(direction));
     let extent = sizes.first_level_size * (1u64 << level.min(62)) as f32;
     let page = extent / sizes.pages as f32;
     let centre = rotation.transform_point3(camera);
-    let snap = |v: f32| (v / page).round() * page;
-    let (x, y) = (snap(centre.x), snap(centre.y));
+    let (kx, ky) = ((centre.x / page).round(), (centre.y / page).round());
+    let (x, y) = (kx * page, ky * page);
     let (near, far) = depth_range(direction, bounds);
     let h = extent * 0.5;
     debug_assert!(near < far);
-    directx::orthographic(x - h, x + h, y - h, y + h, near, far) * rotation
+    // Pages run left to right and top (largest y) down.
+    let half = (sizes.pages / 2) as i32;
+    LayerView {
+        view_proj: directx::orthographic(x - h, x + h, y - h, y + h, near, far) * rotation,
+        unscrolled: directx::orthographic(-h, h, -h, h, near, far) * rotation,
+        origin: IVec2::new(kx as i32 - half, -(ky as i32 + half)),
+    }
 }
 
 /// The clipmap level whose pages are at least as wide as the whole of `bounds` seen from
@@ -183,14 +214,14 @@ fn up_for(direction: Vec3) -> Vec3 {
     }
 }
 
-/// The view and projection of every layer of `light` (`layers` of the layout).
+/// Where every layer of `light` (`layers` of the layout) lies this frame.
 pub fn light_layers(
     light: &Light,
     layers: &LightLayers,
     sizes: &Sizes,
     camera: &Camera,
     bounds: (Vec3, Vec3),
-) -> Vec<Mat4> {
+) -> Vec<LayerView> {
     if layers.clipmap {
         return (0..layers.levels)
             .map(|level| clip_level(light.direction, sizes, level, camera.position, bounds))
@@ -211,14 +242,14 @@ pub fn light_layers(
     // Mip levels share their face's projection.
     faces
         .into_iter()
-        .flat_map(|m| std::iter::repeat_n(m, layers.levels as usize))
+        .flat_map(|m| std::iter::repeat_n(LayerView::fixed(m), layers.levels as usize))
         .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use zoo_host::glam::Vec4Swizzles;
+    use zoo_host::glam::{Vec2, Vec4Swizzles};
 
     fn sizes() -> Sizes {
         Sizes {
@@ -270,8 +301,8 @@ mod tests {
         let bounds = (Vec3::splat(-50.0), Vec3::splat(50.0));
         let dir = Vec3::new(0.3, -1.0, 0.2);
         let camera = Vec3::new(3.1, 1.0, -2.2);
-        let m0 = clip_level(dir, &s, 0, camera, bounds);
-        let m3 = clip_level(dir, &s, 3, camera, bounds);
+        let m0 = clip_level(dir, &s, 0, camera, bounds).view_proj;
+        let m3 = clip_level(dir, &s, 3, camera, bounds).view_proj;
         // The camera lies inside every level, within a page of the centre.
         for (m, pages) in [(m0, 16.0), (m3, 16.0)] {
             let ndc = (m * camera.extend(1.0)).xy();
@@ -283,7 +314,7 @@ mod tests {
         let d3 = (m3 * (camera + step).extend(1.0)).xy() - (m3 * camera.extend(1.0)).xy();
         assert!((d0.length() / d3.length() - 8.0).abs() < 1e-3);
         // Moving less than a page (level 0: 0.5 m) leaves it, or moves it by one page exactly.
-        let moved = clip_level(dir, &s, 0, camera + Vec3::new(0.05, 0.0, 0.0), bounds);
+        let moved = clip_level(dir, &s, 0, camera + Vec3::new(0.05, 0.0, 0.0), bounds).view_proj;
         let shift = (moved * camera.extend(1.0)).xy() - (m0 * camera.extend(1.0)).xy();
         let pages = shift.abs() * 16.0 / 2.0;
         assert!(pages.max_element() < 1e-3 || (pages.max_element() - 1.0).abs() < 1e-3);
@@ -292,6 +323,43 @@ mod tests {
             let z = (m0 * corner.extend(1.0)).z;
             assert!((0.0..=1.0).contains(&z), "{z}");
         }
+    }
+
+    /// The page of the level's grid a world point falls in: its page in the window plus the
+    /// window's origin (as the shaders address the page table).
+    fn grid_page(view: &LayerView, pages: u32, p: Vec3) -> IVec2 {
+        let ndc = (view.view_proj * p.extend(1.0)).xy();
+        let uv = Vec2::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+        (uv * pages as f32).floor().as_ivec2() + view.origin
+    }
+
+    #[test]
+    fn a_scrolling_level_keeps_each_world_page_on_its_grid_page() {
+        let s = sizes();
+        let bounds = (Vec3::splat(-50.0), Vec3::splat(50.0));
+        let dir = Vec3::new(0.3, -1.0, 0.2);
+        let camera = Vec3::new(3.1, 1.0, -2.2);
+        let points = [camera, camera + Vec3::new(1.3, 0.2, -0.7), camera - Vec3::X];
+        let before = clip_level(dir, &s, 1, camera, bounds);
+        // Level 1's pages are 1 m wide: walk 0.25 m at a time across several of them.
+        let mut scrolled = 0;
+        for step in 1..40 {
+            let walked = camera + Vec3::new(0.25, 0.0, 0.1) * step as f32;
+            let after = clip_level(dir, &s, 1, walked, bounds);
+            assert_eq!(after.unscrolled, before.unscrolled);
+            scrolled += usize::from(after.origin != before.origin);
+            for p in points {
+                assert_eq!(
+                    grid_page(&before, 16, p),
+                    grid_page(&after, 16, p),
+                    "{step}"
+                );
+            }
+        }
+        assert!(scrolled > 30, "the window scrolled {scrolled} times");
+        // A turning light moves the whole level.
+        let turned = clip_level(dir + Vec3::X * 0.1, &s, 1, camera, bounds);
+        assert_ne!(turned.unscrolled, before.unscrolled);
     }
 
     #[test]
@@ -305,7 +373,7 @@ mod tests {
         for half in [0.01f32, 0.5, 3.0, 20.0, 90.0] {
             let bounds = (Vec3::splat(-half), Vec3::splat(half));
             let level = fallback_level(dir, &s, camera, bounds);
-            let m = clip_level(dir, &s, level, camera, bounds);
+            let m = clip_level(dir, &s, level, camera, bounds).view_proj;
             // The pages (of 16 a side) each corner falls in, over both axes.
             let page = |c: Vec3| {
                 let ndc = (m * c.extend(1.0)).xy();
@@ -353,8 +421,9 @@ mod tests {
         assert_eq!(layers.len(), 30);
         assert_eq!(layers[0], layers[4]);
         assert_ne!(layers[4], layers[5]);
+        assert!(layers.iter().all(|l| l.origin == IVec2::ZERO));
         // A point below the light projects into face -Y's centre.
-        let clip = layers[3 * 5] * (point.position - Vec3::Y).extend(1.0);
+        let clip = layers[3 * 5].view_proj * (point.position - Vec3::Y).extend(1.0);
         let ndc = clip.xyz() / clip.w;
         assert!(ndc.truncate().length() < 1e-4 && (0.0..1.0).contains(&ndc.z));
     }

@@ -1,9 +1,9 @@
 //! Virtual shadow maps: each light's map is far larger than any texture, split into pages of
 //! which only those that visible pixels need are allocated from one physical pool, drawn,
-//! and kept across frames until their layer moves (a light that moves or turns, a clipmap
-//! level that scrolls with the camera). Directional lights get a clipmap of levels centred on
-//! the camera, each twice the size of the one before; spot lights one frustum and point
-//! lights six cube faces, with mip levels each (`layers.rs`).
+//! and kept across frames until their layer moves (a light that moves or turns) or scrolls
+//! past them (a clipmap level following the camera). Directional lights get a clipmap of
+//! levels centred on the camera, each twice the size of the one before; spot lights one
+//! frustum and point lights six cube faces, with mip levels each (`layers.rs`).
 //!
 //! Every step runs on the GPU each frame, nothing read back but counters
 //! (`shaders/virtual-maps/bookkeeping.wgsl`, `pages.rs`): pixels mark the pages they need
@@ -16,12 +16,12 @@
 mod layers;
 mod pages;
 
-use zoo_host::glam::{Mat4, Vec3};
+use zoo_host::glam::{IVec2, Mat4, Vec3};
 use zoo_host::kit::FullscreenLightPass;
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 
-use layers::{Layout, Sizes, depth_range, fallback_level, light_layers};
+use layers::{LayerView, Layout, Sizes, depth_range, fallback_level, light_layers};
 use pages::{GUTTER, Pages, Stages};
 use zoo_shadow_maps::light_space::perspective_near;
 use zoo_shadow_maps::{FilterParams, MapFilter, MapFilters, light_scissor, light_size};
@@ -91,15 +91,31 @@ zoo_host::gpu_struct! {
     #[derive(Debug, Clone, Copy, PartialEq)]
     pub(crate) struct VirtualLayer {
         pub(crate) view_proj: Mat4,
+        /// Its window's first page on its page grid (`LayerView::origin`), and how far the
+        /// window scrolled since the last frame.
+        pub(crate) origin: IVec2,
+        pub(crate) scrolled: IVec2,
         /// Pages a side, and its first page-table entry.
         pub(crate) pages: u32,
         pub(crate) first_entry: u32,
         /// Its level within its face, and its light.
         pub(crate) level: u32,
         pub(crate) light: u32,
-        /// 1 when it moved since the last frame: its pages are freed.
+        /// Which of its pages are freed ([`Invalidate`]).
         pub(crate) invalidate: u32,
     }
+}
+
+/// Which pages of a layer are freed at the start of a frame (`INVALIDATE_*` in
+/// `virtual-maps/tables.wgsl`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Invalidate {
+    /// None: the layer has not moved.
+    None = 0,
+    /// Every one: the layer moved (a light that moved or turned) or nothing may be kept.
+    All = 1,
+    /// Those that left its window: a clipmap level that scrolled.
+    Scrolled = 2,
 }
 
 zoo_host::gpu_struct! {
@@ -244,30 +260,39 @@ struct VirtualMaps {
 }
 
 impl VirtualMaps {
-    /// This frame's layers; those whose matrix changed since the last frame (or every one,
-    /// where unchanged work may not be kept) are invalidated.
+    /// This frame's layers; those that moved since the last frame free their pages (every
+    /// one, or for a clipmap level that only scrolled, those that left its window), and every
+    /// layer does where unchanged work may not be kept.
     fn frame_layers(&self, ctx: &RenderContext<'_>, pages: &mut Pages) -> Vec<VirtualLayer> {
         let sizes = pages.layout.sizes;
         let bounds = ctx.scene.bounds();
-        let matrices: Vec<Mat4> = (pages.layout.lights.iter().zip(ctx.lights))
+        let views: Vec<LayerView> = (pages.layout.lights.iter().zip(ctx.lights))
             .flat_map(|(layers, light)| light_layers(light, layers, &sizes, ctx.camera, bounds))
             .collect();
-        let layers = (matrices.iter().enumerate())
-            .map(|(k, m)| {
+        let layers = (views.iter().enumerate())
+            .map(|(k, view)| {
                 let (count, first_entry) = pages.layout.layers[k];
-                let moved = pages.last_layers.get(k) != Some(m);
+                let last = pages.last_layers.get(k);
+                let invalidate = match last {
+                    _ if !ctx.reuse_unchanged => Invalidate::All,
+                    Some(last) if last == view => Invalidate::None,
+                    Some(last) if last.unscrolled == view.unscrolled => Invalidate::Scrolled,
+                    _ => Invalidate::All,
+                };
                 let (light, level) = light_and_level(&pages.layout, k);
                 VirtualLayer {
-                    view_proj: *m,
+                    view_proj: view.view_proj,
+                    origin: view.origin,
+                    scrolled: last.map_or(IVec2::ZERO, |last| view.origin - last.origin),
                     pages: count,
                     first_entry,
                     level,
                     light,
-                    invalidate: u32::from(moved || !ctx.reuse_unchanged),
+                    invalidate: invalidate as u32,
                 }
             })
             .collect();
-        pages.last_layers = matrices;
+        pages.last_layers = views;
         layers
     }
 }
@@ -524,6 +549,11 @@ mod tests {
             constant("CANDIDATE_LISTS"),
             Ok(pages::CANDIDATE_LISTS as i64)
         );
+        for invalidate in [Invalidate::None, Invalidate::All, Invalidate::Scrolled] {
+            let name = format!("INVALIDATE_{}", format!("{invalidate:?}").to_uppercase());
+            let code = wgsl_integer_constant(&source, &name);
+            assert_eq!(code, Ok(invalidate as i64), "{name}");
+        }
         for (name, index) in [
             ("COUNT_DRAWN", pages::COUNT_DRAWN),
             ("COUNT_NEEDED", pages::COUNT_NEEDED),

@@ -211,8 +211,8 @@ pub struct Pages {
     draw: [Vec<StageBindGroup>; 3],
     pub lookup_tables: Vec<StageBindGroup>,
     stats: Mutex<ReadbackRing>,
-    /// The layers' matrices of the last frame, to find the layers that moved.
-    pub last_layers: Vec<zoo_host::glam::Mat4>,
+    /// Where the layers lay in the last frame, to find those that moved.
+    pub last_layers: Vec<crate::layers::LayerView>,
 }
 
 /// A storage buffer of `bytes` (at least 16, uninitialised).

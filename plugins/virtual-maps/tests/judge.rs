@@ -191,6 +191,44 @@ fn the_cache_view_shows_pages_drawn_and_kept() {
     );
 }
 
+/// A camera walking over `kilometre` scrolls the clipmap levels under it: each level keeps the
+/// pages still inside its window (addressed modulo the window) and draws only those it gains.
+/// Walking back over the same ground draws nothing (a level that freed its pages whenever it
+/// scrolled would redraw them), and the shadows are those of pages all drawn afresh.
+#[test]
+fn scrolling_clipmap_levels_keep_their_pages() {
+    let size = UVec2::new(128, 128);
+    let hard = [("filter", "None")];
+    let mut walked = renderer("kilometre.ron", &hard, size);
+    walked.render(&View::Final).unwrap();
+    let start = *walked.camera();
+    // 2 m a step: the levels 128x128 pixels read (pages of 0.8 to 6.4 m) scroll by a page or
+    // more in most steps, and the view sees ground it did not see.
+    let step = zoo_host::glam::Vec3::new(2.0, 0.0, -1.0);
+    let walk = |walked: &mut Renderer, to: i32| {
+        let mut camera = start;
+        camera.position += step * to as f32;
+        camera.target += step * to as f32;
+        walked.set_camera(camera);
+        walked.render(&View::Visibility { light: 0 }).unwrap();
+        let counters = walked.wait_for_counters();
+        counter(&counters, "pages drawn").unwrap()
+    };
+    let out: f64 = (1..=4).map(|to| walk(&mut walked, to)).sum();
+    let back: f64 = (0..4).rev().map(|to| walk(&mut walked, to)).sum();
+    assert!(out > 0.0, "the walk saw no new ground");
+    assert_eq!(
+        back, 0.0,
+        "pages redrawn on the way back ({out} on the way out)"
+    );
+    let mut fresh = renderer("kilometre.ron", &hard, size);
+    fresh.set_camera(start);
+    fresh.render(&View::Visibility { light: 0 }).unwrap();
+    let (a, b) = (walked.read_output(), fresh.read_output());
+    let differ = (a.pixels().zip(b.pixels())).filter(|(p, q)| p != q).count();
+    assert_eq!(differ, 0, "pixels the kept pages shadow unlike fresh ones");
+}
+
 #[test]
 fn a_pool_too_small_falls_back_to_coarser_pages_and_keeps_the_shadows() {
     // 16 pages for three lights' pages: the finer ones find no room.
