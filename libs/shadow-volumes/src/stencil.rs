@@ -8,8 +8,11 @@ use zoo_host::{RenderContext, TechniqueResult, wgpu};
 pub(crate) const STENCIL_READ: &str = "shadow-volumes/stencil_read.wgsl";
 
 zoo_host::param_choice! {
-    /// How volume crossings are counted.
-    pub enum Counting { ZFail, ZPass }
+    /// How volume crossings are counted: z-fail (exact wherever the camera is), z-pass (wrong
+    /// where a volume reaches the near plane), or for each light the cheaper one that is exact
+    /// (Everitt and Kilgard: z-pass unless the light's near-clip volume meets a caster,
+    /// [`crate::near_clip`]).
+    pub enum Counting { ZFail, ZPass, Auto }
 }
 
 /// Volume vertices: `vec4<f32>` positions, w = 0 for points at infinity.
@@ -49,7 +52,8 @@ pub fn volume_depth_stencil(
         wgpu::StencilOperation::DecrementWrap,
     );
     let (front, back) = match counting {
-        Counting::ZFail => (face(keep, decrement), face(keep, increment)),
+        // A light counted by `Auto` takes one of the other two, chosen by the technique.
+        Counting::ZFail | Counting::Auto => (face(keep, decrement), face(keep, increment)),
         Counting::ZPass => (face(increment, keep), face(decrement, keep)),
     };
     stencil_state(wgpu::CompareFunction::Less, front, back, bias)

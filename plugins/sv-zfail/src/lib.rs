@@ -27,13 +27,16 @@ use zoo_host::{
 mod passes;
 
 use passes::{COUNTS_VIEW, OVERLAY_VIEW, Passes};
-use zoo_shadow_volumes::{ARGS_BYTES, VolumeShape, piece_pass_name};
+use zoo_shadow_volumes::culling::reaches_box;
+use zoo_shadow_volumes::{ARGS_BYTES, VolumeShape, piece_pass_name, zpass_is_exact};
 pub use zoo_shadow_volumes::{Counting, Volumes, silhouette};
 
 zoo_host::technique_params! {
     /// Parameters of stencil shadow volumes.
     pub struct SvParams {
-        /// Counting: z-fail (robust, the default) or z-pass (wrong with the camera in a shadow).
+        /// Counting: z-fail (robust, the default), z-pass (wrong with the camera in a shadow),
+        /// or Auto: per light, z-pass where no caster meets the hull of the near plane and the
+        /// light (no volume can reach the camera), else z-fail (Everitt and Kilgard).
         counting: Counting = Counting::ZFail, flags(rebuild);
         /// Volumes from silhouette edges (default) or one volume per triangle (seed 004's baseline).
         volumes: Volumes = Volumes::Silhouette, flags(rebuild);
@@ -88,6 +91,8 @@ pub struct ShadowVolumes {
     stats: Option<Mutex<ReadbackRing>>,
     debug: NamedTextures,
     lights: usize,
+    /// Lights the last frame counted by z-pass.
+    zpass_lights: usize,
 }
 
 impl ShadowVolumes {
@@ -114,6 +119,25 @@ impl ShadowVolumes {
                 (words[base + 4], words[base + 5] / 3)
             })
             .collect()
+    }
+}
+
+impl ShadowVolumes {
+    /// How `light`'s volumes are counted this frame: the parameter's counting, or for `Auto`
+    /// z-pass where the light's near-clip volume meets no caster it reaches.
+    fn counting(&self, ctx: &RenderContext<'_>, light: &zoo_host::Light) -> Counting {
+        if self.params.counting != Counting::Auto {
+            return self.params.counting;
+        }
+        let aspect = ctx.size.x as f32 / ctx.size.y.max(1) as f32;
+        let casters = (ctx.scene.objects.iter())
+            .filter(|o| o.casts_shadows)
+            .filter_map(|o| o.bounds)
+            .filter(|&b| reaches_box(light, b));
+        match zpass_is_exact(light, ctx.camera, aspect, casters) {
+            true => Counting::ZPass,
+            false => Counting::ZFail,
+        }
     }
 }
 
@@ -167,6 +191,10 @@ impl ShadowTechnique for ShadowVolumes {
         };
         let stats = (stats.lock().ok()).and_then(|mut ring| ring.target().cloned());
         let showing_debug = matches!(ctx.debug_view, Some(COUNTS_VIEW | OVERLAY_VIEW));
+        let countings: Vec<Counting> = (ctx.lights.iter())
+            .map(|light| self.counting(ctx, light))
+            .collect();
+        self.zpass_lights = countings.iter().filter(|c| **c == Counting::ZPass).count();
         for light in 0..self.lights {
             let debug_here = showing_debug && light as u32 == self.params.debug_light;
             let pieces = p.generator.pieces(light);
@@ -177,7 +205,8 @@ impl ShadowTechnique for ShadowVolumes {
                 p.generator.record(ctx, recorder, (light, piece), &name)?;
                 let last = piece + 1 == pieces;
                 let name = piece_pass_name(VOLUME_PASS, light, piece);
-                p.record_volume(ctx, recorder, (light, piece, last), &name)?;
+                let counting = countings[light];
+                p.record_volume(ctx, recorder, (light, piece, last, counting), &name)?;
                 if debug_here {
                     let name = piece_pass_name(DEBUG_PASS, light, piece);
                     p.record_overlay(ctx, recorder, (&self.debug, piece), &name)?;
@@ -227,7 +256,11 @@ impl ShadowTechnique for ShadowVolumes {
             },
         );
         let pieces = (self.passes.iter()).flat_map(|p| p.generator.counters());
-        workload.chain(pieces).collect()
+        let zpass = (
+            "lights counted by z-pass".to_string(),
+            self.zpass_lights as f64,
+        );
+        workload.chain(pieces).chain([zpass]).collect()
     }
 }
 
@@ -242,6 +275,7 @@ fn create(
         stats: None,
         debug: passes::debug_targets(),
         lights: 0,
+        zpass_lights: 0,
     }))
 }
 

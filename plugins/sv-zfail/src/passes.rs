@@ -6,7 +6,7 @@ use zoo_host::kit::{NamedTextures, Stage, TextureSpec};
 use zoo_host::technique::ViewMapping;
 use zoo_host::{PassRecorder, RenderContext, TechniqueError, TechniqueResult, wgpu};
 use zoo_shadow_volumes::{
-    COUNTS_FORMAT, StencilCounts, VolumeGenerator, resolve_stage, stencil_test,
+    COUNTS_FORMAT, Counting, StencilCounts, VolumeGenerator, resolve_stage, stencil_test,
     volume_depth_stencil, volume_stage,
 };
 
@@ -35,8 +35,9 @@ pub(crate) fn debug_targets() -> NamedTextures {
 /// The volume generator and every stage of the technique.
 pub(crate) struct Passes {
     pub(crate) generator: VolumeGenerator,
-    /// Counts a piece of volumes into the G-buffer's stencil.
-    volume: Stage,
+    /// Counts a piece of volumes into the G-buffer's stencil: by z-fail, then z-pass (where
+    /// the counting is `Auto`, both, chosen per light).
+    volumes: Vec<(Counting, Stage)>,
     /// Shadows the pixels with a non-zero count.
     resolve: Stage,
     /// Adds volumes to the overlay view.
@@ -52,12 +53,17 @@ impl Passes {
             slope_scale: params.slope_bias,
             clamp: 0.0,
         };
-        let draw = "shadow-volumes/draw.wgsl";
-        let volume = volume_stage(
-            draw,
-            "vs_volume",
-            volume_depth_stencil(params.counting, bias),
-        );
+        let countings = match params.counting {
+            Counting::Auto => vec![Counting::ZFail, Counting::ZPass],
+            one => vec![one],
+        };
+        let volumes = (countings.into_iter())
+            .map(|counting| {
+                let state = volume_depth_stencil(counting, bias);
+                let stage = volume_stage("shadow-volumes/draw.wgsl", "vs_volume", state);
+                Ok((counting, stage.build(ctx)?))
+            })
+            .collect::<TechniqueResult<_>>()?;
         let additive = wgpu::BlendState {
             color: wgpu::BlendComponent {
                 src_factor: wgpu::BlendFactor::One,
@@ -78,23 +84,27 @@ impl Passes {
             })]);
         Ok(Passes {
             generator: VolumeGenerator::new(ctx, "sv-zfail")?,
-            volume: volume.build(ctx)?,
+            volumes,
             resolve: resolve_stage(ctx)?,
             overlay: overlay.build(ctx)?,
             counts: StencilCounts::new(ctx)?,
         })
     }
 
-    /// Counts the volume piece just generated into the G-buffer's stencil for `light`
-    /// (cleared by piece 0); after the `last` piece, writes the light's visibility 0 where the
-    /// count is not 0.
+    /// Counts the volume piece just generated into the G-buffer's stencil for `light` by
+    /// `counting` (z-fail or z-pass; cleared by piece 0); after the `last` piece, writes the
+    /// light's visibility 0 where the count is not 0.
     pub(crate) fn record_volume(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
-        (light, piece, last): (usize, usize, bool),
+        (light, piece, last, counting): (usize, usize, bool, Counting),
         name: &str,
     ) -> TechniqueResult {
+        let stage = (self.volumes.iter())
+            .find(|(c, _)| *c == counting)
+            .map(|(_, stage)| stage)
+            .ok_or_else(TechniqueError::not_prepared)?;
         let (Some(volume), Some(args)) = (self.generator.volume(), self.generator.args()) else {
             return Err(TechniqueError::not_prepared());
         };
@@ -104,7 +114,7 @@ impl Passes {
         };
         let stencil = zoo_host::gpu::stencil_attachment(&ctx.gbuffer.depth_view, load);
         let mut pass = ctx.light_pass(recorder, name, light, stencil);
-        self.volume.set_on(ctx, &mut pass, &[], &[])?;
+        stage.set_on(ctx, &mut pass, &[], &[])?;
         pass.set_vertex_buffer(0, volume.slice(..));
         pass.draw_indirect(args, 0);
         if last {

@@ -60,6 +60,33 @@ fn camera_inside_a_shadow_volume_is_exact_with_z_fail_and_wrong_with_z_pass() {
     );
 }
 
+/// The lights a renderer of `scene` counted by z-pass in its last frame, with counting `Auto`.
+fn lights_counted_by_z_pass(scene: &str) -> f64 {
+    let scene = Scene::load(&scene_path(scene)).unwrap();
+    let registration = zoo_host::find_technique("sv-zfail").unwrap();
+    let schema = (registration.params)();
+    let mut values = zoo_host::params::defaults(&schema);
+    let auto = [("counting".to_string(), "Auto".to_string())];
+    zoo_host::params::apply_assignments(&schema, &mut values, &auto).unwrap();
+    let mut renderer = Renderer::new(gpu(), scene, UVec2::new(64, 64)).unwrap();
+    renderer.set_technique("sv-zfail", &values).unwrap();
+    renderer.render(&View::Final).unwrap();
+    let counters = renderer.wait_for_counters();
+    zoo_host::test_support::counter(&counters, "lights counted by z-pass").unwrap()
+}
+
+/// Everitt and Kilgard's choice (`counting` Auto): a light whose near-clip volume meets a caster
+/// (the camera may stand in its shadow) is counted by z-fail, the others by z-pass, and both
+/// are exact: the camera in the slab's shadow on `inside-shadow`, and outside every shadow of
+/// `planar-room`'s three lights.
+#[test]
+fn auto_counting_takes_z_pass_where_it_is_exact() {
+    for (scene, zpass) in [("inside-shadow.ron", 0.0), ("planar-room.ron", 3.0)] {
+        assert_exact(&judge(scene, "sv-zfail", &[("counting", "Auto")], SIZE));
+        assert_eq!(lights_counted_by_z_pass(scene), zpass, "{scene}");
+    }
+}
+
 #[test]
 fn per_triangle_volumes_give_the_same_shadows() {
     let run = judge(
