@@ -195,7 +195,7 @@ impl ShadowTechnique for ShadowVolumes {
             .map(|light| self.counting(ctx, light))
             .collect();
         self.zpass_lights = countings.iter().filter(|c| **c == Counting::ZPass).count();
-        for light in 0..self.lights {
+        for (light, &counting) in countings.iter().enumerate().take(self.lights) {
             let debug_here = showing_debug && light as u32 == self.params.debug_light;
             let pieces = p.generator.pieces(light);
             // Each piece is generated into the one buffer and counted into the light's
@@ -205,7 +205,6 @@ impl ShadowTechnique for ShadowVolumes {
                 p.generator.record(ctx, recorder, (light, piece), &name)?;
                 let last = piece + 1 == pieces;
                 let name = piece_pass_name(VOLUME_PASS, light, piece);
-                let counting = countings[light];
                 p.record_volume(ctx, recorder, (light, piece, last, counting), &name)?;
                 if debug_here {
                     let name = piece_pass_name(DEBUG_PASS, light, piece);
