@@ -154,14 +154,21 @@ fn cached_reference(
 }
 
 /// Every scene of `scenes/` (sorted) but the many-lamp benchmark plazas (`lights-*`, hundreds
-/// of lights: the CPU reference alone would take minutes in a test).
+/// of lights: the CPU reference alone would take minutes in a test) and the scenes set up to
+/// show an artifact (`artifact-*`, which their technique's tests judge).
 pub fn standard_scenes() -> Vec<PathBuf> {
+    let skipped = |p: &Path| {
+        (p.file_stem()).is_some_and(|s| {
+            let s = s.to_string_lossy();
+            s.starts_with("lights-") || s.starts_with("artifact-")
+        })
+    };
     let mut scenes: Vec<PathBuf> = std::fs::read_dir(workspace_root().join("scenes"))
         .unwrap_or_else(|e| panic!("scenes/: {e}"))
         .filter_map(Result::ok)
         .map(|e| e.path())
         .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-        .filter(|p| !(p.file_stem()).is_some_and(|s| s.to_string_lossy().starts_with("lights-")))
+        .filter(|p| !skipped(p))
         .collect();
     scenes.sort();
     scenes
