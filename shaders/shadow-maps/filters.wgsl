@@ -308,9 +308,10 @@ fn smrt(plane: TapPlane, frame: mat2x3<f32>, texel: f32, noise: FilterNoise, lig
             last = length - light.near;
         }
         let jitter = fract(noise.still.x + f32(k) * 0.7548777);
-        // The distance from the light of the surface the ray is under (negative: none), and
-        // where along the ray it was last seen under it.
-        var under = -1.0;
+        // Whether the ray is under a surface, that surface's distance from the light (depths
+        // of a parallel map may be negative) and where along the ray it was last seen under it.
+        var is_under = false;
+        var under = 0.0;
         var under_at = 0.0;
         var blocked = false;
         for (var j = 0u; j < samples && !blocked; j++) {
@@ -322,11 +323,12 @@ fn smrt(plane: TapPlane, frame: mat2x3<f32>, texel: f32, noise: FilterNoise, lig
                 continue;
             }
             if p.ray > p.stored + bias {
+                is_under = true;
                 under = p.stored;
                 under_at = t;
                 continue;
             }
-            if under >= 0.0 {
+            if is_under {
                 // Out from under a surface between `under_at` and `t`: find where.
                 var out_at = t;
                 for (var r = 0u; r < SMRT_REFINEMENTS; r++) {
@@ -342,12 +344,12 @@ fn smrt(plane: TapPlane, frame: mat2x3<f32>, texel: f32, noise: FilterNoise, lig
                 }
                 // Through the surface (the ray now as near the light as it), or beside it.
                 blocked = p.ray < under + 2.0 * bias;
-                under = -1.0;
+                is_under = false;
             }
         }
         // A ray still under a surface at its last sample comes out above it on its way to
         // the light.
-        blocked = blocked || under >= 0.0;
+        blocked = blocked || is_under;
         reached += select(1.0, 0.0, blocked);
     }
     return reached / f32(count);
