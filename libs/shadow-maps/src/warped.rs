@@ -1,7 +1,8 @@
 //! Warped single maps against perspective aliasing: light-space perspective shadow maps
-//! (LiSPSM, Wimmer, Scherzer and Purgathofer 2004) and perspective shadow maps (PSM,
-//! Stamminger and Drettakis 2002; seed 000 sections 7.9 and 13.2). Both spend more texels near
-//! the viewer by putting a perspective into the light's projection.
+//! (LiSPSM, Wimmer, Scherzer and Purgathofer 2004), trapezoidal shadow maps (TSM, Martin and
+//! Tan 2004) and perspective shadow maps (PSM, Stamminger and Drettakis 2002; seed 000 sections
+//! 7.9 and 13.2). All spend more texels near the viewer by putting a perspective into the
+//! light's projection.
 
 use zoo_host::glam::camera::rh::{proj::directx, view::look_to_mat4};
 use zoo_host::glam::{Mat4, UVec2, Vec2, Vec3, Vec3Swizzles, Vec4, Vec4Swizzles};
@@ -142,6 +143,114 @@ pub fn lispsm_frustum(
         frustum: LightFrustum::warped(light_view, light_to_map * light_view),
         n,
         sin_gamma,
+    }
+}
+
+/// What a TSM fit chose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TsmFit {
+    pub frustum: LightFrustum,
+    /// The trapezoid's distance η from its top edge to its apex, the centre of the warp
+    /// (infinite when the map is uniform), and its height λ from top to base.
+    pub eta: f32,
+    pub lambda: f32,
+}
+
+/// The share of the map's rows the focus region gets (the paper's "80 % rule").
+pub const TSM_FOCUS_SHARE: f32 = 0.8;
+
+/// TSM's distance η from the trapezoid's top edge to its apex, for a trapezoid of height
+/// `lambda` whose first `delta` (the focus region) must take [`TSM_FOCUS_SHARE`] of the
+/// map's rows: with rows v(s) = s (λ + η) / (λ (s + η)) for a distance s from the top edge,
+/// v(δ) = 0.8 gives η = 0.2 λ δ / (0.8 λ − δ) (the paper's ξ = −0.6). Infinite (a uniform map)
+/// when the focus region already takes that share.
+pub fn tsm_eta(lambda: f32, delta: f32) -> f32 {
+    let rest = TSM_FOCUS_SHARE * lambda - delta;
+    if rest <= 1e-6 * lambda {
+        return f32::INFINITY;
+    }
+    (1.0 - TSM_FOCUS_SHARE) * lambda * delta / rest
+}
+
+/// A TSM map for a directional light travelling along `direction`, seen by `camera` over view
+/// depths [near, far] (with `casters` that can shadow it): in light space, the view slice's
+/// outline is bounded by a trapezoid whose top and base edges are perpendicular to the line
+/// from the near plane's centre to the far plane's, and whose sides meet at an apex placed
+/// ([`tsm_eta`]) so that the first `focus` of the depth range (the focus region) takes 80 % of
+/// the map's rows; the projective map of the trapezoid onto the square warps the light's
+/// projection. Uniform when the view looks along the light (the line has no length).
+#[allow(clippy::too_many_arguments)]
+pub fn tsm_frustum(
+    direction: Vec3,
+    camera: &Camera,
+    aspect: f32,
+    (near, far): (f32, f32),
+    casters: &[Aabb],
+    focus: f32,
+) -> TsmFit {
+    let light_view = look_to_mat4(camera.position, direction, up_for(direction));
+    let slice = slice_corners(camera, aspect, near, far);
+    let body = light_space_body(light_view, &slice, casters);
+    let outline: Vec<Vec2> = (slice.iter())
+        .map(|p| light_view.transform_point3(*p).xy())
+        .collect();
+    let centre = |points: &[Vec2]| points.iter().copied().sum::<Vec2>() / points.len() as f32;
+    let (near_centre, far_centre) = (centre(&outline[..4]), centre(&outline[4..]));
+    let uniform = TsmFit {
+        frustum: LightFrustum::warped(light_view, fit_to_map(Mat4::IDENTITY, &body) * light_view),
+        eta: f32::INFINITY,
+        lambda: 0.0,
+    };
+    let axis = far_centre - near_centre;
+    let (lo, hi) = transformed_bounds(Mat4::IDENTITY, &body);
+    if axis.length() <= 1e-3 * resolvable(hi.x - lo.x, magnitude(lo, hi)) {
+        return uniform;
+    }
+    let u = axis.normalize();
+    let along = |p: Vec2| (p - near_centre).dot(u);
+    let top = outline
+        .iter()
+        .map(|p| along(*p))
+        .fold(f32::INFINITY, f32::min);
+    let base = outline
+        .iter()
+        .map(|p| along(*p))
+        .fold(f32::NEG_INFINITY, f32::max);
+    let lambda = base - top;
+    // The focus region ends at the view depth `focus` of the way from near to far.
+    let view_dir = (camera.target - camera.position).normalize_or(Vec3::NEG_Z);
+    let focus_depth = near + focus.clamp(0.0, 1.0) * (far - near);
+    let focus_point = light_view.transform_point3(camera.position + view_dir * focus_depth);
+    let delta = (along(focus_point.xy()) - top).clamp(0.0, lambda);
+    let eta = tsm_eta(lambda, delta);
+    if !eta.is_finite() {
+        return TsmFit { lambda, ..uniform };
+    }
+    // Apex q on the centre line, η before the top edge; a = distance along u from q, b across.
+    let q = near_centre + u * (top - eta);
+    let across = Vec2::new(-u.y, u.x);
+    let slope = |p: Vec2| (p - q).dot(across) / (p - q).dot(u);
+    let low = outline
+        .iter()
+        .map(|p| slope(*p))
+        .fold(f32::INFINITY, f32::min);
+    let high = outline
+        .iter()
+        .map(|p| slope(*p))
+        .fold(f32::NEG_INFINITY, f32::max);
+    let (mid, half) = ((low + high) * 0.5, ((high - low) * 0.5).max(1e-6));
+    // x' = (b / a - mid) / half, y' = α − β / a over the trapezoid: −1 at its top (a = η), 1 at
+    // its base (a = η + λ); in homogeneous coordinates with w = a.
+    let beta = 2.0 * eta * (eta + lambda) / lambda;
+    let alpha = 1.0 + 2.0 * eta / lambda;
+    let a = Vec4::new(u.x, u.y, 0.0, -q.dot(u));
+    let b = Vec4::new(across.x, across.y, 0.0, -q.dot(across));
+    let rows = [(b - a * mid) / half, a * alpha - Vec4::W * beta, Vec4::Z, a];
+    let warp = Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
+    TsmFit {
+        frustum: LightFrustum::warped(light_view, fit_to_map(warp, &body) * light_view),
+        eta,
+        lambda,
     }
 }
 
@@ -505,6 +614,65 @@ mod tests {
             warped < 0.5 * flat,
             "texel at 2 m: warped {warped}, uniform {flat}"
         );
+    }
+
+    #[test]
+    fn tsm_gives_the_focus_region_eighty_percent_of_the_rows() {
+        // η from the paper's ξ = −0.6: (λδ + λδξ) / (λ − 2δ − λξ).
+        let (lambda, delta, xi) = (10.0f32, 3.0f32, -0.6f32);
+        let paper = (lambda * delta + lambda * delta * xi) / (lambda - 2.0 * delta - lambda * xi);
+        assert!((tsm_eta(lambda, delta) - paper).abs() < 1e-4);
+        assert!(tsm_eta(lambda, 0.85 * lambda).is_infinite());
+        let c = camera();
+        let direction = Vec3::new(0.8, -0.5, 0.1).normalize();
+        let caster_centre = Vec3::new(-30.0, 18.0, -10.0);
+        let caster = (caster_centre - Vec3::ONE, caster_centre + Vec3::ONE);
+        let focus = 0.1;
+        let fit = tsm_frustum(direction, &c, 1.5, (0.1, 200.0), &[caster], focus);
+        assert!(fit.eta.is_finite() && fit.lambda > 0.0, "{fit:?}");
+        for z in [1.0, 5.0, 40.0, 190.0] {
+            for x in [-0.3, 0.0, 0.3] {
+                let p = Vec3::new(x * z, 0.0, -z);
+                assert!(inside(&fit.frustum, p), "ground at {p}");
+            }
+        }
+        assert!(
+            inside(&fit.frustum, caster_centre),
+            "caster towards the light"
+        );
+        // The rows of the map's near edge and of the focus depth: 80 % of the way apart, in
+        // the map's row direction (along the view on the map), as the near plane's centre is
+        // to the far plane's.
+        let view_dir = (c.target - c.position).normalize();
+        let row = |d: f32| map(&fit.frustum, c.position + view_dir * d).truncate();
+        let (first, focused, last) = (row(0.1), row(0.1 + focus * 199.9), row(200.0));
+        let share = (focused - first).length() / (last - first).length();
+        assert!(
+            (share - TSM_FOCUS_SHARE).abs() < 0.05,
+            "focus share {share}"
+        );
+        // So texels near the viewer are finer than a uniform map's.
+        let uniform = lispsm_frustum(direction, &c, 1.5, (0.1, 200.0), &[caster], 0.0);
+        let at = Vec3::new(0.0, 0.0, -2.0);
+        let (warped, flat) = (
+            fit.frustum.texel_world_size(at, 2048),
+            uniform.frustum.texel_world_size(at, 2048),
+        );
+        assert!(
+            warped < 0.5 * flat,
+            "texel at 2 m: TSM {warped}, uniform {flat}"
+        );
+    }
+
+    #[test]
+    fn tsm_becomes_uniform_when_light_and_view_align() {
+        let c = camera();
+        let direction = (c.target - c.position).normalize();
+        let fit = tsm_frustum(direction, &c, 1.5, (0.1, 200.0), &[], 0.3);
+        assert!(fit.eta.is_infinite());
+        for z in [1.0, 190.0] {
+            assert!(inside(&fit.frustum, c.position + direction * z));
+        }
     }
 
     #[test]

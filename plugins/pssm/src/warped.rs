@@ -1,6 +1,6 @@
-//! Warped single maps: light-space perspective shadow maps (`lispsm`, directional lights) and
-//! perspective shadow maps (`psm`, directional and spot lights), fitted by the shadow-map
-//! library (`zoo_shadow_maps::warped`). One layer per light; the lookup measures texel sizes
+//! Warped single maps: light-space perspective shadow maps (`lispsm`) and trapezoidal shadow
+//! maps (`tsm`) for directional lights, and perspective shadow maps (`psm`, directional and
+//! spot lights), fitted by the shadow-map library (`zoo_shadow_maps::warped`). One layer per light; the lookup measures texel sizes
 //! where it filters. Where PSM cannot hold the view in one map (the light inside the view's
 //! post-perspective box) the light falls back to the ordinary fitted map, and the counters
 //! say how often.
@@ -15,7 +15,9 @@ use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 use zoo_shadow_maps::cascades::slice_corners;
 use zoo_shadow_maps::cascades::visible_depth_range;
 use zoo_shadow_maps::light_space::LightFrustum;
-use zoo_shadow_maps::warped::{lispsm_frustum, psm_frustum, receiver_box, worst_texel_to_pixel};
+use zoo_shadow_maps::warped::{
+    lispsm_frustum, psm_frustum, receiver_box, tsm_frustum, worst_texel_to_pixel,
+};
 use zoo_shadow_maps::{
     DepthState, FilterParams, LayerPlan, LightMaps, LookupPass, LookupShader, MapFilter,
     MapFilters, MapParams, PlanInputs, ShadowMapSet, StandardLayers, light_size,
@@ -42,6 +44,16 @@ zoo_host::technique_params! {
 }
 
 zoo_host::technique_params! {
+    /// Parameters of trapezoidal shadow maps.
+    pub struct TsmParams {
+        use shared: WarpedParams;
+        /// The focus region, as a fraction of the visible depth range from the near plane: it
+        /// takes 80 % of the map's rows (the trapezoid's apex is placed for it).
+        focus: f32 = 0.3, range(0.01, 1.0), step(0.01);
+    }
+}
+
+zoo_host::technique_params! {
     /// Parameters of perspective shadow maps.
     pub struct PsmParams {
         use shared: WarpedParams;
@@ -56,6 +68,8 @@ zoo_host::technique_params! {
 enum Warp {
     /// LiSPSM with this strength.
     Lispsm(f32),
+    /// TSM with this focus region (fraction of the visible depth range).
+    Tsm(f32),
     /// PSM with this smallest virtual near plane (fraction of far).
     Psm(f32),
 }
@@ -64,6 +78,7 @@ enum Warp {
 #[derive(Debug, Clone)]
 enum Params {
     Lispsm(LispsmParams),
+    Tsm(TsmParams),
     Psm(PsmParams),
 }
 
@@ -72,6 +87,7 @@ impl Params {
     fn id(&self) -> &'static str {
         match self {
             Params::Lispsm(_) => "lispsm",
+            Params::Tsm(_) => "tsm",
             Params::Psm(_) => "psm",
         }
     }
@@ -79,6 +95,7 @@ impl Params {
     fn warp(&self) -> Warp {
         match self {
             Params::Lispsm(p) => Warp::Lispsm(p.strength),
+            Params::Tsm(p) => Warp::Tsm(p.focus),
             Params::Psm(p) => Warp::Psm(p.near_fraction),
         }
     }
@@ -86,6 +103,7 @@ impl Params {
     fn shared(&self) -> &WarpedParams {
         match self {
             Params::Lispsm(p) => &p.shared,
+            Params::Tsm(p) => &p.shared,
             Params::Psm(p) => &p.shared,
         }
     }
@@ -93,6 +111,7 @@ impl Params {
     fn update(&mut self, values: &ParamValues) -> Result<ParamUpdate, ParamError> {
         match self {
             Params::Lispsm(p) => p.update(values),
+            Params::Tsm(p) => p.update(values),
             Params::Psm(p) => p.update(values),
         }
     }
@@ -170,6 +189,17 @@ impl LayerPlan for WarpedLayers {
                 )
                 .frustum,
             ),
+            Warp::Tsm(focus) => Some(
+                tsm_frustum(
+                    light.direction,
+                    inputs.camera,
+                    aspect,
+                    range,
+                    inputs.casters,
+                    focus,
+                )
+                .frustum,
+            ),
             Warp::Psm(near_fraction) => psm_frustum(
                 light,
                 inputs.camera,
@@ -223,7 +253,7 @@ struct Gpu {
     fallbacks: u32,
 }
 
-/// A warped-map technique (LiSPSM or PSM).
+/// A warped-map technique (LiSPSM, TSM or PSM).
 struct WarpedMaps {
     params: Params,
     gpu: LazyGpu<Gpu>,
@@ -242,7 +272,7 @@ impl WarpedMaps {
 }
 
 impl Gpu {
-    /// The maps and lookup of technique `id` (`lispsm` or `psm`).
+    /// The maps and lookup of technique `id` (`lispsm`, `tsm` or `psm`).
     fn new(ctx: &RenderContext<'_>, id: &str, p: &WarpedParams) -> TechniqueResult<Gpu> {
         let state = DepthState {
             constant_bias: 0,
@@ -379,6 +409,13 @@ fn create_lispsm(
     }))
 }
 
+fn create_tsm(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    Ok(Box::new(WarpedMaps {
+        params: Params::Tsm(TsmParams::from_values(values)?),
+        gpu: LazyGpu::default(),
+    }))
+}
+
 fn create_psm(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
     Ok(Box::new(WarpedMaps {
         params: Params::Psm(PsmParams::from_values(values)?),
@@ -395,6 +432,17 @@ zoo_host::register_technique! {
     light_kinds: &[LightKind::Directional],
     params: LispsmParams::schema,
     create: create_lispsm,
+}
+
+zoo_host::register_technique! {
+    id: "tsm",
+    name: "Trapezoidal shadow maps",
+    description: "Directional lights: one map warped so a trapezoid around the view's outline in light space fills it, its focus region taking 80 % of the rows",
+    source: "seed 000 section 3.5.3 (Martin and Tan 2004)",
+    readme: include_str!("../README.md"),
+    light_kinds: &[LightKind::Directional],
+    params: TsmParams::schema,
+    create: create_tsm,
 }
 
 zoo_host::register_technique! {

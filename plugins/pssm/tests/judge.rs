@@ -60,9 +60,12 @@ fn spot_and_point_lights_are_declared_unsupported() {
 }
 
 #[test]
-fn lispsm_within_bounds_on_vista_atrium_and_planar_room() {
-    for scene in ["vista.ron", "atrium.ron", "planar-room.ron"] {
-        judge(scene, "lispsm", &[("map_size", "2048")], SIZE).assert_core_bounds(0.005, 0.01);
+fn lispsm_and_tsm_within_bounds_on_vista_atrium_and_planar_room() {
+    for technique in ["lispsm", "tsm"] {
+        for scene in ["vista.ron", "atrium.ron", "planar-room.ron"] {
+            let run = judge(scene, technique, &[("map_size", "2048")], SIZE);
+            run.assert_core_bounds(0.005, 0.01);
+        }
     }
 }
 
@@ -95,11 +98,14 @@ fn warped_maps_beat_one_uniform_map_on_vista() {
         let m = run.metrics(0);
         m.false_shadow_core + m.false_lit_core
     };
-    let (lispsm, psm) = (core("lispsm"), core("psm"));
-    eprintln!("vista core error at 2048: lispsm {lispsm:.5}, psm {psm:.5}, uniform {uniform:.5}");
+    let (lispsm, tsm, psm) = (core("lispsm"), core("tsm"), core("psm"));
+    eprintln!(
+        "vista core error at 2048: lispsm {lispsm:.5}, tsm {tsm:.5}, psm {psm:.5}, uniform \
+         {uniform:.5}"
+    );
     assert!(
-        lispsm < 0.5 * uniform && psm < uniform,
-        "lispsm {lispsm}, psm {psm}, uniform {uniform}"
+        lispsm < 0.5 * uniform && tsm < 0.5 * uniform && psm < uniform,
+        "lispsm {lispsm}, tsm {tsm}, psm {psm}, uniform {uniform}"
     );
 }
 
