@@ -443,7 +443,7 @@ fn compare_writes_the_indirect_light_it_scores() {
     let all = text(&out);
     assert!(out.status.success(), "{all}");
     let csv = std::fs::read_to_string(out_dir.join("indirect.csv")).unwrap();
-    let header = "scene,technique,view,indirect_rmse,leak,unlit_share";
+    let header = "scene,technique,view,indirect_rmse,leak,unlit_share,unbounced_lights";
     assert_eq!(csv.lines().next(), Some(header), "{csv}");
     let row = csv.lines().nth(1).expect("a row for lpv");
     let fields: Vec<&str> = row.split(',').collect();

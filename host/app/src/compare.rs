@@ -13,7 +13,7 @@ use zoo_host::judging::perceptual::{FlipScore, score_image};
 use zoo_host::judging::{Judged, Leak, LightScore, SceneReference, error_map, judge_technique};
 use zoo_host::params::{self, ParamValues};
 use zoo_host::scene::paths;
-use zoo_host::{Renderer, Scene, TechniqueRegistration};
+use zoo_host::{LightKind, Renderer, Scene, TechniqueRegistration};
 
 use crate::cli::{CompareArgs, Judge};
 use crate::setup::headless_gpu;
@@ -48,6 +48,21 @@ pub struct IndirectScore {
     pub rmse: f64,
     /// Its light on surfaces no directly lit surface sees.
     pub leak: Leak,
+    /// The lights that add nothing to its indirect light, and why.
+    pub unbounced: Vec<(usize, LightKind, String)>,
+}
+
+impl IndirectScore {
+    /// The lights that do not bounce, as `1 (point), 2 (spot)`, or `none`.
+    fn unbounced_list(&self, separator: &str) -> String {
+        if self.unbounced.is_empty() {
+            return "none".to_string();
+        }
+        (self.unbounced.iter())
+            .map(|(light, kind, _)| format!("{light} ({})", kind.name()))
+            .collect::<Vec<_>>()
+            .join(separator)
+    }
 }
 
 /// The times of `views` views spread evenly over the scene's paths, both ends included; one
@@ -402,6 +417,13 @@ fn print_summaries(views: &[JudgedView]) {
                 "  {:16} indirect_rmse {:.4} leak {:.4} (unlit {:.3} of pixels)",
                 score.technique, score.rmse, score.leak.leak, score.leak.unlit_share
             );
+            for (light, kind, why) in &score.unbounced {
+                println!(
+                    "  {:16} light {light} ({}) adds no indirect light: {why}",
+                    score.technique,
+                    kind.name()
+                );
+            }
         }
     }
 }
@@ -783,10 +805,14 @@ fn judge_indirect(
             let path = output_name("reference", view.view, several, "indirect.hdr");
             save_radiance(&args.out.join(path), expected, width)?;
         }
+        let unbounced = (j.unbounced.iter())
+            .map(|(light, why)| (*light, lights[*light].kind, why.clone()))
+            .collect();
         scores.push(IndirectScore {
             technique: j.technique.clone(),
             rmse,
             leak,
+            unbounced,
         });
     }
     Ok(scores)
@@ -795,15 +821,21 @@ fn judge_indirect(
 /// `indirect.csv`: the relative RMSE and the leak of each technique that adds light, per view
 /// (`None` when no technique adds light).
 fn indirect_csv(scene: &str, views: &[JudgedView]) -> Option<String> {
-    let mut csv = String::from("scene,technique,view,indirect_rmse,leak,unlit_share\n");
+    let mut csv =
+        String::from("scene,technique,view,indirect_rmse,leak,unlit_share,unbounced_lights\n");
     let mut any = false;
     for v in views {
         for score in &v.indirect {
             any = true;
             writeln!(
                 csv,
-                "{scene},{},{},{:.6},{:.6},{:.6}",
-                score.technique, v.view, score.rmse, score.leak.leak, score.leak.unlit_share
+                "{scene},{},{},{:.6},{:.6},{:.6},{}",
+                score.technique,
+                v.view,
+                score.rmse,
+                score.leak.leak,
+                score.leak.unlit_share,
+                score.unbounced_list(";")
             )
             .expect("write to string");
         }
@@ -1068,15 +1100,41 @@ fn indirect_md(w: &mut String, views: &[JudgedView]) {
         w,
         "\n## Indirect light\n\nRelative RMSE of each technique's indirect light (irradiance over π) against the one-bounce diffuse reference, over the pixels with a surface; error maps `<technique>-indirect-error.png` (black: exact, white: off by the reference's own value or more); the values themselves in `reference-indirect.hdr` and `<technique>-indirect.hdr` (linear Radiance HDR). Leak: the technique's mean indirect light on the surfaces that no directly lit surface sees (the reference is exactly 0 there: no cosine ray found light, and none of the points traced as lit from every light is in view), as a fraction of the reference's mean over every surface; `unlit` is those surfaces' share of the pixels.\n"
     );
-    let _ = writeln!(w, "| technique | view | indirect_rmse | leak | unlit |");
-    let _ = writeln!(w, "|---|---|---|---|---|");
+    let _ = writeln!(
+        w,
+        "| technique | view | indirect_rmse | leak | unlit | lights not bounced |"
+    );
+    let _ = writeln!(w, "|---|---|---|---|---|---|");
+    let mut reasons = std::collections::BTreeSet::new();
     for v in views {
         for score in &v.indirect {
             let _ = writeln!(
                 w,
-                "| {} | {} | {:.4} | {:.4} | {:.3} |",
-                score.technique, v.view, score.rmse, score.leak.leak, score.leak.unlit_share
+                "| {} | {} | {:.4} | {:.4} | {:.3} | {} |",
+                score.technique,
+                v.view,
+                score.rmse,
+                score.leak.leak,
+                score.leak.unlit_share,
+                score.unbounced_list(", ")
             );
+            for (light, kind, why) in &score.unbounced {
+                reasons.insert(format!(
+                    "- `{}`: light {light} ({}) adds no indirect light: {why}",
+                    score.technique,
+                    kind.name()
+                ));
+            }
+        }
+    }
+    if !reasons.is_empty() {
+        let _ = writeln!(
+            w,
+            "\nThe one-bounce reference bounces every light; a technique's error includes the \
+             light of those it does not bounce:\n"
+        );
+        for reason in reasons {
+            let _ = writeln!(w, "{reason}");
         }
     }
 }

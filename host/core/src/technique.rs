@@ -536,6 +536,13 @@ pub trait ShadowTechnique: Send {
         Ok(ParamUpdate::Rebuild)
     }
 
+    /// For a technique that adds light: why `light` adds nothing to its indirect light (a kind
+    /// of light it renders no bounce for), a sentence `compare`'s report and the viewer show
+    /// beside its indirect light's error; `None` for the lights that bounce (the default).
+    fn unbounced(&self, _light: &Light) -> Option<String> {
+        None
+    }
+
     /// What it cannot meet for the current scene and lights (a limit of the device that
     /// leaves part of its output out, for example), each a sentence naming the technique:
     /// `compare`'s report and the viewer show them beside its results. Empty (the default)

@@ -342,14 +342,10 @@ pub struct Lpv {
 }
 
 impl Lpv {
-    /// The lights that render a reflective shadow map.
+    /// The lights that render a reflective shadow map: those that bounce.
     fn rsm_lights(&self, lights: &[zoo_host::Light]) -> Vec<usize> {
         (0..lights.len())
-            .filter(|&i| match lights[i].kind {
-                LightKind::Directional => true,
-                LightKind::Spot => self.params.spot_lights,
-                LightKind::Point => false,
-            })
+            .filter(|&i| self.unbounced(&lights[i]).is_none())
             .collect()
     }
 }
@@ -402,6 +398,23 @@ impl ShadowTechnique for Lpv {
             out.push(ResourceInfo::texture("shadow maps", &maps.texture, true));
         }
         out
+    }
+
+    fn unbounced(&self, light: &zoo_host::Light) -> Option<String> {
+        match light.kind {
+            LightKind::Directional => None,
+            LightKind::Spot if self.params.spot_lights => None,
+            LightKind::Spot => Some(
+                "spot lights render no reflective shadow map unless `spot_lights` is on, so \
+                 their light does not bounce"
+                    .to_string(),
+            ),
+            LightKind::Point => Some(
+                "point lights render no reflective shadow map (lpv injects from directional \
+                 and spot lights' maps only), so their light does not bounce"
+                    .to_string(),
+            ),
+        }
     }
 
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {

@@ -45,6 +45,34 @@ fn share(c: Vec3, channel: usize) -> f32 {
     c[channel] / (c.x + c.y + c.z).max(1e-9)
 }
 
+/// lpv says which lights it does not bounce (and the judge, `compare` and the viewer pass it
+/// on) instead of leaving their missing light a bare error: on `planar-room` the point light
+/// never, the spot light only with `spot_lights`; the sun always bounces.
+#[test]
+fn the_lights_lpv_does_not_bounce_are_named() {
+    let scene = Scene::load(&scene_path("planar-room.ron")).unwrap();
+    let kinds: Vec<&str> = scene.lights.iter().map(|l| l.kind.name()).collect();
+    assert_eq!(kinds, ["point", "spot", "directional"]);
+    let mut renderer = Renderer::new(gpu(), scene, UVec2::new(32, 32)).unwrap();
+    let reference = SceneReference::compute(&mut renderer, 1, |_| {}).unwrap();
+    for (spot_lights, unbounced) in [("false", vec![0, 1]), ("true", vec![0])] {
+        let values = params(&[("spot_lights", spot_lights)]);
+        let judged = judge_technique(&mut renderer, &reference, "lpv", &values).unwrap();
+        let lights: Vec<usize> = judged.unbounced.iter().map(|(l, _)| *l).collect();
+        assert_eq!(
+            lights, unbounced,
+            "spot_lights {spot_lights}: {:?}",
+            judged.unbounced
+        );
+        assert!(
+            judged
+                .unbounced
+                .iter()
+                .all(|(_, why)| why.contains("does not bounce"))
+        );
+    }
+}
+
 #[test]
 fn atrium_against_the_one_bounce_reference() {
     let scene = Scene::load(&scene_path("atrium.ron")).unwrap();

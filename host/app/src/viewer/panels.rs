@@ -28,8 +28,21 @@ impl ViewerState {
             }
             ui.separator();
         }
-        // What the running technique cannot meet here, for as long as it cannot.
-        let warnings = self.renderer.technique_instance().warnings();
+        // What the running technique cannot meet here, for as long as it cannot, and the lights
+        // a technique that adds light does not bounce.
+        let mut warnings = self.renderer.technique_instance().warnings();
+        if self.renderer.technique().adds_light {
+            let technique = self.renderer.technique_instance();
+            warnings.extend(
+                (self.renderer.lights().iter().enumerate()).filter_map(|(i, l)| {
+                    let why = technique.unbounced(l)?;
+                    Some(format!(
+                        "light {i} ({}) adds no indirect light: {why}",
+                        l.kind.name()
+                    ))
+                }),
+            );
+        }
         for warning in &warnings {
             ui.colored_label(WARNING_AMBER, format!("Warning: {warning}"));
         }

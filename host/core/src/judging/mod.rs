@@ -234,6 +234,9 @@ pub struct Judged {
     pub masks_opaque: bool,
     /// What it could not meet in the judged frame ([`crate::ShadowTechnique::warnings`]).
     pub warnings: Vec<String>,
+    /// For a technique that adds light, the lights that add nothing to its indirect light, and
+    /// why ([`crate::ShadowTechnique::unbounced`]).
+    pub unbounced: Vec<(usize, String)>,
 }
 
 impl Judged {
@@ -321,6 +324,12 @@ pub fn judge_technique(
         indirect: registration.adds_light.then(|| renderer.read_indirect()),
         masks_opaque: registration.masks_opaque_in(renderer.scene()),
         warnings: renderer.technique_instance().warnings(),
+        unbounced: match registration.adds_light {
+            true => (renderer.lights().iter().enumerate())
+                .filter_map(|(i, l)| Some((i, renderer.technique_instance().unbounced(l)?)))
+                .collect(),
+            false => Vec::new(),
+        },
     })
 }
 
