@@ -272,16 +272,17 @@ impl Rsm {
         self.cameras.write(ctx.gpu, cameras);
     }
 
-    /// Renders every layer of the maps in `targets` (see [`texture_specs`]): one pass per
-    /// light, `"LPV RSM: light {l}"`.
+    /// Renders every layer of the maps in `targets` (see [`texture_specs`]), one a (light,
+    /// face) of `layers`: one pass each, `"LPV RSM: light {l}"` (`"… face {f}"` for a point
+    /// light's cube faces).
     pub fn record(
         &self,
         ctx: &RenderContext<'_>,
         recorder: &mut PassRecorder<'_>,
         targets: &NamedTextures,
-        lights: &[usize],
+        layers: &[(usize, usize)],
     ) -> TechniqueResult {
-        for (layer, light) in lights.iter().enumerate() {
+        for (layer, &(light, face)) in layers.iter().enumerate() {
             let view = |name| {
                 (targets.layer_view(name, layer as u32)).ok_or_else(TechniqueError::not_prepared)
             };
@@ -290,7 +291,11 @@ impl Rsm {
                 .map(|m| Ok(zoo_host::gpu::color_attachment(view(m.0)?, clear)))
                 .collect::<TechniqueResult<Vec<_>>>()?;
             let depth = view(RSM_DEPTH)?;
-            let label = kit::light_pass_name(RSM_PASS, *light);
+            let cube = layers.iter().filter(|(l, _)| *l == light).count() > 1;
+            let mut label = kit::light_pass_name(RSM_PASS, light);
+            if cube {
+                label = format!("{label} face {face}");
+            }
             let mut pass = recorder.render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(&label),
                 color_attachments: &colors,

@@ -26,7 +26,7 @@ use zoo_host::gpu::{GpuStruct, GpuType, gpu_bytes};
 use zoo_host::kit::{FullscreenLightPass, NamedTextures, SharedGroup, Stage, StageBindGroup};
 use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, DebugVolume, ResourceInfo, VolumeAxis, VolumeSlice};
-use zoo_shadow_maps::light_space::{directional_frustum_over, spot_frustum};
+use zoo_shadow_maps::light_space::{cube_frustums, directional_frustum_over, spot_frustum};
 use zoo_shadow_maps::{DepthState, ShadowMapSet, object_bounds};
 
 use gpu::{
@@ -102,6 +102,8 @@ zoo_host::technique_params! {
         skip_dark_cells: bool = true, flags(shader);
         /// Spot lights also render reflective shadow maps (directional lights always do).
         spot_lights: bool = false;
+        /// Point lights also render reflective shadow maps, one per cube face.
+        point_lights: bool = false;
         /// Direct shadow-map resolution.
         map_size: u32 = 2048, range(256, 8192), step(256);
         /// Grid the volume debug views show (0 the finest).
@@ -213,7 +215,8 @@ struct Gpu {
     targets: NamedTextures,
     groups: Option<Groups>,
     /// Lights with a reflective shadow map, one per layer.
-    rsm_lights: Vec<usize>,
+    /// The reflective shadow maps' (light, face), one a layer.
+    rsm_layers: Vec<(usize, usize)>,
 }
 
 impl Gpu {
@@ -244,7 +247,7 @@ impl Gpu {
             data,
             targets: NamedTextures::new("lpv", texture_specs(p.rsm_size, 1, p.grid_size)),
             groups: None,
-            rsm_lights: Vec::new(),
+            rsm_layers: Vec::new(),
         })
     }
 
@@ -342,10 +345,18 @@ pub struct Lpv {
 }
 
 impl Lpv {
-    /// The lights that render a reflective shadow map: those that bounce.
-    fn rsm_lights(&self, lights: &[zoo_host::Light]) -> Vec<usize> {
+    /// The reflective shadow maps, one a layer: (light, face) for every face of each light
+    /// that bounces (a point light's six cube faces, one face of the others).
+    fn rsm_layers(&self, lights: &[zoo_host::Light]) -> Vec<(usize, usize)> {
         (0..lights.len())
             .filter(|&i| self.unbounced(&lights[i]).is_none())
+            .flat_map(|i| {
+                let faces = match lights[i].kind {
+                    LightKind::Point => 6,
+                    _ => 1,
+                };
+                (0..faces).map(move |face| (i, face))
+            })
             .collect()
     }
 }
@@ -409,9 +420,10 @@ impl ShadowTechnique for Lpv {
                  their light does not bounce"
                     .to_string(),
             ),
+            LightKind::Point if self.params.point_lights => None,
             LightKind::Point => Some(
-                "point lights render no reflective shadow map (lpv injects from directional \
-                 and spot lights' maps only), so their light does not bounce"
+                "point lights render no reflective shadow maps unless `point_lights` is on, so \
+                 their light does not bounce"
                     .to_string(),
             ),
         }
@@ -420,7 +432,8 @@ impl ShadowTechnique for Lpv {
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
         self.gpu
             .prepare(changes.scene, || Gpu::new(ctx, &self.params))?;
-        let rsm_lights = self.rsm_lights(ctx.lights);
+        let rsm_layers = self.rsm_layers(ctx.lights);
+        let rsm_lights: Vec<usize> = rsm_layers.iter().map(|&(light, _)| light).collect();
         let p = self.params.clone();
         let gpu = self.gpu.get_mut()?;
         gpu.maps.prepare(ctx, changes, p.map_size, true);
@@ -431,13 +444,15 @@ impl ShadowTechnique for Lpv {
             |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
         );
         let origin = (bounds.0 + bounds.1) * 0.5;
-        let cameras: Vec<RsmCamera> = rsm_lights
+        let cameras: Vec<RsmCamera> = rsm_layers
             .iter()
-            .map(|&l| {
+            .map(|&(l, face)| {
                 let light = &ctx.lights[l];
                 let frustum = match light.kind {
                     LightKind::Spot => spot_frustum(light),
-                    _ => directional_frustum_over(light.direction, bounds),
+                    // Faces of exactly 90 degrees: every direction in one face's texels.
+                    LightKind::Point => cube_frustums(light, p.rsm_size, 0)[face],
+                    LightKind::Directional => directional_frustum_over(light.direction, bounds),
                 };
                 RsmCamera::new(&frustum, l, p.rsm_size, origin)
             })
@@ -446,7 +461,7 @@ impl ShadowTechnique for Lpv {
         let specs = texture_specs(p.rsm_size, rsm_lights.len() as u32, p.grid_size);
         gpu.targets.respec_all(specs);
         gpu.targets.prepare(ctx);
-        gpu.rsm_lights = rsm_lights.clone();
+        gpu.rsm_layers = rsm_layers.clone();
         // The grids, in front of the camera.
         let diagonal = bounds.0.distance(bounds.1);
         let finest = if p.finest_cell > 0.0 {
@@ -491,13 +506,13 @@ impl ShadowTechnique for Lpv {
             return Err(TechniqueError::not_prepared());
         };
         gpu.maps.record(ctx, recorder, MAP_PASS)?;
-        (gpu.rsm).record(ctx, recorder, &gpu.targets, &gpu.rsm_lights)?;
+        (gpu.rsm).record(ctx, recorder, &gpu.targets, &gpu.rsm_layers)?;
         let encoder = recorder.encoder();
         encoder.clear_buffer(&volumes.light_sums, 0, None);
         encoder.clear_buffer(&volumes.occluder_sums, 0, None);
         encoder.clear_buffer(&volumes.moment_sums, 0, None);
         let s = &gpu.stages;
-        let layers = gpu.rsm_lights.len() as u32;
+        let layers = gpu.rsm_layers.len() as u32;
         if layers > 0 {
             s.inject.dispatch(
                 ctx,
@@ -578,7 +593,7 @@ impl ShadowTechnique for Lpv {
         };
         let mut counters = gpu.maps.counters();
         let vpls = gpu.rsm_resolution().map_or(0, |resolution| {
-            u64::from(resolution).pow(2) * gpu.rsm_lights.len() as u64
+            u64::from(resolution).pow(2) * gpu.rsm_layers.len() as u64
         });
         counters.push(("virtual point lights".into(), vpls as f64));
         let cells = gpu.volumes.as_ref().map_or(0, |v| v.cells);
