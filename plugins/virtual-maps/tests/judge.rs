@@ -5,9 +5,12 @@
 // Link the plugin so its technique registers.
 use zoo_plugin_virtual_maps as _;
 
+use zoo_host::LightKind;
 use zoo_host::glam::UVec2;
 use zoo_host::params::{apply_assignments, defaults};
-use zoo_host::test_support::{JudgeRun, Metric, counter, gpu, judge, scene_path};
+use zoo_host::test_support::{
+    JudgeRun, Metric, counter, crowd_scene, gpu, judge, judge_scene, scene_path,
+};
 use zoo_host::{Renderer, Scene, View};
 
 /// One tap (hard), the judge's bounds.
@@ -33,6 +36,20 @@ fn hard_shadows_keep_the_bounds_where_one_map_fails() {
     ] {
         assert_hard_bounds(&judge(scene, "virtual-maps", &HARD, UVec2::new(256, 256)));
     }
+}
+
+/// A crowd of real meshes: 64 instanced fandisks (830 thousand triangles; `../shared/models`,
+/// skipped where absent) under a spot light, a point light and a sun, every light within the
+/// hard bounds.
+#[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
+fn a_crowd_of_real_meshes_keeps_the_hard_bounds() {
+    let lights = [LightKind::Spot, LightKind::Point, LightKind::Directional];
+    let Some(scene) = crowd_scene("fandisk", 64, &lights) else {
+        return;
+    };
+    let run = judge_scene(scene, "virtual-maps", &HARD, UVec2::new(256, 256));
+    assert_hard_bounds(&run);
 }
 
 /// 256 local lights (spot and point) in one pool.
