@@ -5,6 +5,7 @@
 //! tests that walk every shipped technique use `test_support::shipped_techniques`.
 
 mod bench;
+mod bias_artifacts;
 mod cli;
 mod contact_sheet;
 mod exact_methods;
