@@ -297,9 +297,12 @@ fn smrt(plane: TapPlane, frame: mat2x3<f32>, texel: f32, noise: FilterNoise, lig
         var last: f32;
         if plane.parallel {
             // Against the light's travel, tilted within its angular radius, until the ray's
-            // depth reaches the map's near plane.
+            // depth reaches the map's near plane, or (maps without one near plane pass it at
+            // -infinity) as far as the light's width spreads the rays `max_texels` texels
+            // apart: a caster beyond casts a penumbra wider than PCSS's widest.
             dir = normalize(towards + across);
-            last = (start.y - light.near) / max(dot(dir, towards), 0.05);
+            let spread = light.max_texels * texel / max(light.size, 1e-6);
+            last = min((start.y - light.near) / max(dot(dir, towards), 0.05), spread);
         } else {
             // To the point of the light's sphere, stopping at the map's near plane.
             let to = plane.apex + across - plane.point;
@@ -307,7 +310,7 @@ fn smrt(plane: TapPlane, frame: mat2x3<f32>, texel: f32, noise: FilterNoise, lig
             dir = to / max(length, 1e-30);
             last = length - light.near;
         }
-        let jitter = fract(noise.still.x + f32(k) * 0.7548777);
+        let jitter = fract(noise.still.x * 7.13 + noise.still.y * 3.71 + f32(k) * 0.7548777);
         // Whether the ray is under a surface, that surface's distance from the light (depths
         // of a parallel map may be negative) and where along the ray it was last seen under it.
         var is_under = false;
@@ -337,9 +340,12 @@ fn smrt(plane: TapPlane, frame: mat2x3<f32>, texel: f32, noise: FilterNoise, lig
                     if q.known && q.ray > q.stored + bias {
                         under = q.stored;
                         under_at = middle;
-                    } else if q.known {
+                    } else {
+                        // Out from under it by then (or past what the map holds).
                         out_at = middle;
-                        p = q;
+                        if q.known {
+                            p = q;
+                        }
                     }
                 }
                 // Through the surface (the ray now as near the light as it), or beside it.

@@ -13,6 +13,7 @@ use zoo_host::judging::perceptual::{FlipScore, score_image};
 use zoo_host::judging::{Judged, Leak, LightScore, SceneReference, error_map, judge_technique};
 use zoo_host::params::{self, ParamValues};
 use zoo_host::scene::paths;
+use zoo_host::technique::unbounced_sentence;
 use zoo_host::{LightKind, Renderer, Scene, TechniqueRegistration};
 
 use crate::cli::{CompareArgs, Judge};
@@ -418,11 +419,8 @@ fn print_summaries(views: &[JudgedView]) {
                 score.technique, score.rmse, score.leak.leak, score.leak.unlit_share
             );
             for (light, kind, why) in &score.unbounced {
-                println!(
-                    "  {:16} light {light} ({}) adds no indirect light: {why}",
-                    score.technique,
-                    kind.name()
-                );
+                let sentence = unbounced_sentence(*light, *kind, why);
+                println!("  {:16} {sentence}", score.technique);
             }
         }
     }
@@ -1119,11 +1117,8 @@ fn indirect_md(w: &mut String, views: &[JudgedView]) {
                 score.unbounced_list(", ")
             );
             for (light, kind, why) in &score.unbounced {
-                reasons.insert(format!(
-                    "- `{}`: light {light} ({}) adds no indirect light: {why}",
-                    score.technique,
-                    kind.name()
-                ));
+                let sentence = unbounced_sentence(*light, *kind, why);
+                reasons.insert(format!("- `{}`: {sentence}", score.technique));
             }
         }
     }

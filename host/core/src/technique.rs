@@ -319,6 +319,15 @@ pub enum ViewMapping {
     FloatBits { channel: u32, min: f32, max: f32 },
 }
 
+/// How reports name a light that adds nothing to a technique's indirect light, and why
+/// ([`ShadowTechnique::unbounced`]).
+pub fn unbounced_sentence(light: usize, kind: LightKind, why: &str) -> String {
+    format!(
+        "light {light} ({}) adds no indirect light: {why}",
+        kind.name()
+    )
+}
+
 /// A technique resource as listed in the memory table and debug view menu.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResourceInfo {

@@ -222,7 +222,9 @@ pub fn tsm_frustum(
     let focus_depth = near + focus.clamp(0.0, 1.0) * (far - near);
     let focus_point = light_view.transform_point3(camera.position + view_dir * focus_depth);
     let delta = (along(focus_point.xy()) - top).clamp(0.0, lambda);
-    let eta = tsm_eta(lambda, delta);
+    // A focus region at the top edge would put the apex on it (w = 0 there): keep it a
+    // hundredth of the trapezoid away.
+    let eta = tsm_eta(lambda, delta).max(0.01 * lambda);
     if !eta.is_finite() {
         return TsmFit { lambda, ..uniform };
     }

@@ -217,7 +217,8 @@ pub fn texture_specs(rsm_size: u32, rsm_layers: u32, grid_size: u32) -> Vec<Text
     specs
 }
 
-/// The reflective shadow map passes (one per light, `"LPV RSM: light {l}"`).
+/// The reflective shadow map passes (one per map: a light's, or each cube face's of a point
+/// light, `"LPV RSM: light {l}"`, `"… face {f}"`).
 pub const RSM_PASS: &str = "LPV RSM";
 /// The injection of virtual point lights and their surfels.
 pub const INJECT_PASS: &str = "LPV injection";

@@ -214,7 +214,6 @@ struct Gpu {
     /// The reflective shadow maps and the debug images ([`texture_specs`]).
     targets: NamedTextures,
     groups: Option<Groups>,
-    /// Lights with a reflective shadow map, one per layer.
     /// The reflective shadow maps' (light, face), one a layer.
     rsm_layers: Vec<(usize, usize)>,
 }
@@ -342,6 +341,9 @@ impl Gpu {
 pub struct Lpv {
     params: LpvParams,
     gpu: LazyGpu<Gpu>,
+    /// Where lights that would bounce found no layer left for their maps (the device's array
+    /// layers) in the last `prepare`, the warning that says so.
+    layer_warning: Option<String>,
 }
 
 impl Lpv {
@@ -411,6 +413,10 @@ impl ShadowTechnique for Lpv {
         out
     }
 
+    fn warnings(&self) -> Vec<String> {
+        self.layer_warning.iter().cloned().collect()
+    }
+
     fn unbounced(&self, light: &zoo_host::Light) -> Option<String> {
         match light.kind {
             LightKind::Directional => None,
@@ -432,7 +438,25 @@ impl ShadowTechnique for Lpv {
     fn prepare(&mut self, ctx: &RenderContext<'_>, changes: Changes) -> TechniqueResult {
         self.gpu
             .prepare(changes.scene, || Gpu::new(ctx, &self.params))?;
-        let rsm_layers = self.rsm_layers(ctx.lights);
+        let mut rsm_layers = self.rsm_layers(ctx.lights);
+        // Whole lights up to the device's array layers; the rest do not bounce (a warning).
+        let limit = ctx.gpu.device.limits().max_texture_array_layers as usize;
+        self.layer_warning = None;
+        if rsm_layers.len() > limit {
+            let first_left_out = rsm_layers[limit].0;
+            let cut = (rsm_layers.iter())
+                .position(|&(l, _)| l == first_left_out)
+                .unwrap_or(limit);
+            let mut left_out: Vec<usize> = rsm_layers[cut..].iter().map(|&(l, _)| l).collect();
+            left_out.dedup();
+            self.layer_warning = Some(format!(
+                "lpv: {} lights (from light {first_left_out}) found no layer left for their \
+                 reflective shadow maps (the device holds {limit} array layers; a point light \
+                 takes six) and do not bounce",
+                left_out.len()
+            ));
+            rsm_layers.truncate(cut);
+        }
         let rsm_lights: Vec<usize> = rsm_layers.iter().map(|&(light, _)| light).collect();
         let p = self.params.clone();
         let gpu = self.gpu.get_mut()?;
@@ -750,6 +774,7 @@ fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn Shado
     Ok(Box::new(Lpv {
         params,
         gpu: LazyGpu::default(),
+        layer_warning: None,
     }))
 }
 

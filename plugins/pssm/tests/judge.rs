@@ -69,6 +69,17 @@ fn lispsm_and_tsm_within_bounds_on_vista_atrium_and_planar_room() {
     }
 }
 
+/// Shadow-map ray tracing through warped maps, which pass no near plane for directional
+/// lights (SMRT then marches as far as the light's width spreads its rays): the shadows keep
+/// the techniques' bounds.
+#[test]
+fn smrt_on_warped_maps_keeps_the_bounds() {
+    for technique in ["lispsm", "tsm"] {
+        let run = judge("planar-room.ron", technique, &[("filter", "Smrt")], SIZE);
+        run.assert_core_bounds(0.005, 0.01);
+    }
+}
+
 #[test]
 fn psm_within_bounds_on_atrium_and_planar_room_spot_included() {
     for scene in ["atrium.ron", "planar-room.ron"] {

@@ -195,7 +195,7 @@ impl ShadowTechnique for ShadowVolumes {
             .map(|light| self.counting(ctx, light))
             .collect();
         self.zpass_lights = countings.iter().filter(|c| **c == Counting::ZPass).count();
-        for (light, &counting) in countings.iter().enumerate().take(self.lights) {
+        for (light, &counting) in countings.iter().enumerate() {
             let debug_here = showing_debug && light as u32 == self.params.debug_light;
             let pieces = p.generator.pieces(light);
             // Each piece is generated into the one buffer and counted into the light's

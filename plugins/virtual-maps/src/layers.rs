@@ -356,7 +356,10 @@ mod tests {
                 );
             }
         }
-        assert!(scrolled > 30, "the window scrolled {scrolled} times");
+        assert!(
+            scrolled > 30,
+            "the window left its first place in {scrolled} steps of 39"
+        );
         // A turning light moves the whole level.
         let turned = clip_level(dir + Vec3::X * 0.1, &s, 1, camera, bounds);
         assert_ne!(turned.unscrolled, before.unscrolled);

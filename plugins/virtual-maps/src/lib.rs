@@ -155,7 +155,7 @@ zoo_host::gpu_struct! {
     "virtual-maps/caster_box.wgsl" =>
     /// One caster object's world box, its run and its place among the run's objects, culled
     /// against every page drawn (`virtual-maps/cull.wgsl`).
-    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[derive(Debug, Clone, Copy, PartialEq, Default)]
     pub(crate) struct CasterBox {
         pub(crate) lo: Vec3,
         pub(crate) run: u32,

@@ -236,9 +236,8 @@ fn init(
     contents: &[u8],
     usage: wgpu::BufferUsages,
 ) -> wgpu::Buffer {
-    // At least one element of the largest struct a binding reads (an empty list binds).
     let mut bytes = contents.to_vec();
-    bytes.resize(bytes.len().max(CasterBox::SIZE), 0);
+    bytes.resize(bytes.len().max(16), 0);
     ctx.gpu
         .device
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -402,10 +401,17 @@ impl Pages {
                 })
             })
             .collect();
+        // One box at least, for the binding's size (with no casters none is read).
+        let one = [CasterBox::default()];
+        let boxes = if boxes.is_empty() {
+            &one[..]
+        } else {
+            &boxes[..]
+        };
         let caster_boxes = init(
             ctx,
             "virtual-maps caster boxes",
-            &gpu_bytes(&boxes),
+            &gpu_bytes(boxes),
             storage_init,
         );
         let instances = storage(

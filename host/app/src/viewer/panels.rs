@@ -36,10 +36,7 @@ impl ViewerState {
             warnings.extend(
                 (self.renderer.lights().iter().enumerate()).filter_map(|(i, l)| {
                     let why = technique.unbounced(l)?;
-                    Some(format!(
-                        "light {i} ({}) adds no indirect light: {why}",
-                        l.kind.name()
-                    ))
+                    Some(zoo_host::technique::unbounced_sentence(i, l.kind, &why))
                 }),
             );
         }
