@@ -123,6 +123,6 @@ fn fs_lookup(in: FullscreenOut) -> @location(0) vec4<f32> {
     let texel = texel_size(light, tap_level, s.position);
     let noise = filter_noise(in.position.xy, camera.frame);
     let v = virtual_lights[light];
-    let visibility = filter_map(virtual_lookup.map_filter, plane, tangent_frame(ray), texel, noise, v.near, !parallel);
+    let visibility = filter_map(v.map_filter, plane, tangent_frame(ray), texel, noise, v.near, !parallel);
     return vec4<f32>(visibility);
 }
