@@ -74,6 +74,12 @@ fn rt_intersect(index: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec
     return vec3<f32>(t, b1, b2);
 }
 
+// The triangle and instance of the nearest hit so far of a closest-hit walk, and the instance
+// being walked (`RT_NO_OBJECT`: triangles stored in world space), for `rt_closest_surface`.
+var<private> rt_nearest_triangle: u32;
+var<private> rt_nearest_instance: u32;
+var<private> rt_walked_instance: u32;
+
 // What a walk of the hierarchy answers.
 const RT_ANY_HIT: u32 = 0u;
 const RT_FILTER: u32 = 1u;
@@ -119,6 +125,8 @@ fn rt_walk(
                     rt_filter_cross(crossing, crossed, rt_translucent[crossed].transmittance);
                 } else {
                     *nearest = RtHit(true, hit.x, hit.yz);
+                    rt_nearest_triangle = i;
+                    rt_nearest_instance = rt_walked_instance;
                 }
             }
         } else if top + 2u <= RT_STACK_SIZE {
@@ -158,6 +166,7 @@ fn rt_walk_instances(
                 let o = vec4<f32>(origin, 1.0);
                 let local_origin = vec3<f32>(dot(m[0], o), dot(m[1], o), dot(m[2], o));
                 let local_dir = vec3<f32>(dot(m[0].xyz, dir), dot(m[1].xyz, dir), dot(m[2].xyz, dir));
+                rt_walked_instance = i;
                 let hit = rt_walk(instance.root, local_origin, local_dir, mode, instance.translucent, crossing, nearest);
                 if hit && mode == RT_ANY_HIT {
                     return true;
@@ -187,6 +196,7 @@ fn rt_occluded(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> bool {
 // The nearest opaque or masked caster on the segment from `origin` along unit `dir` up to
 // `tmax`: a closest-hit ray.
 fn rt_closest(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> RtHit {
+    rt_walked_instance = RT_NO_OBJECT;
     var crossing = rt_filter_new();
     var nearest = RtHit(false, tmax, vec2<f32>(0.0));
     rt_walk(0u, origin, dir, RT_CLOSEST, RT_NO_OBJECT, &crossing, &nearest);
@@ -209,4 +219,35 @@ fn rt_transmittance(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> vec3<f32> {
         rt_walk_instances(rt_roots.translucent_instances, origin, dir, RT_FILTER, &crossing, &nearest);
     }
     return crossing.light;
+}
+
+// The surface a closest-hit ray meets: the hit, its triangle in `rt_triangles`, its instance
+// in `rt_instances` (`RT_NO_OBJECT` for a triangle stored in world space), the triangle's unit
+// geometric normal in world space (its winding's side) and the texture coordinates there.
+struct RtSurfaceHit {
+    hit: RtHit,
+    triangle: u32,
+    instance: u32,
+    normal: vec3<f32>,
+    uv: vec2<f32>,
+}
+
+// The nearest opaque or masked caster on the segment from `origin` along unit `dir` up to
+// `tmax`, and its surface (`rt_closest` naming what it hits; the portable traversal only).
+fn rt_closest_surface(origin: vec3<f32>, dir: vec3<f32>, tmax: f32) -> RtSurfaceHit {
+    let hit = rt_closest(origin, dir, tmax);
+    if !hit.found {
+        return RtSurfaceHit(hit, 0u, RT_NO_OBJECT, vec3<f32>(0.0), vec2<f32>(0.0));
+    }
+    let tri = rt_triangles[rt_nearest_triangle];
+    var normal = cross(tri.e1, tri.e2);
+    if rt_nearest_instance != RT_NO_OBJECT {
+        // Normals go to world space by the inverse placement's transpose.
+        let m = rt_instances[rt_nearest_instance].to_local;
+        normal = m[0].xyz * normal.x + m[1].xyz * normal.y + m[2].xyz * normal.z;
+    }
+    let uv = rt_texcoords[rt_nearest_triangle].uv;
+    let b = hit.barycentrics;
+    let at = uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y;
+    return RtSurfaceHit(hit, rt_nearest_triangle, rt_nearest_instance, normalize(normal), at);
 }

@@ -14,6 +14,7 @@ mod foliage;
 mod gl_backend;
 mod gpu_judge;
 mod indirect_light;
+mod indirect_scenes;
 mod instances;
 mod judge;
 mod kit;

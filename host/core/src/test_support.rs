@@ -638,3 +638,81 @@ pub fn assert_crowds_in_pieces_match_one_piece(technique: &'static str) {
         }
     }
 }
+
+/// The defaults of technique `id`'s parameters with `assignments` (`key`, `value`) applied.
+pub fn technique_params(id: &str, assignments: &[(&str, &str)]) -> crate::params::ParamValues {
+    let registration = crate::find_technique(id).unwrap_or_else(|e| panic!("{e}"));
+    let schema = (registration.params)();
+    let mut values = crate::params::defaults(&schema);
+    let pairs: Vec<(String, String)> = (assignments.iter())
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    crate::params::apply_assignments(&schema, &mut values, &pairs)
+        .unwrap_or_else(|e| panic!("{id}: {e}"));
+    values
+}
+
+/// A scene file rendered at a size, with its reference, for judging the indirect light of
+/// techniques that add light.
+pub struct IndirectRun {
+    pub scene: crate::scene::Scene,
+    pub renderer: crate::Renderer,
+    pub reference: crate::judging::SceneReference,
+}
+
+/// A technique's indirect light judged against the one-bounce reference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IndirectScore {
+    /// Relative RMSE.
+    pub rmse: f64,
+    /// Light on surfaces no lit surface sees, over the reference's mean
+    /// ([`crate::judging::Leak`]).
+    pub leak: f64,
+    /// Its total over the reference's, on every surface pixel.
+    pub amount: f32,
+}
+
+impl IndirectRun {
+    /// Scene file `scene` (in `scenes/`) at `size` on the shared context, and its reference.
+    pub fn new(scene: &str, size: glam::UVec2) -> IndirectRun {
+        let loaded =
+            crate::scene::Scene::load(&scene_path(scene)).unwrap_or_else(|e| panic!("{e}"));
+        let mut renderer = crate::Renderer::new(gpu(), loaded.clone(), size).unwrap();
+        let reference = crate::judging::SceneReference::compute(&mut renderer, 1, |_| {}).unwrap();
+        IndirectRun {
+            scene: loaded,
+            renderer,
+            reference,
+        }
+    }
+
+    /// Technique `id` with `assignments` judged against the reference with `rays` cosine
+    /// rays a pixel.
+    pub fn score(&mut self, id: &str, assignments: &[(&str, &str)], rays: u32) -> IndirectScore {
+        let values = technique_params(id, assignments);
+        let judged =
+            crate::judging::judge_technique(&mut self.renderer, &self.reference, id, &values)
+                .unwrap_or_else(|e| panic!("{id}: {e}"));
+        let (scene, reference) = (&self.scene, &mut self.reference);
+        let lights = &scene.lights;
+        let rmse = judged.indirect_rmse(reference, scene, lights, rays);
+        let leak = judged.indirect_leak(reference, scene, lights, rays);
+        let (Some(rmse), Some(leak)) = (rmse, leak) else {
+            panic!("{id} adds no light");
+        };
+        let mask = reference.surface_mask();
+        let expected = reference.indirect(scene, lights, rays);
+        let sum = |light: &[glam::Vec3]| {
+            (light.iter().zip(&mask))
+                .filter(|(_, keep)| **keep)
+                .map(|(l, _)| l.element_sum())
+                .sum::<f32>()
+        };
+        let got = judged.indirect.as_deref().unwrap_or_default();
+        IndirectScore {
+            rmse,
+            leak: leak.leak,
+            amount: sum(got) / sum(expected),
+        }
+    }
+}

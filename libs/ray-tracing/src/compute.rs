@@ -105,6 +105,18 @@ zoo_host::gpu_struct! {
     }
 }
 
+/// The scene object of every stored triangle and every instance, for rays that need the
+/// surface they hit (`rt_closest_surface`): a triangle of a shared mesh is its instance's
+/// (its own entry names the mesh's first instance).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SurfaceObjects {
+    /// Per triangle of [`CasterGeometry::triangles`] ([`NO_OBJECT`] for the placeholder of a
+    /// scene without blocking casters).
+    pub triangles: Vec<u32>,
+    /// Per instance of [`CasterGeometry::instances`].
+    pub instances: Vec<u32>,
+}
+
 /// The shadow casters as the GPU traces them, triangles in their hierarchies' leaf order.
 /// Casters drawn once are in world space; each mesh instances share has a hierarchy of its
 /// own in its stored space, and the instances (in leaf order) are under hierarchies over their
@@ -119,6 +131,9 @@ pub struct CasterGeometry {
     pub roots: GpuRoots,
     /// The translucent objects' records ([`crate::translucent_records`]).
     pub translucent: Vec<GpuTranslucent>,
+    /// Which scene object each triangle and each instance belong to
+    /// ([`SurfaceObjects`]).
+    pub objects: SurfaceObjects,
     /// The first node of every hierarchy.
     hierarchies: Vec<u32>,
     /// The triangles of every hierarchy over triangles: its first node, first triangle and
@@ -147,6 +162,7 @@ impl CasterGeometry {
                 translucent_instances: NO_HIERARCHY,
             },
             translucent: Vec::new(),
+            objects: SurfaceObjects::default(),
             hierarchies: Vec::new(),
             triangle_runs: Vec::new(),
             traced: casters.traced_count(),
@@ -161,6 +177,7 @@ impl CasterGeometry {
             });
             geometry.triangles.push(GpuTriangle::default());
             geometry.texcoords.push(GpuTexcoords::default());
+            geometry.objects.triangles.push(NO_OBJECT);
             geometry.hierarchies.push(0);
         }
         // (None where every translucent triangle is degenerate and left out.)
@@ -219,6 +236,7 @@ impl CasterGeometry {
                 root,
                 translucent: instance.translucent.unwrap_or(NO_OBJECT),
             });
+            self.objects.instances.push(instance.object);
         }
         self.hierarchies.push(node_base);
         Some(node_base)
@@ -257,6 +275,7 @@ impl CasterGeometry {
                 alpha_cutoff: mask.map_or(0.0, |m| m.cutoff),
             });
             self.texcoords.push(GpuTexcoords { uv: caster.uv });
+            self.objects.triangles.push(caster.object);
         }
         self.hierarchies.push(node_base);
         let count = self.triangles.len() as u32 - triangle_base;
@@ -345,13 +364,20 @@ pub(crate) fn entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     ]
 }
 
+/// What [`upload`] makes: the group and its statistics, the casters' batches and the
+/// surfaces' objects.
+pub(crate) type Uploaded = (
+    (wgpu::BindGroup, BuildStats),
+    (Vec<GpuBatch>, SurfaceObjects),
+);
+
 /// Builds and uploads the hierarchy of `ctx`'s scene: its bind group and its size (without
-/// the time), and its blocking casters' batches; an error when it is deeper than the
+/// the time), and its blocking casters' batches and surfaces' objects; an error when it is deeper than the
 /// traversal's stack holds.
 pub(crate) fn upload(
     ctx: &RenderContext<'_>,
     layout: &wgpu::BindGroupLayout,
-) -> TechniqueResult<((wgpu::BindGroup, BuildStats), Vec<GpuBatch>)> {
+) -> TechniqueResult<Uploaded> {
     let geometry = CasterGeometry::of(ctx.scene);
     let depth = geometry.depth();
     if depth >= STACK_SIZE {
@@ -415,7 +441,8 @@ pub(crate) fn upload(
         }),
         milliseconds: 0.0,
     };
-    Ok(((bind_group, stats), geometry.caster_batches()))
+    let batches = geometry.caster_batches();
+    Ok(((bind_group, stats), (batches, geometry.objects)))
 }
 #[cfg(test)]
 mod tests {

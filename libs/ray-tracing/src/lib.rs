@@ -1,7 +1,10 @@
 //! Ray tracing on any adapter: rays against the scene's shadow casters, uploaded once per
 //! scene: any-hit shadow rays (`rt_occluded(origin, dir, tmax)`), closest-hit rays
 //! (`rt_closest`, the nearest caster's distance and barycentric coordinates,
-//! `ray-tracing/hit.wgsl`) and translucent filtering (`rt_transmittance`). Two traversals give
+//! `ray-tracing/hit.wgsl`) and translucent filtering (`rt_transmittance`). The portable
+//! traversal also names the surface a closest-hit ray meets (`rt_closest_surface`: its
+//! triangle, instance, normal and texture coordinates; [`RayTracing::object_buffer`] its
+//! object). Two traversals give
 //! the same answers:
 //!
 //! - [`Tracer::Compute`]: the judge's own bounding volume hierarchy
@@ -30,13 +33,15 @@ use zoo_host::scene::{AlphaMask, Scene};
 use zoo_host::{RenderContext, ShaderLibrary, TechniqueError, TechniqueResult, wgpu};
 
 mod compute;
+mod light_pass;
 mod origin;
 mod query;
 
 pub use compute::{
     CasterGeometry, GpuBatch, GpuInstance, GpuNode, GpuRoots, GpuTexcoords, GpuTriangle,
-    NO_INSTANCE, NO_OBJECT, STACK_SIZE,
+    NO_INSTANCE, NO_OBJECT, STACK_SIZE, SurfaceObjects,
 };
+pub use light_pass::{TraceEntry, TracePass, replace_target, transmittance_slot};
 pub use origin::{ERROR_MODULE, RASTER_SUBPIXEL};
 pub use query::GpuMaskedTriangle;
 
@@ -50,6 +55,9 @@ pub const QUERY_MODULE: &str = "ray-tracing/query.wgsl";
 /// The exact per-triangle methods' resolve: a full-screen `fs_resolve` that shadows each pixel
 /// flagged in its `shadowed` buffer (one `u32` a pixel).
 pub const RESOLVE_SHADOWED_SHADER: &str = "ray-tracing/shadowed.wgsl";
+/// Shadow rays from a G-buffer surface to a light's centre or disk, as the judge's references
+/// trace them (`rt_light_visibility`), for a technique's direct shadows.
+pub const LIGHT_RAYS_MODULE: &str = "ray-tracing/light_rays.wgsl";
 
 /// The device limits of the exact per-triangle methods (per-triangle-volumes, frustum-traced):
 /// in compute, the frame's lights and objects, the casters' five buffers and five of the
@@ -203,6 +211,8 @@ pub(crate) struct CasterTriangle {
     pub uv: [Vec2; 3],
     /// For a translucent caster, its object's index in [`Casters::transmittance`].
     pub translucent: Option<u32>,
+    /// Its object's index in the scene (a shared mesh's: its first instance's).
+    pub object: u32,
 }
 
 /// A mesh that instances share, in its stored space: its casters (their translucent object
@@ -217,6 +227,8 @@ pub(crate) struct SharedMesh {
 /// [`Casters::transmittance`].
 pub(crate) struct CasterInstance {
     pub mesh: usize,
+    /// Its object's index in the scene.
+    pub object: u32,
     pub to_world: Mat4,
     pub translucent: Option<u32>,
 }
@@ -244,7 +256,9 @@ impl Casters {
             instances: Vec::new(),
         };
         let mut shared = std::collections::HashMap::new();
-        for o in scene.objects.iter().filter(|o| o.casts_shadows) {
+        let casting = (scene.objects.iter().enumerate()).filter(|(_, o)| o.casts_shadows);
+        for (object, o) in casting {
+            let object = object as u32;
             let translucent = o.transmittance().map(|t| {
                 casters.transmittance.push(t);
                 casters.transmittance.len() as u32 - 1
@@ -258,6 +272,7 @@ impl Casters {
                         mask: o.alpha_mask.filter(|_| o.transmittance().is_none()),
                         uv: tri.map(|i| scene.mesh.uvs.get(i).copied().unwrap_or_default()),
                         translucent,
+                        object,
                     })
                     .collect::<Vec<_>>()
             };
@@ -274,6 +289,7 @@ impl Casters {
             });
             casters.instances.push(CasterInstance {
                 mesh,
+                object,
                 to_world: o.placement,
                 translucent,
             });
@@ -384,6 +400,9 @@ pub struct RayTracing {
     /// ([`CasterGeometry::caster_batches`]; the portable traversal's only, empty for ray
     /// queries).
     pub batches: Vec<GpuBatch>,
+    /// The scene object of each triangle and instance the portable traversal stores (empty
+    /// for ray queries, whose hits `rt_closest_surface` does not name).
+    pub objects: SurfaceObjects,
     /// The scene vertex buffer it was built from (a new scene has a new one).
     vertices: wgpu::Buffer,
 }
@@ -398,15 +417,16 @@ impl RayTracing {
         layout: &wgpu::BindGroupLayout,
     ) -> TechniqueResult<RayTracing> {
         let start = std::time::Instant::now();
-        let ((bind_group, mut stats), batches) = match tracer {
+        let ((bind_group, mut stats), (batches, objects)) = match tracer {
             Tracer::Compute => compute::upload(ctx, layout)?,
-            Tracer::RayQuery => (query::upload(ctx, layout)?, Vec::new()),
+            Tracer::RayQuery => (query::upload(ctx, layout)?, Default::default()),
         };
         stats.milliseconds = start.elapsed().as_secs_f64() * 1000.0;
         Ok(RayTracing {
             bind_group,
             stats,
             batches,
+            objects,
             vertices: ctx.scene_buffers.vertices.clone(),
         })
     }
@@ -435,6 +455,25 @@ impl RayTracing {
         });
         ctx.gpu.queue.write_buffer(&buffer, 0, &bytes);
         buffer
+    }
+
+    /// [`Self::objects`] in one storage buffer of `u32`, for shaders that name the object of
+    /// `rt_closest_surface`'s hits: the object of each stored triangle, then of each instance
+    /// (one entry of [`NO_OBJECT`] where there are none); and where the instances' start.
+    pub fn object_buffer(&self, ctx: &RenderContext<'_>, label: &str) -> (wgpu::Buffer, u32) {
+        let objects = &self.objects;
+        let mut all: Vec<u32> = objects
+            .triangles
+            .iter()
+            .chain(&objects.instances)
+            .copied()
+            .collect();
+        if all.is_empty() {
+            all.push(NO_OBJECT);
+        }
+        let bytes: Vec<u8> = all.iter().flat_map(|o| o.to_le_bytes()).collect();
+        let buffer = storage_buffer(&ctx.gpu.device, label, &bytes);
+        (buffer, objects.triangles.len() as u32)
     }
 
     /// The number of caster triangles of [`Self::batches`]' flat numbering.

@@ -276,6 +276,7 @@ fn placed_masked_triangles(casters: &Casters) -> Vec<CasterTriangle> {
                 mask: t.mask,
                 uv: t.uv,
                 translucent: None,
+                object: i.object,
             })
         })
         .collect()

@@ -7,7 +7,7 @@ use zoo_host::prelude::*;
 use zoo_host::technique::{DebugImage, ResourceInfo, ViewMapping};
 
 use crate::RtLight;
-use crate::trace_pass::TracePass;
+use zoo_ray_tracing::TracePass;
 
 /// The debug view's (and resource's) name.
 pub const VIEW: &str = "blocker distance";
@@ -20,7 +20,7 @@ const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub struct BlockerView {
     /// The tracing shader's text for the chosen tracer.
     text: String,
-    pass: Option<TracePass>,
+    pass: Option<TracePass<RtLight>>,
     /// The distances, made (and viewable) when first traced.
     targets: kit::NamedTextures,
 }
@@ -53,7 +53,7 @@ impl BlockerView {
     ) -> TechniqueResult {
         if self.pass.is_none() {
             let entry = (shader, self.text.as_str(), "fs_blocker_distance");
-            let target = TracePass::replace(FORMAT);
+            let target = zoo_ray_tracing::replace_target(FORMAT);
             let pass = TracePass::new(ctx, "Blocker distance", entry, target, tracing)?;
             self.pass = Some(pass);
         }

@@ -8,15 +8,13 @@
 
 use zoo_host::prelude::*;
 use zoo_host::{ResourceInfo, Scene};
-use zoo_ray_tracing::{RayTracing, Tracer, Traversal};
+use zoo_ray_tracing::{RayTracing, TracePass, Tracer, Traversal};
 
 mod blocker;
 mod history;
-mod trace_pass;
 
 use blocker::BlockerView;
 use history::History;
-use trace_pass::TracePass;
 use zoo_host::render::visibility::VISIBILITY_FORMAT;
 use zoo_host::technique::DebugImage;
 
@@ -76,9 +74,9 @@ struct Gpu {
     tracer: Tracer,
     tracing_layout: wgpu::BindGroupLayout,
     trace: FullscreenLightPass<RtLight>,
-    accumulation: TracePass,
+    accumulation: TracePass<RtLight>,
     denoise: FullscreenLightPass<RtLight>,
-    transmittance: TracePass,
+    transmittance: TracePass<RtLight>,
     blocker: BlockerView,
     tracing: Option<RayTracing>,
     history: Option<History>,
@@ -107,7 +105,7 @@ impl Gpu {
             ctx,
             "Transmittance",
             entry("fs_transmittance"),
-            TracePass::replace(VISIBILITY_FORMAT),
+            zoo_ray_tracing::replace_target(VISIBILITY_FORMAT),
             &tracing,
         )?;
         let blocker = BlockerView::new(&trace_text);
@@ -206,10 +204,7 @@ impl ShadowTechnique for RtShadows {
         }
         if ctx.transmittance.in_use {
             // Each light's colour into its transmittance slot (white until written).
-            let slot = |light| {
-                let view = ctx.transmittance.slot_view(&ctx.visibility.slots, light);
-                view.map(|view| (view, wgpu::LoadOp::Load))
-            };
+            let slot = |light| zoo_ray_tracing::transmittance_slot(ctx, light);
             let no_blend = |_| None;
             (gpu.transmittance).record(ctx, rec, tracing, per_light, slot, no_blend)?;
         }

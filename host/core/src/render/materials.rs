@@ -39,7 +39,8 @@ impl MaterialBindings {
     /// Uploads `scene`'s textures (every mip level) and object materials.
     pub fn new(gpu: &GpuContext, scene: &Scene) -> MaterialBindings {
         let device = &gpu.device;
-        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        // Compute too: ddgi's probe rays read the albedo of what they hit.
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let layout = bind_group_layout(
             device,
             "materials layout",
