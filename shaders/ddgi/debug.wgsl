@@ -9,12 +9,14 @@
 // Off probes' tiles are tinted by this.
 const OFF_TINT: vec3<f32> = vec3<f32>(1.0, 0.2, 0.2);
 
-// The probe whose tile of side `side` holds `texel`, and the texel in the tile.
+// The probe whose tile of side `side` holds `texel`, the texel in the tile, and 1 where there
+// is such a probe (0 past the rows' ends and the last probe).
 fn tile_of(texel: vec2<u32>, side: u32) -> vec3<u32> {
     let tile = texel / side;
     let probe = tile.y * grid.tiles_per_row + tile.x;
     let at = texel % side;
-    return vec3<u32>(probe, at.y * side + at.x, u32(probe < probe_count()));
+    let valid = tile.x < grid.tiles_per_row && probe < probe_count();
+    return vec3<u32>(probe, at.y * side + at.x, u32(valid));
 }
 
 @compute @workgroup_size(8, 8, 1)

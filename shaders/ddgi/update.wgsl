@@ -13,6 +13,8 @@ const INSIDE_SHARE: f32 = 0.25;
 const NEAREST_SURFACE: f32 = 0.2;
 // Probes stay within this share of the spacing of their homes.
 const MOST_OFFSET: f32 = 0.45;
+// Rays this far or further from a distance texel's direction (cosine) count for nothing.
+const DISTANCE_COSINE_CUTOFF: f32 = 0.75;
 
 // A chunk of a probe's rays that a workgroup reads once for all its texels: direction and
 // distance, and light.
@@ -55,7 +57,10 @@ fn cs_irradiance(
     for (var first = 0u; first < grid.rays; first += CHUNK) {
         load_chunk(probe, first, local, side * side);
         for (var k = 0u; k < min(CHUNK, grid.rays - first); k++) {
-            let weight = max(dot(dir, chunk_rays[k].xyz), 0.0);
+            let weight = dot(dir, chunk_rays[k].xyz);
+            if weight <= 0.0 {
+                continue;
+            }
             sum += chunk_light[k] * weight;
             total += weight;
         }
@@ -87,7 +92,8 @@ fn cs_distance(
         load_chunk(probe, first, local, side * side);
         for (var k = 0u; k < min(CHUNK, grid.rays - first); k++) {
             let c = dot(dir, chunk_rays[k].xyz);
-            if c <= 0.0 {
+            // cos^50 is below 6e-7 past this: most rays, skipped without a power.
+            if c <= DISTANCE_COSINE_CUTOFF {
                 continue;
             }
             let weight = pow(c, 50.0);
@@ -104,8 +110,9 @@ fn cs_distance(
 }
 
 // Moves each probe out of the geometry it is inside (through the nearest back it sees) or away
-// from the nearest surface it nearly touches, then switches it off if it is still inside (with
-// `grid.classify`).
+// from the nearest surface it nearly touches (with `grid.relocate`); or, on the last relocation
+// frame (`grid.classify`), switches it off if its rays, traced where it ended, still find it
+// inside.
 @compute @workgroup_size(64, 1, 1)
 fn cs_relocate(@builtin(global_invocation_id) id: vec3<u32>) {
     let probe = id.x;
@@ -134,7 +141,7 @@ fn cs_relocate(@builtin(global_invocation_id) id: vec3<u32>) {
     var offset = ddgi[probe].xyz;
     if grid.relocate == 1u {
         var moved = offset;
-        if inside && backs > 0u {
+        if inside {
             // Through the nearest back, past it by a little.
             moved = offset + nearest_back.xyz * (nearest_back.w + NEAREST_SURFACE * 0.5 * spacing);
         } else if nearest_front.w < NEAREST_SURFACE * spacing {

@@ -124,6 +124,9 @@ pub struct Gpu {
     /// [`Count`]s of the last relocation, and their way back.
     counts: wgpu::Buffer,
     readback: Mutex<ReadbackRing>,
+    /// The readback frame ([`ReadbackRing::frames`]) the last counting frame copied into: older
+    /// results (a run before the probes started over) are not this run's.
+    counted: Option<u64>,
     views: NamedTextures,
 }
 
@@ -200,6 +203,7 @@ impl Gpu {
             probes: None,
             counts,
             readback: Mutex::new(readback),
+            counted: None,
             views: NamedTextures::new("ddgi", view_specs(1)),
         })
     }
@@ -227,8 +231,20 @@ impl Gpu {
         {
             return Ok(false);
         }
+        let limits = ctx.gpu.device.limits();
+        let groups = limits.max_compute_workgroups_per_dimension;
+        if grid.probe_count() > groups {
+            // The passes over probes dispatch a workgroup (row) a probe along one axis.
+            return Err(TechniqueError::Other(format!(
+                "{} probes ({} x {} x {}), above the device's {groups} workgroups along one                  axis; lower `probes`",
+                grid.probe_count(),
+                grid.counts.x,
+                grid.counts.y,
+                grid.counts.z
+            )));
+        }
         let bytes = buffer_vec4s(grid.probe_count(), rays) * 16;
-        let limit = ctx.gpu.device.limits().max_storage_buffer_binding_size;
+        let limit = limits.max_storage_buffer_binding_size;
         if bytes > limit {
             return Err(TechniqueError::Other(format!(
                 "{} probes of {rays} rays need {} MiB, above the device's {} MiB a storage \
@@ -334,18 +350,28 @@ impl Gpu {
             let target = [("debug_out", wgpu::BindingResource::TextureView(view))];
             run(rec, &s.debug[k], DEBUG_PASS, extent, &target)?;
         }
-        let ring = self.readback.lock().ok();
-        if let Some(target) = ring.and_then(|mut ring| ring.target().cloned()) {
+        if frame.start {
+            self.counted = None;
+        }
+        if frame.counting
+            && let Ok(mut ring) = self.readback.lock()
+            && let Some(target) = ring.target().cloned()
+        {
             let bytes = self.counts.size();
             (rec.encoder()).copy_buffer_to_buffer(&self.counts, 0, &target, 0, bytes);
+            self.counted = Some(ring.frames());
         }
         Ok(())
     }
 
-    /// The newest [`Count`]s that have arrived (none until one has; never waits).
+    /// The [`Count`]s of the last relocation once they have arrived (never waits).
     pub fn counts(&self) -> Option<Vec<u32>> {
+        let counted = self.counted?;
         let mut ring = self.readback.lock().ok()?;
-        let (_, bytes) = ring.latest(&self.device)?;
+        let (frame, bytes) = ring.latest(&self.device)?;
+        if frame < counted {
+            return None;
+        }
         Some(
             (bytes.chunks_exact(4))
                 .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))

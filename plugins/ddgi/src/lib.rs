@@ -25,8 +25,8 @@ pub use grid::{MAX_PROBES, ProbeGrid};
 pub const IRRADIANCE_TEXELS: u32 = 6;
 /// Texels along a distance map's side, borders left out (`DISTANCE_TEXELS`).
 pub const DISTANCE_TEXELS: u32 = 14;
-/// Frames at the start during which probes move and are classified (`cs_relocate`); their
-/// maps start over after them.
+/// Frames at the start during which probes move and, on the last, are classified from rays
+/// traced where they ended (`cs_relocate`); their maps start over after them.
 pub const RELOCATION_FRAMES: u32 = 4;
 
 zoo_host::param_choice! {
@@ -73,7 +73,7 @@ zoo_host::gpu_struct! {
     pub struct DdgiGrid {
         /// The first probe's home.
         origin: Vec3,
-        /// Where [`RayTracing::object_buffer`]'s instances start.
+        /// Where [`zoo_ray_tracing::RayTracing::object_buffer`]'s instances start.
         instance_objects: u32,
         spacing: Vec3,
         rays: u32,
@@ -114,11 +114,22 @@ zoo_host::gpu_struct! {
     }
 }
 
+impl DdgiParams {
+    /// The parameters the probes start over for (see `Ddgi::started_with`).
+    fn start(&self) -> (bool, bool, Bounces) {
+        (self.relocation, self.classification, self.bounces)
+    }
+}
+
 struct Ddgi {
     params: DdgiParams,
     gpu: LazyGpu<Gpu>,
     /// Frames since the probes started over.
     frames: u32,
+    /// What the probes started over with: a change of placement (`relocation`,
+    /// `classification`) or of what the maps gather (`bounces`) starts them over again; other
+    /// parameters apply from the next frame.
+    started_with: (bool, bool, Bounces),
 }
 
 /// A rotation of the ray pattern for frame `frame`: uniformly distributed (Shoemake's
@@ -154,6 +165,8 @@ impl Ddgi {
         let relocating = self.frames < RELOCATION_FRAMES;
         let grid = probes.grid;
         let (lo, hi) = ctx.scene.bounds();
+        // The last relocation frame classifies and counts, from rays traced where the probes
+        // ended; the frames before move them.
         let counting = self.frames + 1 == RELOCATION_FRAMES;
         Frame {
             grid: DdgiGrid {
@@ -168,8 +181,8 @@ impl Ddgi {
                 max_distance: 1.5 * grid.spacing.min_element(),
                 self_shadow_bias: p.self_shadow_bias,
                 surface_offset: SURFACE_OFFSET * (hi - lo).length().max(1e-3),
-                relocate: u32::from(relocating && p.relocation),
-                classify: u32::from(relocating && p.classification),
+                relocate: u32::from(relocating && !counting && p.relocation),
+                classify: u32::from(counting && p.classification),
                 trace_inactive: u32::from(relocating),
                 count: u32::from(counting),
                 tiles_per_row: gpu::tiles_per_row(grid.probe_count()),
@@ -197,8 +210,13 @@ impl ShadowTechnique for Ddgi {
         }
         let (lo, hi) = ctx.scene.bounds();
         let grid = ProbeGrid::fitted(lo, hi, self.params.probes);
-        if gpu.probes_for(ctx, grid, self.params.rays_per_probe)? || changes.params {
+        let start = self.params.start();
+        let new_buffer = gpu.probes_for(ctx, grid, self.params.rays_per_probe)?;
+        if new_buffer || (changes.params && start != self.started_with) {
             self.frames = 0;
+        }
+        if self.frames == 0 {
+            self.started_with = start;
         }
         Ok(())
     }
@@ -264,8 +282,10 @@ impl ShadowTechnique for Ddgi {
 }
 
 fn create(_: &GpuContext, values: &ParamValues) -> TechniqueResult<Box<dyn ShadowTechnique>> {
+    let params = DdgiParams::from_values(values)?;
     Ok(Box::new(Ddgi {
-        params: DdgiParams::from_values(values)?,
+        started_with: params.start(),
+        params,
         gpu: LazyGpu::default(),
         frames: 0,
     }))
@@ -327,6 +347,7 @@ mod tests {
             params: DdgiParams::default(),
             gpu: LazyGpu::default(),
             frames: 0,
+            started_with: DdgiParams::default().start(),
         };
         let weights: Vec<f32> = (0..RELOCATION_FRAMES + 40)
             .map(|frame| {
