@@ -340,6 +340,12 @@ impl JudgeRun {
         })
     }
 
+    /// The mean over lights of each light's mean absolute error.
+    pub fn mean_mae(&self) -> f64 {
+        let lights = self.loaded.lights.len();
+        (0..lights).map(|l| self.metrics(l).mae).sum::<f64>() / lights.max(1) as f64
+    }
+
     /// Mean visibility the technique gives `light` where the area reference sees none of the
     /// light (full umbra, contributing pixels): light leaking into shadow, the flaw of
     /// filtered moment maps. Panics when the view holds fewer than 500 umbra pixels.

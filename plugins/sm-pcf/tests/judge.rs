@@ -185,12 +185,6 @@ fn pcss_follows_a_large_light_better_than_hard_shadows() {
     );
 }
 
-/// The mean over a run's lights of their mean absolute error against the area reference.
-fn mean_mae(run: &JudgeRun) -> f64 {
-    let lights = run.loaded.lights.len();
-    (0..lights).map(|l| run.metrics(l).mae).sum::<f64>() / lights as f64
-}
-
 /// Shadow-map ray tracing against PCSS on the same map: on `soft` (a large light over casters
 /// from contact to two metres up) and `wall-lamps` (four lamps on a room's walls) its error is
 /// at most 0.8 of PCSS's, the bound of the virtual-maps issue (measured 0.0054 against 0.0104
@@ -198,8 +192,8 @@ fn mean_mae(run: &JudgeRun) -> f64 {
 #[test]
 fn smrt_follows_area_lights_closer_than_pcss() {
     for scene in ["soft.ron", "wall-lamps.ron"] {
-        let smrt = mean_mae(&judge(scene, "sm-pcf", &[("filter", "Smrt")], SIZE));
-        let pcss = mean_mae(&judge(scene, "sm-pcf", &[("filter", "Pcss")], SIZE));
+        let smrt = judge(scene, "sm-pcf", &[("filter", "Smrt")], SIZE).mean_mae();
+        let pcss = judge(scene, "sm-pcf", &[("filter", "Pcss")], SIZE).mean_mae();
         eprintln!("{scene}: SMRT mae {smrt:.5}, PCSS {pcss:.5}");
         assert!(
             smrt <= 0.8 * pcss,

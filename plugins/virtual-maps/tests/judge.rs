@@ -76,12 +76,6 @@ fn thin_casters_keep_the_hard_bounds() {
     assert_hard_bounds(&run);
 }
 
-/// The mean over a run's lights of their mean absolute error against the area reference.
-fn mean_mae(run: &JudgeRun) -> f64 {
-    let lights = run.loaded.lights.len();
-    (0..lights).map(|l| run.metrics(l).mae).sum::<f64>() / lights as f64
-}
-
 /// Shadow-map ray tracing through the pages against PCSS on the same pages, where local lights
 /// crowd a scene: at most 0.8 of PCSS's error (measured 0.0087 against 0.0129 on
 /// `wall-lamps`, 0.0062 against 0.0094 on `many-lights`). On `soft` it is not (0.0055 against
@@ -91,8 +85,8 @@ fn mean_mae(run: &JudgeRun) -> f64 {
 fn smrt_follows_local_area_lights_closer_than_pcss() {
     for scene in ["wall-lamps.ron", "many-lights.ron"] {
         let size = UVec2::new(256, 256);
-        let smrt = mean_mae(&judge(scene, "virtual-maps", &[("filter", "Smrt")], size));
-        let pcss = mean_mae(&judge(scene, "virtual-maps", &[("filter", "Pcss")], size));
+        let smrt = judge(scene, "virtual-maps", &[("filter", "Smrt")], size).mean_mae();
+        let pcss = judge(scene, "virtual-maps", &[("filter", "Pcss")], size).mean_mae();
         eprintln!("{scene}: SMRT mae {smrt:.5}, PCSS {pcss:.5}");
         assert!(
             smrt <= 0.8 * pcss,
