@@ -25,6 +25,9 @@ pub use grid::{MAX_PROBES, ProbeGrid};
 pub const IRRADIANCE_TEXELS: u32 = 6;
 /// Texels along a distance map's side, borders left out (`DISTANCE_TEXELS`).
 pub const DISTANCE_TEXELS: u32 = 14;
+/// Frames the judge waits past relocation: the maps then hold an even average of this many
+/// frames' rays (or of fewer, where the hysteresis lets each frame count for more).
+pub const AVERAGED_FRAMES: u32 = 16;
 /// Frames at the start during which probes move and, on the last, are classified from rays
 /// traced where they ended (`cs_relocate`); their maps start over after them.
 pub const RELOCATION_FRAMES: u32 = 4;
@@ -43,7 +46,7 @@ zoo_host::technique_params! {
         /// keep the spacing).
         probes: u32 = 16, range(2, 48), step(1);
         /// Rays each probe traces every frame.
-        rays_per_probe: u32 = 128, range(16, 1024), step(16);
+        rays_per_probe: u32 = 64, range(16, 1024), step(16);
         /// How much of the stored maps a frame keeps once past the first frames (which
         /// average evenly): higher is smoother and slower to follow moving lights.
         hysteresis: f32 = 0.97, range(0.0, 0.99), step(0.01);
@@ -236,10 +239,10 @@ impl ShadowTechnique for Ddgi {
     }
 
     fn frames_to_converge(&self) -> u32 {
-        // Past relocation, the even average reaches the hysteresis' share in 1 / (1 - h)
-        // frames.
-        let averaged = (1.0 / (1.0 - self.params.hysteresis)).ceil() as u32;
-        RELOCATION_FRAMES + averaged + 1
+        // Past relocation, an even average of `AVERAGED_FRAMES` frames' rays (1 024 a probe at
+        // the default 64), or fewer where the hysteresis' floor comes first.
+        let floor = (1.0 / (1.0 - self.params.hysteresis)).ceil() as u32;
+        RELOCATION_FRAMES + floor.min(AVERAGED_FRAMES) + 1
     }
 
     fn update_params(&mut self, values: &ParamValues) -> TechniqueResult<ParamUpdate> {
