@@ -165,6 +165,10 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = zoo_host::judging::DEFAULT_SAMPLES,
           value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub samples: u32,
+    /// Frames to render with `--technique` before the one written (techniques that
+    /// accumulate over frames, or read back a frame's results later, settle over them).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
+    pub frames: u32,
     /// Print per-pass GPU times.
     #[arg(long)]
     pub timings: bool,

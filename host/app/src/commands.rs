@@ -201,6 +201,9 @@ fn render_one(args: &RenderArgs, id: &str) -> anyhow::Result<()> {
             unsupported.join(", ")
         );
     }
+    for _ in 1..args.frames {
+        renderer.render(&view)?;
+    }
     let timings = renderer.render(&view)?;
     let image = renderer.read_output();
     image

@@ -5,7 +5,7 @@
 //! CPU judge's own located surfaces, so both judges score the same pixels. The CPU judge stays
 //! the arbiter (`tests/zoo/gpu_judge.rs` measures their agreement).
 
-use std::time::Instant;
+use web_time::Instant;
 
 use anyhow::Context;
 use zoo_host::glam::Vec3;

@@ -200,6 +200,27 @@ pub fn find_technique(id: &str) -> Result<&'static TechniqueRegistration, Techni
         })
 }
 
+/// Keeps the registrations of the module it is invoked in when the crate is linked into a
+/// WebAssembly module. Registrations are statics that nothing references; a native linker
+/// keeps them (rustc hands it a list of them), but rustc cannot write that list for wasm-ld,
+/// which then drops every object file of an rlib that no symbol is needed from, plugins
+/// included. An exported symbol beside the registrations is needed from each. Used by the
+/// registering macros; `$kind` keeps names of different macros apart.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! link_anchor {
+    ($kind:literal) => {
+        const _: () = {
+            // An exported name is all this unsafe attribute adds: the function does nothing.
+            #[allow(unsafe_code)]
+            #[unsafe(export_name = concat!(
+                        "zoo_link:", $kind, ":", module_path!(), ":", line!(), ":", column!()
+                    ))]
+            extern "C" fn link_anchor() {}
+        };
+    };
+}
+
 /// Registers a technique. Takes the fields of [`TechniqueRegistration`] except `package`,
 /// which is set to the calling crate's package name. `id`, `name`, `description`, `source`,
 /// `light_kinds` and `create` are required (the registry rejects a registration without an
@@ -237,6 +258,7 @@ pub fn find_technique(id: &str) -> Result<&'static TechniqueRegistration, Techni
 #[macro_export]
 macro_rules! register_technique {
     ($($field:ident : $value:expr),* $(,)?) => {
+        $crate::link_anchor!("technique");
         $crate::inventory::submit! {
             {
                 // A registration that names every field leaves nothing to the defaults.

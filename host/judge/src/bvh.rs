@@ -11,13 +11,15 @@
 //! only by rounding, outside the exact triangle, may still be missed from far outside it).
 
 use std::cell::RefCell;
-use std::time::Duration;
 
 use glam::{Vec3, Vec3A};
+use obvhs::Boundable;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::builder::build_bvh2;
+use obvhs::bvh2::leaf_collapser::collapse;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 
@@ -93,16 +95,35 @@ impl FlatBvh {
         let aabbs: Vec<Aabb> = (boxes.iter())
             .map(|(lo, hi)| Aabb::new((*lo).into(), (*hi).into()))
             .collect();
-        let bvh = build_bvh2(
-            &aabbs,
-            BvhBuildParams::fast_build(),
-            &mut Duration::default(),
-        );
+        let bvh = build_bvh2(&aabbs);
         FlatBvh {
             nodes: flat_nodes(&bvh),
             triangles: bvh.primitive_indices.clone(),
         }
     }
+}
+
+/// A hierarchy over `primitives` with obvhs's fast build settings: a PLOC build, reinsertion,
+/// leaves collapsed, reinsertion again. (obvhs's own helper for these steps times them with
+/// `std::time`, which panics in the browser build.)
+pub fn build_bvh2<T: Boundable>(primitives: &[T]) -> Bvh2 {
+    let config = BvhBuildParams::fast_build();
+    let indices = (0..primitives.len() as u32).collect();
+    let mut bvh = PlocBuilder::with_capacity(primitives.len()).build(
+        config.ploc_search_distance,
+        primitives,
+        indices,
+        config.sort_precision,
+        config.search_depth_threshold,
+    );
+    let mut reinsertion = ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh, config.reinsertion_batch_ratio, None);
+    let max_leaf = config.max_prims_per_leaf.clamp(1, 255);
+    collapse(&mut bvh, max_leaf, config.collapse_traversal_cost);
+    let after_collapse =
+        config.reinsertion_batch_ratio * config.post_collapse_reinsertion_batch_ratio_multiplier;
+    reinsertion.run(&mut bvh, after_collapse, None);
+    bvh
 }
 
 /// The nodes of `bvh` in flat form.
@@ -178,11 +199,7 @@ impl TriangleBvh {
                 Aabb::new(b.min - padding, b.max + padding)
             })
             .collect();
-        let mut bvh = build_bvh2(
-            &boxes,
-            BvhBuildParams::fast_build(),
-            &mut Duration::default(),
-        );
+        let mut bvh = build_bvh2(&boxes);
         // Store triangles in leaf order so that a leaf's triangles are contiguous.
         let order = std::mem::take(&mut bvh.primitive_indices);
         let triangles = order.iter().map(|&i| kept[i as usize]).collect();

@@ -14,13 +14,10 @@
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::ops::Range;
-use std::time::Duration;
 
 use glam::{Mat4, Vec2, Vec3, Vec3A};
-use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::builder::build_bvh2;
 use zoo_scene::{Scene, SceneObject};
 
 use crate::bvh::{Query, TriangleBvh, Visit, traverse_nodes};
@@ -191,11 +188,7 @@ impl PlacedTriangles {
         let top = if boxes.is_empty() {
             Bvh2::default()
         } else {
-            build_bvh2(
-                &boxes,
-                BvhBuildParams::fast_build(),
-                &mut Duration::default(),
-            )
+            crate::bvh::build_bvh2(&boxes)
         };
         let mut by_index: Vec<(usize, usize)> = parts
             .iter()

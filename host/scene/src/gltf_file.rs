@@ -84,7 +84,7 @@ pub enum GltfAlpha {
 /// Loads a glTF or GLB file: the default scene (or the first one, or every root node when the
 /// file has no scene) with its node transforms applied; missing normals are computed.
 pub fn load_gltf(path: &Path) -> Result<GltfFile, GltfError> {
-    let bytes = std::fs::read(path).map_err(|e| GltfError::Io(e.to_string()))?;
+    let bytes = crate::files::read(path).map_err(|e| GltfError::Io(e.to_string()))?;
     parse_gltf(&bytes, path)
 }
 
@@ -213,7 +213,7 @@ fn read_buffers(
                 }
                 gltf::buffer::Source::Uri(uri) => {
                     let file = folder.join(percent_decoded(uri));
-                    std::fs::read(&file).map_err(|e| GltfError::Invalid {
+                    crate::files::read(&file).map_err(|e| GltfError::Invalid {
                         what: what.clone(),
                         message: format!("{}: {e}", file.display()),
                     })

@@ -4,6 +4,7 @@
 
 pub mod adjacency;
 pub mod description;
+pub mod files;
 pub mod gltf_file;
 #[cfg(any(test, feature = "test-support"))]
 pub mod gltf_writer;
@@ -12,6 +13,7 @@ pub mod material;
 pub mod mesh;
 pub mod paths;
 pub mod shading;
+pub mod stage;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -271,9 +273,13 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Loads a RON scene file; OBJ paths are relative to it.
+    /// Loads a RON scene file (OBJ paths are relative to it), or stages a model file
+    /// (`.obj`, `.gltf`, `.glb`) in a scene of its own ([`stage::around_model`]).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
+        if stage::is_model(path) {
+            return stage::around_model(path);
+        }
+        let text = files::read_to_string(path).map_err(|e| SceneError::Io {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
@@ -477,7 +483,7 @@ pub fn parse_description(text: &str, path: &Path) -> Result<SceneDescription, Sc
 
 /// Reads and parses a scene file's description.
 pub fn read_description(path: &Path) -> Result<SceneDescription, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
+    let text = files::read_to_string(path).map_err(|e| SceneError::Io {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;

@@ -31,7 +31,14 @@ pub enum TextureUse {
 impl ImageSource {
     fn decode(&self) -> image::ImageResult<image::DynamicImage> {
         match self {
-            ImageSource::File(path) => image::open(path),
+            ImageSource::File(path) => {
+                let bytes = crate::files::read(path).map_err(image::ImageError::IoError)?;
+                let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+                if let Ok(format) = image::ImageFormat::from_path(path) {
+                    reader.set_format(format);
+                }
+                reader.decode()
+            }
             ImageSource::Encoded { bytes, .. } => image::load_from_memory(bytes),
         }
     }

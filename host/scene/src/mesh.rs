@@ -370,7 +370,7 @@ impl ObjFile {
 /// Loads an OBJ file: faces are triangulated, missing normals computed, and the `mtllib`
 /// libraries it names are read from beside it.
 pub fn load_obj(path: &Path) -> Result<ObjFile, ObjError> {
-    let text = std::fs::read_to_string(path).map_err(|e| ObjError::Io(e.to_string()))?;
+    let text = crate::files::read_to_string(path).map_err(|e| ObjError::Io(e.to_string()))?;
     parse_obj(&text, path.parent())
 }
 
@@ -425,7 +425,7 @@ fn read_obj(text: &str, library_folder: Option<&Path>) -> Result<ReadObj, ObjErr
             return Ok(Default::default());
         };
         let file = folder.join(library);
-        let loaded = std::fs::read_to_string(&file)
+        let loaded = crate::files::read_to_string(&file)
             .map_err(|e| e.to_string())
             .and_then(|text| {
                 prevalidate_mtl(&text)?;

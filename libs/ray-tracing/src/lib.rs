@@ -416,7 +416,7 @@ impl RayTracing {
         tracer: Tracer,
         layout: &wgpu::BindGroupLayout,
     ) -> TechniqueResult<RayTracing> {
-        let start = std::time::Instant::now();
+        let start = web_time::Instant::now();
         let ((bind_group, mut stats), (batches, objects)) = match tracer {
             Tracer::Compute => compute::upload(ctx, layout)?,
             Tracer::RayQuery => (query::upload(ctx, layout)?, Default::default()),

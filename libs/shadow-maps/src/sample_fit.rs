@@ -167,7 +167,8 @@ impl SampleReduction {
         })
     }
 
-    /// Records the reduction over the G-buffer and waits for it: this frame's fit.
+    /// Records the reduction over the G-buffer and waits for it: this frame's fit (in the
+    /// browser build, which cannot wait, the newest fit that has arrived).
     pub fn fit(
         &mut self,
         ctx: &RenderContext<'_>,
@@ -200,12 +201,29 @@ impl SampleReduction {
             .write_buffer(&s.result, 0, bytemuck::cast_slice(&s.start));
         let extent = [ctx.size.x, ctx.size.y, directions.len().max(1) as u32];
         (self.stage).dispatch(ctx, rec, "Sample fit", &[&s.group], &[], extent)?;
-        let target = s.ring.target().ok_or_else(TechniqueError::not_prepared)?;
         let bytes = 4 * s.start.len() as u64;
-        rec.encoder()
-            .copy_buffer_to_buffer(&s.result, 0, target, 0, bytes);
+        match s.ring.target() {
+            Some(target) => rec
+                .encoder()
+                .copy_buffer_to_buffer(&s.result, 0, target, 0, bytes),
+            // In a browser every readback may still be on its way: this frame's result is
+            // not read back.
+            None if cfg!(target_arch = "wasm32") => {}
+            None => return Err(TechniqueError::not_prepared()),
+        }
+        let span = (camera.near, camera.far);
         let frame = s.ring.frames();
+        // Submitted before the ring maps its targets.
         rec.flush();
+        if cfg!(target_arch = "wasm32") {
+            // A browser cannot wait for the GPU within a frame: the newest fit that has
+            // arrived (a frame or two old; none, the whole view, before the first).
+            let fit = match s.ring.latest(&gpu.device) {
+                Some((_, data)) => decode(bytemuck::cast_slice(data), span, &directions),
+                None => decode(&s.start, span, &directions),
+            };
+            return Ok(Arc::new(fit));
+        }
         // The ring maps what arrived at one poll and returns it at the next.
         for _ in 0..3 {
             gpu.wait_idle();
@@ -213,7 +231,6 @@ impl SampleReduction {
                 && arrived == frame
             {
                 let words: &[u32] = bytemuck::cast_slice(data);
-                let span = (camera.near, camera.far);
                 return Ok(Arc::new(decode(words, span, &directions)));
             }
         }

@@ -107,13 +107,14 @@ impl Method {
     }
 
     /// The method's WGSL constants. The maps hold 32-bit floats, so no moment of an exponent
-    /// in range overflows: exp(2 * 42) < f32::MAX.
+    /// in range overflows: exp(2 * 42) < f32::MAX. The limit is written as its exact decimal
+    /// value: browsers reject the shortest form, 3.4028235e38, as above the largest f32.
     fn prelude(p: &MomentParams) -> String {
         format!(
-            "const POSITIVE_EXPONENT: f32 = {:?};\nconst NEGATIVE_EXPONENT: f32 = {:?};\nconst MOMENT_LIMIT: f32 = {:?};\n",
+            "const POSITIVE_EXPONENT: f32 = {:?};\nconst NEGATIVE_EXPONENT: f32 = {:?};\nconst MOMENT_LIMIT: f32 = {:.1};\n",
             p.positive_exponent,
             p.negative_exponent,
-            f32::MAX,
+            f64::from(f32::MAX),
         )
     }
 

@@ -8,7 +8,7 @@
 //! light's colour is the last frame's rays' (rt-shadows averages visibility over frames, not
 //! colour).
 
-use std::time::Instant;
+use web_time::Instant;
 
 use zoo_host::glam::Vec3;
 use zoo_host::judge::Metrics;

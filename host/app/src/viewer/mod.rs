@@ -4,8 +4,10 @@
 //! compare two techniques (A/B split or difference), judge the view against the ray-traced
 //! reference (in the background on the CPU, or live on the GPU as the view changes), and show
 //! per-pass timings. Edits under `shaders/` are
-//! reloaded while it runs.
+//! reloaded while it runs. On a slow adapter a moving view renders fewer pixels
+//! ([`adaptive`]).
 
+pub mod adaptive;
 pub mod camera;
 pub mod hot_reload;
 pub mod judgement;
@@ -24,11 +26,13 @@ use std::path::Path;
 
 pub use state::ViewerState;
 pub use view::ViewImages;
-#[cfg(feature = "window")]
+#[cfg(all(feature = "window", not(target_arch = "wasm32")))]
 pub use window::run;
+#[cfg(feature = "window")]
+pub use window::{ViewerApp, device_descriptor};
 
 /// Without the `window` feature (the test build's choice) there is no viewer window.
-#[cfg(not(feature = "window"))]
+#[cfg(not(all(feature = "window", not(target_arch = "wasm32"))))]
 pub fn run() -> anyhow::Result<()> {
     anyhow::bail!(
         "this build has no viewer window (it was built without the `window` feature). Use the \

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::thread::JoinHandle;
-use std::time::Instant;
+use web_time::Instant;
 
 use zoo_host::judge::{Metrics, Occluders, Surfaces, reference_visibility};
 use zoo_host::judging::{DEFAULT_SAMPLES, error_map, surface_points};

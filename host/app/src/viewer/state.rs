@@ -543,6 +543,9 @@ impl ViewerState {
 
     /// Saves the current image as PNG in the working folder and returns its path.
     pub fn screenshot(&mut self) -> anyhow::Result<PathBuf> {
+        if cfg!(target_arch = "wasm32") {
+            anyhow::bail!("the browser build writes no files: no screenshots");
+        }
         let path = PathBuf::from(format!("shadow-zoo-{}-{}.png", self.technique, self.frame));
         self.renderer.read_output().save(&path)?;
         self.status = format!("saved {}", path.display());
@@ -565,7 +568,8 @@ fn clamp_to_schema(id: &str, values: ParamValues) -> ParamValues {
         .collect()
 }
 
-/// Scene files in `scenes/` (the working folder's, else the build's).
+/// Scene files in `scenes/` (the working folder's, else the build's), and those mounted there
+/// (the browser build's).
 pub fn scene_files() -> Vec<PathBuf> {
     let local = Path::new("scenes");
     let dir = if local.is_dir() {
@@ -573,10 +577,9 @@ pub fn scene_files() -> Vec<PathBuf> {
     } else {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
     };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .filter_map(|e| e.ok().map(|e| e.path()))
+    let on_disk = (std::fs::read_dir(dir).into_iter().flatten()).filter_map(|e| e.ok());
+    let mounted = zoo_host::scene::files::mounted_in(Path::new("scenes"));
+    let mut files: Vec<PathBuf> = (on_disk.map(|e| e.path()).chain(mounted))
         .filter(|p| p.extension().is_some_and(|e| e == "ron"))
         .collect();
     files.sort();

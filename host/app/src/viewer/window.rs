@@ -1,14 +1,17 @@
 //! The viewer's window: eframe around [`ViewerState`], the renderer's images shown through
-//! egui-wgpu. Built with the `window` feature (on by default).
+//! egui-wgpu. Built with the `window` feature (on by default); the browser build (`web/`)
+//! runs the same [`ViewerApp`] on eframe's web runner.
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::Context as _;
+use web_time::Instant;
 use zoo_host::glam::UVec2;
-use zoo_host::gpu::adapter::choose_adapter_with;
-use zoo_host::{GpuContext, ShaderLibrary, wgpu};
+use zoo_host::{Camera, GpuContext, Light, Scene, ShaderLibrary, wgpu};
 
+use super::adaptive::AdaptiveResolution;
 use super::{ViewImages, ViewerState, settings_path};
 
 /// A renderer image registered with egui, re-registered when its view changes size.
@@ -56,8 +59,15 @@ impl NativeTexture {
 }
 
 /// The eframe application around [`ViewerState`].
-struct ViewerApp {
-    state: ViewerState,
+pub struct ViewerApp {
+    pub state: ViewerState,
+    /// Render at this size whatever the view's size (the browser test's fixed frames).
+    pub fixed_size: Option<UVec2>,
+    resolution: AdaptiveResolution,
+    /// The camera and lights of the last frame, to tell a moving view from a still one.
+    last_view: Option<(Camera, Vec<Light>)>,
+    /// When the last frame started.
+    last_frame: Option<Instant>,
     a: NativeTexture,
     b: NativeTexture,
     difference: NativeTexture,
@@ -68,9 +78,10 @@ impl eframe::App for ViewerApp {
         let Some(render_state) = frame.wgpu_render_state() else {
             return;
         };
-        // Render at the size the central view had last frame.
+        // Render at the size the central view had last frame (fewer pixels while it moves on
+        // a slow adapter).
         let points = self.state.view_points();
-        let size = if points.x < 16.0 || points.y < 16.0 {
+        let full = if points.x < 16.0 || points.y < 16.0 {
             UVec2::new(960, 640)
         } else {
             UVec2::new(
@@ -79,6 +90,17 @@ impl eframe::App for ViewerApp {
             )
         }
         .clamp(UVec2::splat(16), UVec2::splat(4096));
+        let now = Instant::now();
+        if let Some(last) = self.last_frame.replace(now) {
+            self.resolution.frame_took((now - last).as_secs_f64() * 1e3);
+        }
+        let view = (self.state.camera.camera(), self.state.lights.clone());
+        let moving = self.last_view.as_ref().is_some_and(|last| *last != view);
+        self.last_view = Some(view);
+        let size = match self.fixed_size {
+            Some(size) => size,
+            None => self.resolution.size(full, moving),
+        };
         self.state.render(size);
         let state = &self.state;
         let output_size = state.renderer.size();
@@ -115,8 +137,46 @@ impl eframe::App for ViewerApp {
     }
 }
 
+impl ViewerApp {
+    /// The viewer of `scene` on eframe's wgpu device.
+    pub fn new(
+        cc: &eframe::CreationContext<'_>,
+        scene: Scene,
+        shaders: ShaderLibrary,
+    ) -> anyhow::Result<ViewerApp> {
+        let render_state = cc
+            .wgpu_render_state
+            .as_ref()
+            .context("the viewer needs the wgpu renderer")?;
+        let gpu = Arc::new(GpuContext::from_parts(
+            render_state.instance.clone(),
+            render_state.adapter.clone(),
+            render_state.device.clone(),
+            render_state.queue.clone(),
+        ));
+        let state = ViewerState::with_shaders(gpu, scene, UVec2::new(960, 640), shaders)?;
+        Ok(ViewerApp {
+            state,
+            fixed_size: None,
+            resolution: AdaptiveResolution::default(),
+            last_view: None,
+            last_frame: None,
+            a: NativeTexture::default(),
+            b: NativeTexture::default(),
+            difference: NativeTexture::default(),
+        })
+    }
+}
+
+/// The device the viewer asks eframe for: every feature a technique needs or would use.
+pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+    let none_removed = wgpu::Features::empty();
+    GpuContext::device_descriptor(adapter, "shadow-zoo viewer device", none_removed)
+}
+
 /// Shaders from the working folder's `shaders/` (or the build's), for hot reload; the
 /// embedded copies when neither exists.
+#[cfg(not(target_arch = "wasm32"))]
 fn shader_library() -> ShaderLibrary {
     let local = Path::new("shaders");
     if local.is_dir() {
@@ -131,6 +191,7 @@ fn shader_library() -> ShaderLibrary {
 
 /// Opens the viewer on the default scene. Fails with a pointer to the headless commands when
 /// no window or adapter is available.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run() -> anyhow::Result<()> {
     let mut options = eframe::NativeOptions {
         renderer: eframe::Renderer::Wgpu,
@@ -140,17 +201,18 @@ pub fn run() -> anyhow::Result<()> {
         ..Default::default()
     };
     if let egui_wgpu::WgpuSetup::CreateNew(create) = &mut options.wgpu_options.wgpu_setup {
-        create.device_descriptor = Arc::new(|adapter: &wgpu::Adapter| {
-            let none_removed = wgpu::Features::empty();
-            GpuContext::device_descriptor(adapter, "shadow-zoo viewer device", none_removed)
-        });
+        create.device_descriptor = Arc::new(device_descriptor);
         create.native_adapter_selector = Some(Arc::new(
             |adapters: &[wgpu::Adapter], surface: Option<&wgpu::Surface<'_>>| {
-                choose_adapter_with(adapters, wgpu::Backends::all(), |adapter| {
-                    surface
-                        .filter(|s| !adapter.is_surface_supported(s))
-                        .map(|_| "cannot present to the window".to_string())
-                })
+                zoo_host::gpu::adapter::choose_adapter_with(
+                    adapters,
+                    wgpu::Backends::all(),
+                    |adapter| {
+                        surface
+                            .filter(|s| !adapter.is_surface_supported(s))
+                            .map(|_| "cannot present to the window".to_string())
+                    },
+                )
                 .map_err(|e| e.to_string())
             },
         ));
@@ -159,26 +221,10 @@ pub fn run() -> anyhow::Result<()> {
         "Shadow Zoo",
         options,
         Box::new(|cc| {
-            let render_state = cc
-                .wgpu_render_state
-                .as_ref()
-                .context("the viewer needs the wgpu renderer")?;
-            let gpu = Arc::new(GpuContext::from_parts(
-                render_state.instance.clone(),
-                render_state.adapter.clone(),
-                render_state.device.clone(),
-                render_state.queue.clone(),
-            ));
             let scene = crate::setup::load_scene(None)?;
-            let mut state =
-                ViewerState::with_shaders(gpu, scene, UVec2::new(960, 640), shader_library())?;
-            state.restore_settings(&settings_path());
-            Ok(Box::new(ViewerApp {
-                state,
-                a: NativeTexture::default(),
-                b: NativeTexture::default(),
-                difference: NativeTexture::default(),
-            }))
+            let mut app = ViewerApp::new(cc, scene, shader_library())?;
+            app.state.restore_settings(&settings_path());
+            Ok(Box::new(app))
         }),
     );
     result.map_err(|e| {

@@ -90,10 +90,16 @@ impl GpuContext {
     /// Features to request from `adapter`: the union of what techniques need, limited to what
     /// the adapter has.
     pub fn wanted_features(adapter: &wgpu::Adapter) -> wgpu::Features {
-        let mut wanted = wgpu::Features::TIMESTAMP_QUERY
-            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
-            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
-            | wgpu::Features::PIPELINE_STATISTICS_QUERY;
+        // Query results are read back as each frame ends, which a browser cannot wait for:
+        // there passes are timed on the CPU (as submitted).
+        let mut wanted = if cfg!(target_arch = "wasm32") {
+            wgpu::Features::empty()
+        } else {
+            wgpu::Features::TIMESTAMP_QUERY
+                | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+                | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
+                | wgpu::Features::PIPELINE_STATISTICS_QUERY
+        };
         for registration in technique::registry() {
             wanted |= (registration.required_features)() | (registration.optional_features)();
         }
@@ -144,6 +150,14 @@ impl GpuContext {
                 errors.push(message);
             }
         }));
+        let lost = uncaptured.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            let message = format!("the GPU device was lost ({reason:?}): {message}");
+            log::error!("{message}");
+            if let Ok(mut errors) = lost.lock() {
+                errors.push(message);
+            }
+        });
         let info = adapter.get_info();
         let raster_fence = (info.backend == wgpu::Backend::Gl).then(|| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -220,11 +234,25 @@ impl GpuContext {
 
     /// Runs `f` inside a validation error scope and returns the first validation error.
     pub fn validation_scope<T>(&self, f: impl FnOnce() -> T) -> (T, Option<String>) {
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let value = f();
-        let error = pollster::block_on(scope.pop()).map(|e| error_chain(&e));
-        (value, error)
+        let (value, error) = validation_scope(&self.device, f);
+        (value, error.map(|e| error_chain(&e)))
     }
+}
+
+/// Runs `f` inside a validation error scope of `device` and returns the first validation
+/// error. A browser resolves a scope only once control is back in its event loop, which a
+/// frame cannot wait for: there `f` runs unscoped, and its errors reach the uncaptured-error
+/// handler of [`GpuContext::from_parts`] and fail the next frame.
+pub fn validation_scope<T>(
+    device: &wgpu::Device,
+    f: impl FnOnce() -> T,
+) -> (T, Option<wgpu::Error>) {
+    if cfg!(target_arch = "wasm32") {
+        return (f(), None);
+    }
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let value = f();
+    (value, pollster::block_on(scope.pop()))
 }
 
 /// An error and all its causes on one line.

@@ -341,6 +341,7 @@ macro_rules! gpu_struct {
             }
         }
 
+        $crate::link_anchor!("gpu struct");
         $crate::inventory::submit! {
             $crate::params::shader::GeneratedShader {
                 name: $module,

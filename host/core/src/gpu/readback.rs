@@ -10,51 +10,83 @@ pub fn read_texture(
     aspect: wgpu::TextureAspect,
     bytes_per_texel: u32,
 ) -> Vec<u8> {
-    let (width, height) = (texture.width(), texture.height());
-    let unpadded = width * bytes_per_texel;
-    let padded =
-        unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback buffer"),
-        size: (padded * height) as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = gpu
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("readback encoder"),
+    let copy = TextureCopy::submit(gpu, texture, layer, aspect, bytes_per_texel);
+    copy.unpadded(&map_buffer(gpu, &copy.buffer))
+}
+
+/// A texture layer copied into a `MAP_READ` buffer, its rows padded to wgpu's alignment; map
+/// it and call [`Self::unpadded`] (at once with [`map_buffer`], or later where nothing may
+/// block, as in a browser).
+pub struct TextureCopy {
+    pub buffer: wgpu::Buffer,
+    padded_row: u32,
+    row: u32,
+}
+
+impl TextureCopy {
+    /// Records and submits the copy of one layer (and aspect) of `texture`.
+    pub fn submit(
+        gpu: &GpuContext,
+        texture: &wgpu::Texture,
+        layer: u32,
+        aspect: wgpu::TextureAspect,
+        bytes_per_texel: u32,
+    ) -> TextureCopy {
+        let (width, height) = (texture.width(), texture.height());
+        let row = width * bytes_per_texel;
+        let padded_row =
+            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback buffer"),
+            size: u64::from(padded_row * height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
         });
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d {
-                x: 0,
-                y: 0,
-                z: layer,
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("readback encoder"),
+            });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: layer,
+                },
+                aspect,
             },
-            aspect,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(height),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(height),
+                },
             },
-        },
-        wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-    );
-    gpu.queue.submit([encoder.finish()]);
-    map_buffer(gpu, &buffer)
-        .chunks_exact(padded as usize)
-        .flat_map(|row| row[..unpadded as usize].to_vec())
-        .collect()
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+        gpu.queue.submit([encoder.finish()]);
+        TextureCopy {
+            buffer,
+            padded_row,
+            row,
+        }
+    }
+
+    /// The tightly packed rows of the mapped buffer's `bytes`.
+    pub fn unpadded(&self, bytes: &[u8]) -> Vec<u8> {
+        (bytes.chunks_exact(self.padded_row as usize))
+            .flat_map(|row| &row[..self.row as usize])
+            .copied()
+            .collect()
+    }
 }
 
 /// Maps a `MAP_READ` buffer, waits for it, and copies its contents out.

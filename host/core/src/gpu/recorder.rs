@@ -4,7 +4,7 @@
 //! for frame captures and times it: with GPU timestamp queries where the device has them,
 //! otherwise by submitting each pass on its own and measuring its execution on the CPU clock.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use super::GpuContext;
 

@@ -354,12 +354,13 @@ impl ShaderLibrary {
         name: &str,
         composed: ComposedShader,
     ) -> Result<wgpu::ShaderModule, ShaderError> {
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(name),
-            source: wgpu::ShaderSource::Wgsl(composed.source.into()),
+        let (module, error) = super::context::validation_scope(device, || {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(composed.source.into()),
+            })
         });
-        match pollster::block_on(scope.pop()) {
+        match error {
             None => Ok(module),
             Some(e) => Err(ShaderError::Pipeline {
                 label: name.to_string(),

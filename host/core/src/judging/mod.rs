@@ -6,7 +6,7 @@
 pub mod perceptual;
 pub mod shared_references;
 
-use std::time::Instant;
+use web_time::Instant;
 
 use image::{Rgba, RgbaImage};
 use rayon::prelude::*;

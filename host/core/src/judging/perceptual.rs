@@ -3,7 +3,7 @@
 //! crate, at its default viewing condition (67 pixels per degree: a 0.7 m wide 4K monitor seen
 //! from 0.7 m).
 
-use image::{Rgb, RgbImage, RgbaImage};
+use image::{RgbImage, RgbaImage};
 
 use super::{Judged, SceneReference, shade_on_cpu};
 use crate::render::Renderer;
@@ -19,7 +19,16 @@ pub struct FlipScore {
 }
 
 /// FLIP of `test` against `reference` (sRGB images of the same size; alpha is ignored).
+/// `None` when the sizes differ or the images are empty, and in the browser build (FLIP's
+/// library is C++, which that build does not compile).
+#[cfg(target_arch = "wasm32")]
+pub fn flip(_reference: &RgbaImage, _test: &RgbaImage) -> Option<FlipScore> {
+    None
+}
+
+/// FLIP of `test` against `reference` (sRGB images of the same size; alpha is ignored).
 /// `None` when the sizes differ or the images are empty.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn flip(reference: &RgbaImage, test: &RgbaImage) -> Option<FlipScore> {
     let (width, height) = reference.dimensions();
     if test.dimensions() != (width, height) || width == 0 || height == 0 {
@@ -41,7 +50,7 @@ pub fn flip(reference: &RgbaImage, test: &RgbaImage) -> Option<FlipScore> {
     let colours = errors.apply_color_lut(&nv_flip::magma_lut()).to_vec();
     let map = RgbImage::from_fn(width, height, |x, y| {
         let i = 3 * (y * width + x) as usize;
-        Rgb([colours[i], colours[i + 1], colours[i + 2]])
+        image::Rgb([colours[i], colours[i + 1], colours[i + 2]])
     });
     Some(FlipScore {
         mean: f64::from(pool.mean()),

@@ -117,6 +117,7 @@ pub fn generated_shader_names() -> Vec<&'static str> {
 #[macro_export]
 macro_rules! shader_params_module {
     ($name:literal, $ty:ident) => {
+        $crate::link_anchor!("shader params");
         $crate::inventory::submit! {
             $crate::params::shader::GeneratedShader {
                 name: $name,

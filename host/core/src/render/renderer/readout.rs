@@ -25,6 +25,11 @@ impl Renderer {
         &self.output_view
     }
 
+    /// The output image's texture (sRGB RGBA8).
+    pub fn output_texture(&self) -> &wgpu::Texture {
+        &self.output
+    }
+
     /// The output image (sRGB RGBA8).
     pub fn read_output(&self) -> image::RgbaImage {
         let bytes = readback::read_texture(&self.gpu, &self.output, 0, wgpu::TextureAspect::All, 4);

@@ -1,0 +1,115 @@
+//! The 3D view's resolution while it moves: on a slow adapter (lavapipe, llvmpipe, a
+//! browser's SwiftShader) camera and light motion render at fewer pixels, so that it stays at
+//! ten frames a second or more; a still view renders at full resolution at once, so the judge
+//! and screenshots see every pixel.
+
+use zoo_host::glam::UVec2;
+
+/// The frame time aimed at while the view moves: ten frames a second.
+pub const MOVING_FRAME_MS: f64 = 100.0;
+/// The smallest share of the view's side rendered while it moves.
+pub const MIN_SCALE: f32 = 0.25;
+
+/// The scale (per side) of the view's pixels rendered, learnt from the frames' times.
+#[derive(Debug, Clone)]
+pub struct AdaptiveResolution {
+    /// The scale the next moving frame renders at.
+    moving_scale: f32,
+    /// The scale the last frame rendered at.
+    rendered_scale: f32,
+}
+
+impl Default for AdaptiveResolution {
+    fn default() -> Self {
+        Self {
+            moving_scale: 1.0,
+            rendered_scale: 1.0,
+        }
+    }
+}
+
+impl AdaptiveResolution {
+    /// The size to render a view of `full` pixels at: all of them when the view is still, the
+    /// learnt share of them while it moves (the camera or a light changed since last frame).
+    pub fn size(&mut self, full: UVec2, moving: bool) -> UVec2 {
+        self.rendered_scale = if moving { self.moving_scale } else { 1.0 };
+        let scaled = (full.as_vec2() * self.rendered_scale).round().as_uvec2();
+        scaled.max(UVec2::splat(16)).min(full.max(UVec2::splat(16)))
+    }
+
+    /// Learns from the time, in milliseconds, that the frame rendered at the last
+    /// [`Self::size`] took. A frame's cost grows about as its pixels, the square of the scale;
+    /// each frame moves the scale at most by half or double toward the one that would take
+    /// [`MOVING_FRAME_MS`], so one slow frame (a shader compiled, a map resized) does not
+    /// throw it to the floor.
+    pub fn frame_took(&mut self, milliseconds: f64) {
+        if !(milliseconds.is_finite() && milliseconds > 0.0) {
+            return;
+        }
+        let step = ((MOVING_FRAME_MS / milliseconds).sqrt() as f32).clamp(0.5, 2.0);
+        self.moving_scale = (self.rendered_scale * step).clamp(MIN_SCALE, 1.0);
+    }
+
+    /// The scale the last frame rendered at.
+    pub fn rendered_scale(&self) -> f32 {
+        self.rendered_scale
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FULL: UVec2 = UVec2::new(800, 600);
+
+    /// Renders moving frames whose cost is `fixed` plus `per_pixel` times their pixels, and
+    /// returns the last frame's time.
+    fn settle(adaptive: &mut AdaptiveResolution, fixed: f64, per_pixel: f64) -> f64 {
+        let mut took = 0.0;
+        for _ in 0..20 {
+            let size = adaptive.size(FULL, true);
+            took = fixed + per_pixel * f64::from(size.x * size.y);
+            adaptive.frame_took(took);
+        }
+        took
+    }
+
+    #[test]
+    fn a_still_view_renders_every_pixel_whatever_motion_cost() {
+        let mut adaptive = AdaptiveResolution::default();
+        settle(&mut adaptive, 0.0, 1e-3);
+        assert!(adaptive.moving_scale < 0.5);
+        assert_eq!(adaptive.size(FULL, false), FULL);
+        assert_eq!(adaptive.rendered_scale(), 1.0);
+    }
+
+    #[test]
+    fn motion_settles_at_ten_frames_a_second_where_pixels_cost() {
+        // 1.2 s a frame at full size (the viewer shows sm-pcf at 1.8 s on lavapipe).
+        let mut adaptive = AdaptiveResolution::default();
+        let per_pixel = 1200.0 / f64::from(FULL.x * FULL.y);
+        let took = settle(&mut adaptive, 0.0, per_pixel);
+        assert!((took - MOVING_FRAME_MS).abs() < 5.0, "{took} ms");
+        // A fast adapter keeps every pixel while moving.
+        let mut fast = AdaptiveResolution::default();
+        settle(&mut fast, 2.0, 1e-5);
+        assert_eq!(fast.size(FULL, true), FULL);
+    }
+
+    #[test]
+    fn a_fixed_cost_above_the_aim_stops_at_the_smallest_scale() {
+        let mut adaptive = AdaptiveResolution::default();
+        settle(&mut adaptive, 300.0, 1e-4);
+        assert_eq!(adaptive.size(FULL, true), UVec2::new(200, 150));
+    }
+
+    #[test]
+    fn one_slow_frame_halves_the_scale_at_most() {
+        let mut adaptive = AdaptiveResolution::default();
+        adaptive.size(FULL, true);
+        adaptive.frame_took(1e6);
+        assert_eq!(adaptive.size(FULL, true), UVec2::new(400, 300));
+        adaptive.frame_took(f64::NAN);
+        assert_eq!(adaptive.size(FULL, true), UVec2::new(400, 300));
+    }
+}
