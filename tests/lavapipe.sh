@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # Sourced by tests/run.sh and tests/web.sh: on Linux without a Vulkan driver, installs Mesa's
 # lavapipe software driver when run as root, and otherwise stops with the command to run; then
 # points wgpu at it.

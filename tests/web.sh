@@ -4,7 +4,7 @@
 # npm driver playwright-core (web/test). Builds the web viewer (web/build.sh) and the native
 # command, then web/test/browser-test.mjs serves web/dist on loopback, opens the viewer in
 # headless Chromium on SwiftShader's WebGPU for every technique that runs there, and checks
-# each first frame against the native lavapipe render of the same scene, view and size.
+# each third frame against the native lavapipe render of the same scene, view and size.
 # `bash tests/web.sh --only sm-pcf,planar` runs some techniques only. Results and frames go to
 # target/web-test/.
 set -euo pipefail
@@ -26,6 +26,12 @@ install_packages() {
 }
 command -v chromium >/dev/null || install_packages chromium
 command -v npm >/dev/null || install_packages nodejs npm
+# playwright-core 1.64 (and node:zlib's crc32) need Node.js 20 or later.
+node_major=$(node --version | sed 's/^v\([0-9]*\).*/\1/')
+if [ "$node_major" -lt 20 ]; then
+    echo "tests/web.sh needs Node.js 20 or later (found $(node --version))" >&2
+    exit 1
+fi
 if [ ! -d web/test/node_modules/playwright-core ]; then
     (cd web/test && npm ci --no-audit --no-fund --loglevel=error)
 fi
@@ -36,4 +42,4 @@ out=target/web-test
 rm -rf "$out"
 mkdir -p "$out"
 node web/test/browser-test.mjs --dist web/dist --native-bin target/debug/shadow-zoo \
-    --out "$out" "$@"
+    --chromium "$(command -v chromium)" --out "$out" "$@"

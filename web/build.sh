@@ -2,7 +2,8 @@
 # Builds the browser viewer into web/dist: the wasm32 build of zoo-web, wasm-bindgen's
 # JavaScript glue (the CLI at the version of the crate, installed when missing) and the page.
 # `bash web/build.sh --release` for a smaller, faster build (slower to compile).
-# Open it with: python3 -m http.server -d web/dist 8000, then http://localhost:8000
+# Open it with: python3 -m http.server --bind 127.0.0.1 -d web/dist 8000, then
+# http://localhost:8000
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -18,7 +19,11 @@ if ! rustup target list --installed | grep -qx wasm32-unknown-unknown; then
 fi
 # The CLI must match the wasm-bindgen crate the build links exactly.
 version=$(grep -A1 '^name = "wasm-bindgen"$' Cargo.lock | sed -n 's/^version = "\(.*\)"$/\1/p')
-if ! wasm-bindgen --version 2>/dev/null | grep -qF " $version"; then
+if [ -z "$version" ]; then
+    echo "Cargo.lock names no wasm-bindgen version" >&2
+    exit 1
+fi
+if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $version" ]; then
     echo "installing wasm-bindgen-cli $version"
     cargo install wasm-bindgen-cli --version "$version"
 fi

@@ -215,8 +215,9 @@ pub fn frame() -> JsValue {
 }
 
 /// Takes a file the user picked (a scene, OBJ, MTL, glTF or image): mounts it under `user/`
-/// and, when it is a scene or a model, opens it on the next frame (a model in a scene of its
-/// own, on a ground and lit). Pick the files a scene or model names with it, before it.
+/// (by its name alone: the files a scene or model names must sit beside it) and, when it is a
+/// scene or a model, opens it on the next frame (a model in a scene of its own, on a ground
+/// and lit). Give it the files a scene or model names first.
 #[wasm_bindgen]
 pub fn open_file(name: &str, bytes: Vec<u8>) {
     let file_name = Path::new(name).file_name().map(PathBuf::from);
@@ -226,7 +227,10 @@ pub fn open_file(name: &str, bytes: Vec<u8>) {
     };
     let path = Path::new(USER_FOLDER).join(file_name);
     zoo_host::scene::files::mount(&path, bytes);
-    if path.extension().is_some_and(|e| e == "ron") || zoo_host::scene::stage::is_model(&path) {
+    let scene = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
+    if scene || zoo_host::scene::stage::is_model(&path) {
         PAGE.with_borrow_mut(|page| page.to_open = Some(path));
     }
 }

@@ -6,8 +6,8 @@
 // not empty, that it matches the native lavapipe render of the same scene, view and size,
 // and that the console shows no error. Prints a table; exits non-zero on any failure.
 //
-// node browser-test.mjs --dist web/dist --native-bin target/debug/shadow-zoo --out DIR
-//     [--size 256] [--only a,b]
+// node browser-test.mjs --dist web/dist --native-bin target/debug/shadow-zoo
+//     --chromium /usr/bin/chromium --out DIR [--size 256] [--only a,b]
 // Serves --dist on loopback itself; renders the native frames with --native-bin into --out.
 
 import { chromium } from "playwright-core";
@@ -41,15 +41,16 @@ function parseArgs() {
     switch (argv[i]) {
       case "--dist": args.dist = value; break;
       case "--native-bin": args.nativeBin = value; break;
+      case "--chromium": args.chromium = value; break;
       case "--out": args.out = value; break;
       case "--size": args.size = Number(value); break;
       case "--only": args.only = value.split(","); break;
       default: throw new Error(`unknown argument ${argv[i]}`);
     }
   }
-  if (!args.dist || !args.nativeBin || !args.out) {
-    throw new Error("usage: browser-test.mjs --dist DIR --native-bin FILE --out DIR " +
-      "[--size N] [--only a,b]");
+  if (!args.dist || !args.nativeBin || !args.out || !args.chromium) {
+    throw new Error("usage: browser-test.mjs --dist DIR --native-bin FILE --chromium FILE " +
+      "--out DIR [--size N] [--only a,b]");
   }
   return args;
 }
@@ -191,8 +192,8 @@ function distinctColours(rgba) {
   return seen.size;
 }
 
-const launchOptions = {
-  executablePath: "/usr/bin/chromium",
+const launchOptions = (chromium) => ({
+  executablePath: chromium,
   headless: true,
   args: [
     "--no-sandbox", "--no-first-run", "--disable-background-networking",
@@ -206,7 +207,7 @@ const launchOptions = {
     // Software rendering takes seconds a frame; the watchdog must not count that as a hang.
     "--disable-gpu-watchdog",
   ],
-};
+});
 
 // Opens `url` and waits until `zoo` is on the page and `ready(zoo)` holds.
 async function openPage(browser, url, ready) {
@@ -219,16 +220,48 @@ async function openPage(browser, url, ready) {
   });
   page.on("pageerror", (error) => errors.push(String(error)));
   const started = Date.now();
-  await page.goto(url);
-  await page.waitForFunction(ready, null, { timeout: FRAME_TIMEOUT_MS, polling: 100 });
+  try {
+    await page.goto(url);
+    await page.waitForFunction(ready, null, { timeout: FRAME_TIMEOUT_MS, polling: 100 });
+  } catch (error) {
+    // A page left open would go on rendering beside the next ones.
+    await page.close();
+    throw error;
+  }
   return { page, errors, ms: Date.now() - started };
+}
+
+// A model the user picks (an OBJ and its material library, handed over as the page's file
+// picker does) opens in a scene of its own and renders without an error.
+async function checkOpenedModel(browser, url, failures) {
+  const { page, errors } = await openPage(browser, url,
+    () => window.zoo && JSON.parse(window.zoo.status()).frames > 0);
+  const files = ["trellis.mtl", "trellis.obj"].map((name) =>
+    [name, Array.from(readFileSync(`scenes/models/${name}`))]);
+  const frames = await page.evaluate((files) => {
+    for (const [name, bytes] of files) window.zoo.open_file(name, Uint8Array.from(bytes));
+    return JSON.parse(window.zoo.status()).frames;
+  }, files);
+  try {
+    await page.waitForFunction((before) => {
+      const status = JSON.parse(window.zoo.status());
+      return status.scene === "user/trellis.obj" && status.frames > before + 1;
+    }, frames, { timeout: FRAME_TIMEOUT_MS, polling: 100 });
+  } catch (error) {
+    failures.push(`an opened model did not show: ${error.message}`);
+  }
+  const status = JSON.parse(await page.evaluate(() => window.zoo.status()));
+  if (status.error) failures.push(`an opened model: ${status.error}`);
+  failures.push(...errors.map((e) => `an opened model: ${e}`));
+  console.log(`opened model: ${status.scene}, ${status.frames} frames, error ${status.error}`);
+  await page.close();
 }
 
 async function main() {
   const args = parseArgs();
   const { server, url } = await serve(args.dist);
   args.url = url;
-  const browser = await chromium.launch(launchOptions);
+  const browser = await chromium.launch(launchOptions(args.chromium));
   const failures = [];
   const rows = [];
   try {
@@ -239,7 +272,7 @@ async function main() {
     // Every technique of the native build registered in the browser's too (registrations
     // are link-time statics, which wasm-ld drops unless something keeps them).
     const listed = execFileSync(args.nativeBin, ["list"], { encoding: "utf8" })
-      .split("\n").slice(1).map((line) => line.split(/\s+/)[0]).filter(Boolean);
+      .split("\n").map((line) => /^([a-z0-9-]+)\s{2,}/.exec(line)?.[1]).filter(Boolean);
     const missing = listed.filter((id) => !techniques.some((t) => t.id === id));
     if (missing.length) failures.push(`not registered in the browser: ${missing.join(", ")}`);
     console.log(`${techniques.length} techniques registered (native: ${listed.length})`);
@@ -247,6 +280,7 @@ async function main() {
     console.log(`adapter: ${status.adapter}`);
     console.log(`first page: ${first.ms} ms to its first frame`);
     await first.page.close();
+    await checkOpenedModel(browser, args.url, failures);
     const size = `${args.size}x${args.size}`;
     for (const technique of techniques) {
       if (args.only && !args.only.includes(technique.id)) continue;
@@ -277,7 +311,14 @@ async function main() {
         continue;
       }
       const rgba = Uint8Array.from(frame.rgba);
-      const native = nativeFrame(args, technique.id);
+      let native;
+      try {
+        native = nativeFrame(args, technique.id);
+      } catch (error) {
+        failures.push(`${technique.id}: the native render failed: ${error.message}`);
+        rows.push(`| ${technique.id} | ${ms} | failed | | | FAIL |`);
+        continue;
+      }
       const problems = [];
       if (shown.technique !== technique.id) {
         problems.push(`shows ${shown.technique}: ${shown.error}`);
@@ -307,7 +348,8 @@ async function main() {
     `size ${args.size}x${args.size}; bounds: mean <= ${MEAN_BOUND} levels, ` +
       `<= ${100 * PIXEL_SHARE_BOUND} % of pixels off by > ${PIXEL_LEVELS}`,
     `| technique | browser: frame ${COMPARED_FRAME} (ms, page load included) | ` +
-      "native: `render --frames 3` (ms) | mean difference (levels) | pixels off (%) | verdict |",
+      `native: \`render --frames ${COMPARED_FRAME}\` (ms) | mean difference (levels) | ` +
+      "pixels off (%) | verdict |",
     "|---|---|---|---|---|---|",
     ...rows,
   ].join("\n");

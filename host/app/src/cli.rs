@@ -34,7 +34,7 @@ pub enum Command {
 /// Arguments of `shadow-zoo bench`.
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
-    /// Scene file (RON) with keyframed paths.
+    /// Scene file (RON) with keyframed paths, or a model file staged in a scene (still).
     #[arg(long, required_unless_present = "suite")]
     pub scene: Option<PathBuf>,
     /// Run a suite from `scenes/bench/NAME.ron` instead (reproduces a seed's experiment).
@@ -86,7 +86,7 @@ pub struct BenchArgs {
 /// Arguments of `shadow-zoo compare`.
 #[derive(Debug, clap::Args)]
 pub struct CompareArgs {
-    /// Scene file (RON).
+    /// Scene file (RON), or a model file (`.obj`, `.gltf`, `.glb`) staged in a scene.
     #[arg(long)]
     pub scene: PathBuf,
     /// Comma-separated technique ids, or `all`.
@@ -138,7 +138,8 @@ pub enum Judge {
 /// Arguments of `shadow-zoo render`.
 #[derive(Debug, clap::Args)]
 pub struct RenderArgs {
-    /// Scene file (RON). Defaults to the built-in planar-room scene.
+    /// Scene file (RON), or a model file (`.obj`, `.gltf`, `.glb`) staged in a scene. Defaults
+    /// to the built-in planar-room scene.
     #[arg(long)]
     pub scene: Option<PathBuf>,
     /// Technique id (see `shadow-zoo list`). Without it, a contact sheet of `--techniques`.
@@ -165,9 +166,10 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = zoo_host::judging::DEFAULT_SAMPLES,
           value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub samples: u32,
-    /// Frames to render with `--technique` before the one written (techniques that
-    /// accumulate over frames, or read back a frame's results later, settle over them).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
+    /// Frames to render with `--technique`; the last is written (techniques that accumulate
+    /// over frames, or read a frame's results back later, settle over them).
+    #[arg(long, default_value_t = 1, requires = "technique",
+          value_parser = clap::value_parser!(u32).range(1..=10000))]
     pub frames: u32,
     /// Print per-pass GPU times.
     #[arg(long)]

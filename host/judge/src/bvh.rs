@@ -123,6 +123,8 @@ pub fn build_bvh2<T: Boundable>(primitives: &[T]) -> Bvh2 {
     let after_collapse =
         config.reinsertion_batch_ratio * config.post_collapse_reinsertion_batch_ratio_multiplier;
     reinsertion.run(&mut bvh, after_collapse, None);
+    #[cfg(debug_assertions)]
+    bvh.validate(primitives, false, config.pre_split);
     bvh
 }
 

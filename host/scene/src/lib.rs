@@ -481,8 +481,12 @@ pub fn parse_description(text: &str, path: &Path) -> Result<SceneDescription, Sc
     })
 }
 
-/// Reads and parses a scene file's description.
+/// Reads and parses a scene file's description (a model file's is staged:
+/// [`stage::description`]).
 pub fn read_description(path: &Path) -> Result<SceneDescription, SceneError> {
+    if stage::is_model(path) {
+        return stage::description(path);
+    }
     let text = files::read_to_string(path).map_err(|e| SceneError::Io {
         path: path.to_path_buf(),
         message: e.to_string(),

@@ -1,12 +1,14 @@
 //! A scene around one model file: the model as it is, a ground under it, a camera that frames
 //! it and a sun, a spot and a point light, all scaled to the model's size. Opening an OBJ or
-//! glTF file where a scene is expected builds one ([`crate::Scene::load`]).
+//! glTF file where a scene is expected builds one ([`crate::Scene::load`],
+//! [`crate::read_description`]).
 
 use std::path::Path;
 
 use glam::Vec3;
 
-use crate::{Scene, SceneError};
+use crate::description::SceneDescription;
+use crate::{Scene, SceneError, parse_description};
 
 /// Whether `path` names a model file (`.obj`, `.gltf`, `.glb`) rather than a scene.
 pub fn is_model(path: &Path) -> bool {
@@ -25,6 +27,13 @@ fn scene_text(mesh: &str, file: &str, setting: &str, objects: &str) -> String {
 
 /// The scene around the model at `path` (see the module's description).
 pub fn around_model(path: &Path) -> Result<Scene, SceneError> {
+    let base = path.parent().unwrap_or(Path::new("."));
+    Scene::from_description(&description(path)?, path, base)
+}
+
+/// The description of the scene around the model at `path`: the model is loaded once, alone,
+/// for its bounds.
+pub fn description(path: &Path) -> Result<SceneDescription, SceneError> {
     let invalid = |message: String| SceneError::Invalid {
         path: path.to_path_buf(),
         field: "model".into(),
@@ -57,7 +66,8 @@ pub fn around_model(path: &Path) -> Result<Scene, SceneError> {
     // Intensities fall off with the square of distance: the default scene's at its scale.
     let falloff = (extent / 5.0).powi(2);
     let setting = format!(
-        "camera: (position: {eye}, target: {center}, fov_y_degrees: 50, near: {near:?}, far: {far:?}),
+        "camera: (position: {eye}, target: {center}, fov_y_degrees: 50, near: {near:?},
+                  far: {far:?}),
          ambient: (0.04, 0.04, 0.045),
          lights: [
              Directional(direction: (-0.35, -1.0, -0.45), color: (1.0, 1.0, 0.95), intensity: 0.35,
@@ -86,7 +96,7 @@ pub fn around_model(path: &Path) -> Result<Scene, SceneError> {
         size = extent * 6.0,
         at = v(Vec3::new(center.x, lo.y, center.z)),
     );
-    Scene::from_ron(&scene_text(mesh, file, &setting, &ground), path, base)
+    parse_description(&scene_text(mesh, file, &setting, &ground), path)
 }
 
 #[cfg(test)]
@@ -94,28 +104,40 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_model_is_staged_on_a_ground_it_rests_on_at_any_scale() {
+    fn a_model_is_staged_on_a_ground_at_its_foot_at_any_scale() {
         let dir = std::env::temp_dir().join(format!("zoo-stage-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        for scale in [1e-3_f32, 1.0, 1e4] {
-            let obj = dir.join(format!("tetra-{scale}.obj"));
-            let s = scale;
-            let text = format!(
-                "v 0 0 0\nv {s} 0 0\nv 0 {s} 0\nv 0 0 {s}\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
-            );
+        for s in [1e-3_f32, 1.0, 1e4] {
+            // A tetrahedron of side `s` away from the origin.
+            let at = Vec3::new(3.0, 5.0, -2.0) * s;
+            let corners = [Vec3::ZERO, Vec3::X * s, Vec3::Y * s, Vec3::Z * s].map(|c| c + at);
+            let mut text = String::new();
+            for c in corners {
+                text += &format!("v {} {} {}\n", c.x, c.y, c.z);
+            }
+            text += "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+            let obj = dir.join(format!("tetra-{s}.obj"));
             std::fs::write(&obj, text).unwrap();
             let scene = around_model(&obj).unwrap();
-            assert_eq!(scene.objects.len(), 2);
             assert_eq!(scene.lights.len(), 3);
-            let (lo, hi) = scene.bounds();
-            // The ground is at the model's foot and six times its size.
-            assert_eq!(lo.y, 0.0);
-            let extent = Vec3::splat(s).length();
+            let bounds = scene.each_object_bounds();
+            let ((model_lo, model_hi), (ground_lo, ground_hi)) =
+                (bounds[0].unwrap(), bounds[1].unwrap());
+            let extent = model_lo.distance(model_hi);
+            let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * extent;
+            // The ground is flat at the model's foot, six times its size, centred under it.
+            assert!(close(ground_lo.y, model_lo.y) && close(ground_hi.y, model_lo.y));
             assert!(
-                (hi.x - lo.x - 6.0 * extent).abs() <= 1e-3 * extent.max(1.0),
-                "{lo} {hi}"
+                close(ground_hi.x - ground_lo.x, 6.0 * extent),
+                "{ground_lo} {ground_hi}"
             );
+            let centre = (model_lo + model_hi) / 2.0;
+            assert!(close((ground_lo.x + ground_hi.x) / 2.0, centre.x));
+            // The camera looks at the model from outside it, its planes around it.
+            assert!(scene.camera.position.distance(centre) > extent);
             assert!(scene.camera.near < extent && scene.camera.far > 10.0 * extent);
+            // A model path works wherever a scene file does.
+            assert_eq!(crate::read_description(&obj).unwrap().objects.len(), 2);
         }
         let empty = dir.join("empty.obj");
         std::fs::write(&empty, "v 0 0 0\n").unwrap();

@@ -24,8 +24,8 @@ pub const POSITION_ERROR_FACTOR: f32 = if cfg!(target_arch = "wasm32") {
 };
 
 /// The generated module holding `RT_GBUFFER_POSITION_ERROR`, the judge's
-/// [`GBUFFER_POSITION_ERROR`] (times [`POSITION_ERROR_FACTOR`]), `RT_RASTER_SUBPIXEL`, [`RASTER_SUBPIXEL`], and `RT_TO_LIGHT`,
-/// the judge's [`SHADOW_RAY_TO_LIGHT`].
+/// [`GBUFFER_POSITION_ERROR`] (times [`POSITION_ERROR_FACTOR`]), `RT_RASTER_SUBPIXEL`,
+/// [`RASTER_SUBPIXEL`], and `RT_TO_LIGHT`, the judge's [`SHADOW_RAY_TO_LIGHT`].
 pub const ERROR_MODULE: &str = "ray-tracing/gbuffer_error.wgsl";
 
 /// The text of [`ERROR_MODULE`]: the factors as WGSL literals that parse back to the same
@@ -33,8 +33,9 @@ pub const ERROR_MODULE: &str = "ray-tracing/gbuffer_error.wgsl";
 fn error_module() -> String {
     let position_error = GBUFFER_POSITION_ERROR * POSITION_ERROR_FACTOR;
     format!(
-        "// Generated from `zoo_judge::GBUFFER_POSITION_ERROR`, `RASTER_SUBPIXEL` and\n\
-         // `zoo_judge::SHADOW_RAY_TO_LIGHT` (libs/ray-tracing/src/origin.rs).\n\
+        "// Generated from `zoo_judge::GBUFFER_POSITION_ERROR` (times\n\
+         // `POSITION_ERROR_FACTOR`), `RASTER_SUBPIXEL` and `zoo_judge::SHADOW_RAY_TO_LIGHT`\n\
+         // (libs/ray-tracing/src/origin.rs).\n\
          const RT_GBUFFER_POSITION_ERROR: f32 = {position_error:?};\n\
          const RT_RASTER_SUBPIXEL: f32 = {RASTER_SUBPIXEL:?};\n\
          const RT_TO_LIGHT: f32 = {SHADOW_RAY_TO_LIGHT:?};\n"

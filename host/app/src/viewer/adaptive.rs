@@ -9,6 +9,11 @@ use zoo_host::glam::UVec2;
 pub const MOVING_FRAME_MS: f64 = 100.0;
 /// The smallest share of the view's side rendered while it moves.
 pub const MIN_SCALE: f32 = 0.25;
+/// Scales are multiples of this: a new size reallocates the renderer's targets and restarts
+/// techniques' histories, so small steps of a noisy frame time must not change it.
+pub const SCALE_STEP: f32 = 1.0 / 16.0;
+/// Frames longer than this taught nothing (the window was hidden, or the process paused).
+pub const LONGEST_FRAME_MS: f64 = 2000.0;
 
 /// The scale (per side) of the view's pixels rendered, learnt from the frames' times.
 #[derive(Debug, Clone)]
@@ -17,6 +22,8 @@ pub struct AdaptiveResolution {
     moving_scale: f32,
     /// The scale the last frame rendered at.
     rendered_scale: f32,
+    /// Whether the last frame moved.
+    moving: bool,
 }
 
 impl Default for AdaptiveResolution {
@@ -24,6 +31,7 @@ impl Default for AdaptiveResolution {
         Self {
             moving_scale: 1.0,
             rendered_scale: 1.0,
+            moving: false,
         }
     }
 }
@@ -32,22 +40,26 @@ impl AdaptiveResolution {
     /// The size to render a view of `full` pixels at: all of them when the view is still, the
     /// learnt share of them while it moves (the camera or a light changed since last frame).
     pub fn size(&mut self, full: UVec2, moving: bool) -> UVec2 {
+        self.moving = moving;
         self.rendered_scale = if moving { self.moving_scale } else { 1.0 };
         let scaled = (full.as_vec2() * self.rendered_scale).round().as_uvec2();
         scaled.max(UVec2::splat(16)).min(full.max(UVec2::splat(16)))
     }
 
     /// Learns from the time, in milliseconds, that the frame rendered at the last
-    /// [`Self::size`] took. A frame's cost grows about as its pixels, the square of the scale;
-    /// each frame moves the scale at most by half or double toward the one that would take
+    /// [`Self::size`] took, if that frame moved (still frames render every pixel whatever
+    /// they cost). A frame's cost grows about as its pixels, the square of the scale; each
+    /// frame moves the scale at most by half or double toward the one that would take
     /// [`MOVING_FRAME_MS`], so one slow frame (a shader compiled, a map resized) does not
-    /// throw it to the floor.
+    /// throw it to the floor, and in steps of [`SCALE_STEP`].
     pub fn frame_took(&mut self, milliseconds: f64) {
-        if !(milliseconds.is_finite() && milliseconds > 0.0) {
+        let valid = milliseconds.is_finite() && milliseconds > 0.0;
+        if !(self.moving && valid && milliseconds <= LONGEST_FRAME_MS) {
             return;
         }
         let step = ((MOVING_FRAME_MS / milliseconds).sqrt() as f32).clamp(0.5, 2.0);
-        self.moving_scale = (self.rendered_scale * step).clamp(MIN_SCALE, 1.0);
+        let wanted = (self.rendered_scale * step).clamp(MIN_SCALE, 1.0);
+        self.moving_scale = ((wanted / SCALE_STEP).round() * SCALE_STEP).clamp(MIN_SCALE, 1.0);
     }
 
     /// The scale the last frame rendered at.
@@ -75,12 +87,30 @@ mod tests {
     }
 
     #[test]
-    fn a_still_view_renders_every_pixel_whatever_motion_cost() {
+    fn a_still_view_renders_every_pixel_and_keeps_what_motion_learnt() {
         let mut adaptive = AdaptiveResolution::default();
         settle(&mut adaptive, 0.0, 1e-3);
-        assert!(adaptive.moving_scale < 0.5);
+        let learnt = adaptive.moving_scale;
+        assert!(learnt < 0.5);
         assert_eq!(adaptive.size(FULL, false), FULL);
         assert_eq!(adaptive.rendered_scale(), 1.0);
+        adaptive.frame_took(480.0);
+        assert_eq!(adaptive.moving_scale, learnt);
+    }
+
+    #[test]
+    fn sizes_change_in_steps_and_a_paused_frame_teaches_nothing() {
+        let mut adaptive = AdaptiveResolution::default();
+        let per_pixel = 1200.0 / f64::from(FULL.x * FULL.y);
+        settle(&mut adaptive, 0.0, per_pixel);
+        let size = adaptive.size(FULL, true);
+        // Frame times a few per cent off the aim keep the size.
+        for jitter in [0.97, 1.03, 0.95, 1.05] {
+            adaptive.frame_took(MOVING_FRAME_MS * jitter);
+            assert_eq!(adaptive.size(FULL, true), size);
+        }
+        adaptive.frame_took(60_000.0);
+        assert_eq!(adaptive.size(FULL, true), size);
     }
 
     #[test]
@@ -89,7 +119,8 @@ mod tests {
         let mut adaptive = AdaptiveResolution::default();
         let per_pixel = 1200.0 / f64::from(FULL.x * FULL.y);
         let took = settle(&mut adaptive, 0.0, per_pixel);
-        assert!((took - MOVING_FRAME_MS).abs() < 5.0, "{took} ms");
+        // Within the scale's step: 100 ms at a scale of 0.289, which rounds to 0.3125.
+        assert!((took - MOVING_FRAME_MS).abs() < 20.0, "{took} ms");
         // A fast adapter keeps every pixel while moving.
         let mut fast = AdaptiveResolution::default();
         settle(&mut fast, 2.0, 1e-5);
@@ -107,7 +138,7 @@ mod tests {
     fn one_slow_frame_halves_the_scale_at_most() {
         let mut adaptive = AdaptiveResolution::default();
         adaptive.size(FULL, true);
-        adaptive.frame_took(1e6);
+        adaptive.frame_took(1900.0);
         assert_eq!(adaptive.size(FULL, true), UVec2::new(400, 300));
         adaptive.frame_took(f64::NAN);
         assert_eq!(adaptive.size(FULL, true), UVec2::new(400, 300));

@@ -31,7 +31,8 @@ pub use window::run;
 #[cfg(feature = "window")]
 pub use window::{ViewerApp, device_descriptor};
 
-/// Without the `window` feature (the test build's choice) there is no viewer window.
+/// Without the `window` feature (the test build's choice), and in the browser build (whose
+/// page starts the viewer, `web/`), there is no native viewer window.
 #[cfg(not(all(feature = "window", not(target_arch = "wasm32"))))]
 pub fn run() -> anyhow::Result<()> {
     anyhow::bail!(

@@ -148,7 +148,7 @@ Source: {}",
             let label = ui.label("scene file");
             ui.add(
                 egui::TextEdit::singleline(&mut self.scene_file)
-                    .hint_text("any .ron scene")
+                    .hint_text("a .ron scene or a model")
                     .desired_width(150.0),
             )
             .labelled_by(label.id);
