@@ -204,3 +204,56 @@ fn hard_visibility_agrees_off_shadow_edges_at_512() {
     let over = hard_agreement_everywhere(UVec2::splat(512));
     assert!(over.is_empty(), "{over:#?}");
 }
+
+/// A readout requested without waiting arrives frames later with exactly what the blocking
+/// reads see: the G-buffer, the image, and each light's visibility and transmittance (lights
+/// sharing packed slots, and a technique that writes transmittance through coloured glass).
+#[test]
+fn readouts_without_waiting_match_the_blocking_reads() {
+    use zoo_host::render::{ReadoutRequest, View};
+    let size = UVec2::new(96, 64);
+    for (scene, technique) in [
+        ("many-lights.ron", "sm-pcf"),
+        ("translucent.ron", "rt-shadows"),
+    ] {
+        let scene = Scene::load(&zoo_host::test_support::scene_path(scene)).unwrap();
+        let mut renderer = Renderer::new(gpu(), scene, size).unwrap();
+        renderer
+            .set_technique(technique, &Default::default())
+            .unwrap();
+        renderer.render(&View::Final).unwrap();
+        let request = ReadoutRequest {
+            gbuffer: true,
+            output: true,
+            lights: true,
+        };
+        let mut pending = renderer.request_readout(request);
+        let readout = loop {
+            if let Some(readout) = pending.poll(renderer.gpu(), false) {
+                break readout.unwrap();
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        };
+        assert!(
+            pending.poll(renderer.gpu(), false).unwrap().is_err(),
+            "taken once"
+        );
+        let gbuffer = renderer.read_gbuffer();
+        let arrived = readout.gbuffer.unwrap();
+        assert_eq!(arrived.positions, gbuffer.positions);
+        assert_eq!(arrived.normals, gbuffer.normals);
+        assert_eq!(arrived.materials, gbuffer.materials);
+        assert_eq!(readout.output.unwrap(), renderer.read_output());
+        let lights = renderer.lights().len();
+        assert_eq!(readout.visibility.len(), lights);
+        let coloured = renderer.scene().has_translucent_casters() && technique == "rt-shadows";
+        for light in 0..lights {
+            assert_eq!(readout.visibility[light], renderer.read_visibility(light));
+            let transmittance = readout.transmittance[light].as_ref();
+            assert_eq!(transmittance.is_some(), coloured, "light {light}");
+            if let Some(t) = transmittance {
+                assert_eq!(t, &renderer.read_transmittance(light));
+            }
+        }
+    }
+}

@@ -522,6 +522,66 @@ fn live_reference_follows_the_camera_and_agrees_with_the_cpu_judge() {
     }
 }
 
+/// Where nothing may wait for the GPU (the browser), the live judge's traces and judged frames
+/// arrive frames later: no verdict in the frame of a change, then one for the view shown,
+/// area rays added up to the GPU judge's samples, and the waiting judge's verdict.
+#[test]
+fn live_reference_without_waiting_arrives_frames_later_with_the_same_verdict() {
+    use shadow_zoo::gpu_judge::MAX_SAMPLES;
+    let verdict = |wait: bool| {
+        let mut harness = harness();
+        harness.run();
+        harness.get_by_label("sm-pcf").click();
+        harness.run();
+        harness.state_mut().reference.set_live_waits(wait);
+        harness.get_by_label("live (GPU)").click();
+        harness.step();
+        if !wait {
+            // The click's frame started the trace; nothing has been read back in it.
+            assert!(harness.state().reference.result.is_none());
+        }
+        let mut frames = 1;
+        while harness.state().reference.live_samples() != Some(MAX_SAMPLES) {
+            assert!(
+                frames < 40 * MAX_SAMPLES,
+                "{MAX_SAMPLES} area rays a pixel never arrived"
+            );
+            harness.step();
+            frames += 1;
+        }
+        // The verdict for the last trace may still be on its way.
+        for _ in 0..40 {
+            let result = harness.state().reference.result.as_ref();
+            if result.is_some_and(|r| r.live_samples == Some(MAX_SAMPLES)) {
+                break;
+            }
+            harness.step();
+        }
+        let state = harness.state();
+        assert!(state.error.is_none(), "{:?}", state.error);
+        let result = state.reference.result.as_ref().expect("a live verdict");
+        assert_eq!(result.live_samples, Some(MAX_SAMPLES));
+        assert_eq!(&result.view.camera, state.renderer.camera());
+        (frames, result.metrics.clone())
+    };
+    let (frames_waiting, waiting) = verdict(true);
+    let (frames, later) = verdict(false);
+    eprintln!("{MAX_SAMPLES} area rays: {frames_waiting} frames waiting, {frames} without");
+    assert!(frames >= frames_waiting);
+    for (light, (waiting, later)) in waiting.iter().zip(&later).enumerate() {
+        let (waiting, later) = (waiting.as_ref().unwrap(), later.as_ref().unwrap());
+        assert!((waiting.mae - later.mae).abs() <= 0.002, "light {light}");
+        assert!(
+            (waiting.false_shadow - later.false_shadow).abs() <= 0.002,
+            "light {light}"
+        );
+        assert!(
+            (waiting.false_lit - later.false_lit).abs() <= 0.002,
+            "light {light}"
+        );
+    }
+}
+
 #[test]
 fn ab_split_and_difference_compare_two_techniques() {
     let mut harness = harness();

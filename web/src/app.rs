@@ -30,6 +30,54 @@ struct Status {
     adapter: String,
     /// The last technique failure or scene error, if any.
     error: Option<String>,
+    /// The live judge's latest verdict, while it is on and once one has arrived.
+    judge: Option<Verdict>,
+}
+
+/// The live GPU judge's verdict on the view, as the page reads it.
+#[derive(Debug, Clone, Serialize)]
+struct Verdict {
+    technique: String,
+    /// Area rays a pixel traced for the reference (0: hard visibility only).
+    samples: u32,
+    /// Per light: its scores, or `null` where the technique does not support its kind.
+    lights: Vec<Option<LightScores>>,
+}
+
+/// A light's scores against the reference (fractions of the pixels it reaches).
+#[derive(Debug, Clone, Serialize)]
+struct LightScores {
+    pixels: usize,
+    false_shadow: f64,
+    false_lit: f64,
+    false_shadow_core: f64,
+    false_lit_core: f64,
+    mae: f64,
+}
+
+impl Verdict {
+    /// The live judge's latest verdict in `state`, while it is on.
+    fn of(state: &ViewerState) -> Option<Verdict> {
+        state.reference.live_samples()?;
+        let result = state.reference.result.as_ref()?;
+        let lights = (result.metrics.iter())
+            .map(|m| {
+                m.map(|m| LightScores {
+                    pixels: m.pixels,
+                    false_shadow: m.false_shadow,
+                    false_lit: m.false_lit,
+                    false_shadow_core: m.false_shadow_core,
+                    false_lit_core: m.false_lit_core,
+                    mae: m.mae,
+                })
+            })
+            .collect();
+        Some(Verdict {
+            technique: result.view.technique.clone(),
+            samples: result.live_samples?,
+            lights,
+        })
+    }
 }
 
 /// One technique as the page lists it (JSON from [`techniques`]).
@@ -83,6 +131,7 @@ impl WebApp {
         if let Err(e) = set_params(&mut viewer.state, &query.set) {
             viewer.state.error = Some(format!("the address's `set`: {e}"));
         }
+        viewer.state.reference.live = query.judge_live;
         let gpu = viewer.state.renderer.gpu().clone();
         let techniques = (zoo_host::technique::registry().into_iter())
             .map(|r| TechniqueEntry {
@@ -130,6 +179,7 @@ impl eframe::App for WebApp {
             technique: state.technique.clone(),
             adapter: String::new(),
             error: state.error.clone().or_else(|| state.scene_error.clone()),
+            judge: Verdict::of(state),
         };
         PAGE.with_borrow_mut(|page| {
             page.status = Status {
@@ -170,7 +220,8 @@ pub async fn start(canvas: web_sys::HtmlCanvasElement, query: Query) -> Result<(
         .await
 }
 
-/// The viewer's state as JSON: frames rendered, scene, technique, adapter and last error.
+/// The viewer's state as JSON: frames rendered, scene, technique, adapter, last error and the
+/// live judge's verdict.
 #[wasm_bindgen]
 pub fn status() -> String {
     PAGE.with_borrow(|page| serde_json::to_string(&page.status).unwrap_or_default())

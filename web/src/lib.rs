@@ -4,8 +4,9 @@
 //!
 //! The page calls [`start`] with its canvas. The address's query picks what to show first:
 //! `scene=NAME.ron` (a bundled scene), `technique=ID`, `set=KEY=VALUE` (its parameters),
-//! `size=WxH` (render at that size whatever the view's, as the test does) and `capture=N`
-//! (keep frame N for [`frame`]).
+//! `size=WxH` (render at that size whatever the view's, as the test does), `capture=N`
+//! (keep frame N for [`frame`]) and `judge=live` (judge the view live on the GPU; [`status`]
+//! reports the verdict).
 #![cfg(target_arch = "wasm32")]
 
 mod app;

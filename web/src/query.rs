@@ -1,5 +1,5 @@
 //! What the page's address asks for:
-//! `?scene=...&technique=...&set=KEY=VALUE&size=WxH&capture=N`.
+//! `?scene=...&technique=...&set=KEY=VALUE&size=WxH&capture=N&judge=live`.
 
 use zoo_host::glam::UVec2;
 
@@ -17,6 +17,8 @@ pub struct Query {
     pub size: Option<UVec2>,
     /// The frame (counted from 1) to keep for [`crate::frame`].
     pub capture: Option<u64>,
+    /// Whether the live GPU judge starts on (`judge=live`).
+    pub judge_live: bool,
 }
 
 impl Query {
@@ -50,6 +52,12 @@ impl Query {
             }
             parsed
         });
+        let judge_live = params.get("judge").is_some_and(|judge| {
+            if judge != "live" {
+                log::warn!("judge={judge}: the browser judges live on the GPU only (judge=live)");
+            }
+            judge == "live"
+        });
         let set = (params.get_all("set").iter())
             .filter_map(|value| {
                 let text = value.as_string()?;
@@ -68,6 +76,7 @@ impl Query {
             set,
             size,
             capture,
+            judge_live,
         }
     }
 }

@@ -4,7 +4,9 @@
 // that technique at a fixed size, reads its third frame back through a buffer (canvas
 // screenshots can come back blank under headless SwiftShader), and checks that the frame is
 // not empty, that it matches the native lavapipe render of the same scene, view and size,
-// and that the console shows no error. Prints a table; exits non-zero on any failure.
+// and that the console shows no error. Then judges one technique live on the browser's GPU
+// and checks its verdict against the native CPU judge's, the arbiter. Prints a table; exits
+// non-zero on any failure.
 //
 // node browser-test.mjs --dist web/dist --native-bin target/debug/shadow-zoo
 //     --chromium /usr/bin/chromium --out DIR [--size 256] [--only a,b]
@@ -32,6 +34,15 @@ const PIXEL_SHARE_BOUND = 0.01;
 const COMPARED_FRAME = 3;
 // Per technique: loading the page and rendering its first frames on SwiftShader.
 const FRAME_TIMEOUT_MS = 120_000;
+// The live judge's check: the technique, the area rays a pixel it waits for (the GPU judge's
+// most), how long that may take, and how far each light's scores may be from the native CPU
+// judge's (as the native live judge's test bounds them: the two locate the lit pixels and
+// trace on different machines, and both reference and technique render on SwiftShader here).
+const JUDGED = "sm-pcf";
+const JUDGE_SAMPLES = 64;
+const JUDGE_TIMEOUT_MS = 300_000;
+const JUDGE_BOUND = 0.01;
+const DEFAULT_SCENE = "scenes/planar-room.ron";
 
 function parseArgs() {
   const args = { size: 256, only: null };
@@ -257,6 +268,69 @@ async function checkOpenedModel(browser, url, failures) {
   await page.close();
 }
 
+// Reads a CSV with a header row into objects.
+function readCsv(path) {
+  const [header, ...lines] = readFileSync(path, "utf8").trim().split("\n");
+  const keys = header.split(",");
+  return lines.map((line) => Object.fromEntries(line.split(",").map((v, i) => [keys[i], v])));
+}
+
+// Judges JUDGED live on the browser's GPU (`judge=live`) until the reference has
+// JUDGE_SAMPLES area rays a pixel, and compares each light's scores with the native CPU
+// judge's (`compare`, same scene, view and size).
+async function checkLiveJudge(args, browser, failures) {
+  const size = `${args.size}x${args.size}`;
+  const url = `${args.url}?technique=${JUDGED}&size=${size}&judge=live`;
+  let opened;
+  try {
+    opened = await openPage(browser, url, () => window.zoo && JSON.parse(window.zoo.status()).judge);
+  } catch (error) {
+    failures.push(`live judge: no verdict within ${FRAME_TIMEOUT_MS} ms (${error})`);
+    return [];
+  }
+  const { page, errors, ms } = opened;
+  const started = Date.now();
+  let verdict;
+  try {
+    await page.waitForFunction((samples) => {
+      const status = JSON.parse(window.zoo.status());
+      return status.error || status.judge?.samples >= samples;
+    }, JUDGE_SAMPLES, { timeout: JUDGE_TIMEOUT_MS, polling: 250 });
+  } catch (error) {
+    failures.push(`live judge: ${JUDGE_SAMPLES} area rays not reached (${error.message})`);
+  }
+  const status = JSON.parse(await page.evaluate(() => window.zoo.status()));
+  verdict = status.judge;
+  await page.close();
+  if (status.error) failures.push(`live judge: ${status.error}`);
+  failures.push(...errors.map((e) => `live judge: ${e}`));
+  const out = `${args.out}/judge`;
+  execFileSync(args.nativeBin,
+    ["compare", "--scene", DEFAULT_SCENE, "--techniques", JUDGED, "--size", size, "--out", out],
+    { stdio: ["ignore", "ignore", "inherit"] });
+  const cpu = readCsv(`${out}/results.csv`).filter((row) => row.technique === JUDGED);
+  const rows = [`live judge of ${JUDGED}: first verdict ${ms} ms after load, ` +
+    `${verdict?.samples} area rays a pixel ${Date.now() - started} ms later; ` +
+    `bound: each score within ${JUDGE_BOUND} of the native CPU judge's`,
+  "| light | browser live: false shadow / false lit / mae | native CPU judge | verdict |",
+  "|---|---|---|---|"];
+  if (!verdict || verdict.lights.length !== cpu.length) {
+    failures.push(`live judge: ${verdict?.lights.length} lights judged, native ${cpu.length}`);
+    return rows;
+  }
+  cpu.forEach((row, light) => {
+    const live = verdict.lights[light];
+    const scores = ["false_shadow", "false_lit", "mae"];
+    const off = live ? scores.filter((k) => Math.abs(live[k] - Number(row[k])) > JUDGE_BOUND)
+      : (row.pixels === "" ? [] : ["not scored"]);
+    const show = (m) => m ? scores.map((k) => Number(m[k]).toFixed(4)).join(" / ") : "-";
+    rows.push(`| ${light} | ${show(live)} | ${show(row.pixels === "" ? null : row)} | ` +
+      `${off.length ? "FAIL" : "ok"} |`);
+    if (off.length) failures.push(`live judge, light ${light}: ${off.join(", ")} off by > ${JUDGE_BOUND}`);
+  });
+  return rows;
+}
+
 async function main() {
   const args = parseArgs();
   const { server, url } = await serve(args.dist);
@@ -264,6 +338,7 @@ async function main() {
   const browser = await chromium.launch(launchOptions(args.chromium));
   const failures = [];
   const rows = [];
+  let judged = [];
   try {
     // The page lists what runs here.
     const first = await openPage(browser, args.url,
@@ -340,6 +415,9 @@ async function main() {
         `${problems.length ? "FAIL" : "ok"} |`);
       for (const problem of problems) failures.push(`${technique.id}: ${problem}`);
     }
+    if (!args.only || args.only.includes(JUDGED)) {
+      judged = await checkLiveJudge(args, browser, failures);
+    }
   } finally {
     await browser.close();
     server.close();
@@ -352,6 +430,8 @@ async function main() {
       "pixels off (%) | verdict |",
     "|---|---|---|---|---|---|",
     ...rows,
+    "",
+    ...judged,
   ].join("\n");
   console.log(table);
   writeFileSync(`${args.out}/report.md`, table + "\n");

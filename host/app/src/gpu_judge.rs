@@ -40,15 +40,21 @@ pub fn read_traced(renderer: &Renderer) -> Vec<Vec<Vec3>> {
     let coloured = (renderer.technique_instance()).writes_transmittance(renderer.scene());
     (0..renderer.lights().len())
         .map(|light| {
-            let visibility = renderer.read_visibility(light);
-            match coloured.then(|| renderer.read_transmittance(light)) {
-                Some(colour) => (visibility.iter().zip(&colour))
-                    .map(|(v, c)| *v * *c)
-                    .collect(),
-                None => visibility.iter().map(|v| Vec3::splat(*v)).collect(),
-            }
+            let colour = coloured.then(|| renderer.read_transmittance(light));
+            traced_colour(&renderer.read_visibility(light), colour.as_deref())
         })
         .collect()
+}
+
+/// The colour fraction of a light that arrives: `visibility` times the `transmittance`
+/// colour, where the tracer writes one.
+pub fn traced_colour(visibility: &[f32], transmittance: Option<&[Vec3]>) -> Vec<Vec3> {
+    match transmittance {
+        Some(colour) => (visibility.iter().zip(colour))
+            .map(|(v, c)| *v * *c)
+            .collect(),
+        None => visibility.iter().map(|v| Vec3::splat(*v)).collect(),
+    }
 }
 
 /// A light's reference from traced `hard` and `area` colour fractions ([`read_traced`];

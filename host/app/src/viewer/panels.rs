@@ -92,14 +92,7 @@ impl ViewerState {
         egui::CollapsingHeader::new("Reference judge")
             .default_open(true)
             .show(ui, |ui| {
-                if cfg!(target_arch = "wasm32") {
-                    // Both judges read the frame back before it ends, which a browser cannot.
-                    ui.label(
-                        "Not in the browser build yet: the judges read each frame back as it \
-                         ends, which a browser cannot wait for. Run the native viewer or \
-                         `shadow-zoo compare`.",
-                    );
-                } else if let Some(e) = self.reference.panel(ui, &mut self.renderer) {
+                if let Some(e) = self.reference.panel(ui, &mut self.renderer) {
                     self.error = Some(e);
                 }
             });

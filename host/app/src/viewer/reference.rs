@@ -22,6 +22,18 @@ struct Running {
     worker: JoinHandle<Judgement>,
 }
 
+/// Why the CPU judge cannot run here, where it cannot: it traces on a thread of its own and
+/// reads the frame back as it ends.
+const CPU_JUDGE_UNAVAILABLE: Option<&str> = if cfg!(target_arch = "wasm32") {
+    Some(
+        "The CPU judge needs a thread beside the page's and a frame read back at once; this \
+         browser build has neither (no shared-memory workers). Use the live GPU judge, or the \
+         native `shadow-zoo compare`.",
+    )
+} else {
+    None
+};
+
 /// The overlay's state: idle, judging in the background, or showing a result.
 #[derive(Default)]
 pub struct ReferenceOverlay {
@@ -122,6 +134,13 @@ impl ReferenceOverlay {
                 Err(e)
             }
         }
+    }
+
+    /// Whether the live judge waits for the GPU to read its traces and the judged frame back
+    /// (natively it does, and each frame's verdict is its own), or collects them frames later,
+    /// as it must in a browser. Restarts the live judge.
+    pub fn set_live_waits(&mut self, wait: bool) {
+        self.live_reference = LiveReference::new(wait);
     }
 
     /// Area rays a pixel the live judge has traced for the current view, while it is on.
@@ -230,11 +249,17 @@ impl ReferenceOverlay {
         let mut error = None;
         ui.horizontal(|ui| {
             let button = ui
-                .add_enabled(!self.is_running(), egui::Button::new("Judge view"))
+                .add_enabled(
+                    CPU_JUDGE_UNAVAILABLE.is_none() && !self.is_running(),
+                    egui::Button::new("Judge view"),
+                )
                 .on_hover_text(
                     "Trace exact visibility for this view in the background and overlay \
                      where the technique disagrees",
                 );
+            if let Some(why) = CPU_JUDGE_UNAVAILABLE {
+                ui.label("CPU judge: not in the browser").on_hover_text(why);
+            }
             if button.clicked() {
                 // The CPU judge, the arbiter, replaces the live one.
                 self.live = false;

@@ -89,6 +89,85 @@ impl TextureCopy {
     }
 }
 
+/// Texture copies read back without blocking a frame: each is mapped as soon as it is
+/// submitted, and [`Self::take`] hands over all their bytes once every one has arrived.
+pub struct PendingCopies {
+    copies: Vec<TextureCopy>,
+    states: Vec<std::sync::Arc<std::sync::Mutex<MapState>>>,
+    taken: bool,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum MapState {
+    Mapping,
+    Mapped,
+    Failed(String),
+}
+
+impl PendingCopies {
+    /// Starts mapping every copy of `copies` (already submitted).
+    pub fn map(copies: Vec<TextureCopy>) -> PendingCopies {
+        let states = copies
+            .iter()
+            .map(|copy| {
+                let state = std::sync::Arc::new(std::sync::Mutex::new(MapState::Mapping));
+                let shared = state.clone();
+                copy.buffer
+                    .slice(..)
+                    .map_async(wgpu::MapMode::Read, move |result| {
+                        if let Ok(mut state) = shared.lock() {
+                            *state = match result {
+                                Ok(()) => MapState::Mapped,
+                                Err(e) => MapState::Failed(e.to_string()),
+                            };
+                        }
+                    });
+                state
+            })
+            .collect();
+        PendingCopies {
+            copies,
+            states,
+            taken: false,
+        }
+    }
+
+    /// Every copy's tightly packed bytes, in the order given, once all have arrived (waiting
+    /// for the GPU when `wait`); `None` while some are still on their way. The bytes are handed
+    /// over once: later calls return an error.
+    pub fn take(&mut self, gpu: &GpuContext, wait: bool) -> Option<Result<Vec<Vec<u8>>, String>> {
+        if self.taken {
+            return Some(Err("the copies were already taken".into()));
+        }
+        if wait {
+            gpu.wait_idle();
+        } else {
+            let _ = gpu.device.poll(wgpu::PollType::Poll);
+        }
+        let states: Vec<MapState> = (self.states.iter())
+            .map(|s| s.lock().map_or(MapState::Mapping, |s| s.clone()))
+            .collect();
+        if let Some(MapState::Failed(e)) = states.iter().find(|s| matches!(s, MapState::Failed(_)))
+        {
+            return Some(Err(format!("buffer mapping failed: {e}")));
+        }
+        if states.contains(&MapState::Mapping) {
+            return None;
+        }
+        self.taken = true;
+        let mut all = Vec::with_capacity(self.copies.len());
+        for copy in std::mem::take(&mut self.copies) {
+            let bytes = match copy.buffer.slice(..).get_mapped_range() {
+                Ok(view) => copy.unpadded(&view),
+                Err(e) => return Some(Err(format!("buffer mapping failed: {e}"))),
+            };
+            copy.buffer.unmap();
+            all.push(bytes);
+        }
+        Some(Ok(all))
+    }
+}
+
 /// Maps a `MAP_READ` buffer, waits for it, and copies its contents out.
 pub fn map_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<u8> {
     let slice = buffer.slice(..);

@@ -337,17 +337,22 @@ pub fn judge_technique(
 /// visibility, times the mean of its transmittance colour where it writes one (behind
 /// translucent casters the light that arrives, as the reference's), and that colour.
 pub fn scored_visibility(renderer: &Renderer, light: usize) -> (Vec<f32>, Option<Vec<glam::Vec3>>) {
-    let mut v = renderer.read_visibility(light);
     let colored = renderer
         .technique_instance()
         .writes_transmittance(renderer.scene());
     let t = colored.then(|| renderer.read_transmittance(light));
-    if let Some(t) = &t {
-        for (v, t) in v.iter_mut().zip(t) {
+    (scored(renderer.read_visibility(light), t.as_deref()), t)
+}
+
+/// Visibility as scored: times the mean of the colour kept through translucent casters, where
+/// the technique writes it.
+pub fn scored(mut visibility: Vec<f32>, transmittance: Option<&[glam::Vec3]>) -> Vec<f32> {
+    if let Some(t) = transmittance {
+        for (v, t) in visibility.iter_mut().zip(t) {
             *v *= (t.x + t.y + t.z) / 3.0;
         }
     }
-    (v, t)
+    visibility
 }
 
 /// The error map of one light: red where the technique shadows a lit pixel, blue where it

@@ -14,7 +14,10 @@ pub use difference::ImageDifference;
 pub use frame::{CameraMatrices, FrameBindings};
 pub use gbuffer::GBuffer;
 pub use materials::MaterialBindings;
-pub use renderer::{GBufferData, MAX_OUTPUT_SIDE, Overlay, RenderError, Renderer, View};
+pub use renderer::{
+    GBufferData, MAX_OUTPUT_SIDE, Overlay, PendingReadout, Readout, ReadoutRequest, RenderError,
+    Renderer, View,
+};
 pub use scene_buffers::{Placement, SceneBuffers, Vertex, drawn_runs};
 pub use visibility::{
     IndirectTarget, SlotAssignment, SlotRequest, TransmittanceTargets, VisibilityTargets,

@@ -10,7 +10,7 @@ mod readout;
 mod view;
 
 use containment::{ActiveTechnique, guarded, instantiate};
-pub use readout::GBufferData;
+pub use readout::{GBufferData, PendingReadout, Readout, ReadoutRequest};
 pub use view::{Overlay, View};
 
 use super::debug_view::DebugViewPass;
