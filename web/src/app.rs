@@ -26,6 +26,9 @@ struct Status {
     /// The scene shown (its file, or the built-in default).
     scene: String,
     technique: String,
+    /// The size the 3D view rendered at last frame (fewer pixels while it moves on a slow
+    /// adapter).
+    size: [u32; 2],
     /// The adapter, backend and driver.
     adapter: String,
     /// The last technique failure or scene error, if any.
@@ -177,6 +180,7 @@ impl eframe::App for WebApp {
             frames: self.frames,
             scene: self.scene.clone(),
             technique: state.technique.clone(),
+            size: state.renderer.size().to_array(),
             adapter: String::new(),
             error: state.error.clone().or_else(|| state.scene_error.clone()),
             judge: Verdict::of(state),
