@@ -6,6 +6,7 @@
 
 mod bench;
 mod bias_artifacts;
+mod claims;
 mod cli;
 mod contact_sheet;
 mod exact_methods;

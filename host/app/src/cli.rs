@@ -29,6 +29,24 @@ pub enum Command {
     /// Benchmark techniques along the scene's camera and light paths: per-pass GPU times,
     /// CPU frame times, counters and flicker, as CSV, markdown and PNG plots.
     Bench(BenchArgs),
+    /// Reproduce the sources' headline claims: one measurement per claim (a bench suite's
+    /// ratio, or the judge for seed 000's claims without numbers), written as claims.md and
+    /// claims.csv beside the sources' figures.
+    Claims(ClaimsArgs),
+}
+
+/// Arguments of `shadow-zoo claims`.
+#[derive(Debug, clap::Args)]
+pub struct ClaimsArgs {
+    /// Folder for claims.md, claims.csv and the benchmark's outputs (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Only the claims whose text or source contains this (any case), e.g. `seed 002`.
+    #[arg(long)]
+    pub only: Option<String>,
+    /// Read WGSL from DIR first (laid out as `shaders/`).
+    #[arg(long, value_name = "DIR")]
+    pub shaders: Option<PathBuf>,
 }
 
 /// Arguments of `shadow-zoo bench`.

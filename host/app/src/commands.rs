@@ -21,6 +21,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Render(args)) => render(&args),
         Some(Command::Compare(args)) => crate::compare::run(&args),
         Some(Command::Bench(args)) => crate::bench::run(&args),
+        Some(Command::Claims(args)) => crate::claims::run(&args),
     }
 }
 

@@ -4,6 +4,7 @@
 //! binary and the workspace integration tests see the same registry.
 
 pub mod bench;
+pub mod claims;
 pub mod cli;
 pub mod commands;
 pub mod compare;

@@ -6,6 +6,8 @@ use std::sync::{Arc, OnceLock};
 
 use crate::gpu::GpuContext;
 
+pub use zoo_judge::Metric;
+
 /// The shared headless context, created on first use. Panics with the driver install hint when
 /// no adapter exists, since GPU tests cannot run then.
 pub fn gpu() -> Arc<GpuContext> {
@@ -63,43 +65,6 @@ pub fn shared_models() -> Option<PathBuf> {
 /// Path of a scene shipped in `scenes/`.
 pub fn scene_path(name: &str) -> PathBuf {
     workspace_root().join("scenes").join(name)
-}
-
-/// A metric the judge reports, for bounds in plugin tests.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Metric {
-    FalseShadow,
-    FalseLit,
-    FalseShadowCore,
-    FalseLitCore,
-    Mae,
-    P95Error,
-}
-
-impl Metric {
-    /// Column name as in `results.csv`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Metric::FalseShadow => "false_shadow",
-            Metric::FalseLit => "false_lit",
-            Metric::FalseShadowCore => "false_shadow_core",
-            Metric::FalseLitCore => "false_lit_core",
-            Metric::Mae => "mae",
-            Metric::P95Error => "p95_error",
-        }
-    }
-
-    /// This metric's value in `metrics`.
-    pub fn of(self, metrics: &zoo_judge::Metrics) -> f64 {
-        match self {
-            Metric::FalseShadow => metrics.false_shadow,
-            Metric::FalseLit => metrics.false_lit,
-            Metric::FalseShadowCore => metrics.false_shadow_core,
-            Metric::FalseLitCore => metrics.false_lit_core,
-            Metric::Mae => metrics.mae,
-            Metric::P95Error => metrics.p95_error,
-        }
-    }
 }
 
 /// A technique rendered on a scene and judged.

@@ -23,7 +23,7 @@ mod surfaces;
 pub use bvh::{FlatBvh, FlatNode, has_no_area};
 pub use indirect::{ReflectorHit, Reflectors, one_bounce, reflected_direct, relative_rmse};
 pub use leak::{leak, lit_points, unlit_by_one_bounce};
-pub use metrics::{ErrorClass, Metrics, edge_band, error_class, percentile};
+pub use metrics::{ErrorClass, Metric, Metrics, edge_band, error_class, percentile};
 pub use occluders::Occluders;
 pub use placed::placed_box;
 pub use reference::{DEFAULT_AREA_SAMPLES, LightReference, reference_visibility};

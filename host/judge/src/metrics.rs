@@ -21,6 +21,58 @@ pub struct Metrics {
     pub p95_error: f64,
 }
 
+/// One of the judge's metrics, by name (bounds in tests, the claims report).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Metric {
+    FalseShadow,
+    FalseLit,
+    FalseShadowCore,
+    FalseLitCore,
+    Mae,
+    P95Error,
+}
+
+impl Metric {
+    /// Every metric.
+    pub const ALL: [Metric; 6] = [
+        Metric::FalseShadow,
+        Metric::FalseLit,
+        Metric::FalseShadowCore,
+        Metric::FalseLitCore,
+        Metric::Mae,
+        Metric::P95Error,
+    ];
+
+    /// The metric whose [`Self::name`] is `name`.
+    pub fn named(name: &str) -> Option<Metric> {
+        Metric::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// Column name as in `results.csv`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::FalseShadow => "false_shadow",
+            Metric::FalseLit => "false_lit",
+            Metric::FalseShadowCore => "false_shadow_core",
+            Metric::FalseLitCore => "false_lit_core",
+            Metric::Mae => "mae",
+            Metric::P95Error => "p95_error",
+        }
+    }
+
+    /// This metric's value in `metrics`.
+    pub fn of(self, metrics: &Metrics) -> f64 {
+        match self {
+            Metric::FalseShadow => metrics.false_shadow,
+            Metric::FalseLit => metrics.false_lit,
+            Metric::FalseShadowCore => metrics.false_shadow_core,
+            Metric::FalseLitCore => metrics.false_lit_core,
+            Metric::Mae => metrics.mae,
+            Metric::P95Error => metrics.p95_error,
+        }
+    }
+}
+
 /// How a pixel's technique visibility compares with the hard reference.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ErrorClass {

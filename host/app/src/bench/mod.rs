@@ -114,6 +114,29 @@ pub fn run_plans(
     Ok(BenchRun { results, skipped })
 }
 
+/// How suite runs are measured: `bench`'s flags, or the claims report's choices.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunOptions {
+    /// Measured frames instead of each run's own.
+    pub frames: Option<u32>,
+    /// Whether to measure flicker (against the judge's reference, frame by frame).
+    pub flicker: bool,
+    pub cpu_timing: bool,
+    pub reuse_unchanged: bool,
+}
+
+impl RunOptions {
+    /// The options `bench`'s flags give.
+    fn of(args: &BenchArgs) -> RunOptions {
+        RunOptions {
+            frames: args.frames,
+            flicker: !args.no_flicker,
+            cpu_timing: args.cpu_timing,
+            reuse_unchanged: args.reuse_unchanged,
+        }
+    }
+}
+
 /// The plans of suite `name`'s runs, the suite, and the runs skipped because files they need
 /// are absent.
 fn suite_plans(
@@ -123,7 +146,19 @@ fn suite_plans(
     let path = suite::locate(name)?;
     let s = suite::load(&path)?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let absent = (s.runs.iter())
+    let (plans, absent) = plans_of_runs(&s.runs, dir, &RunOptions::of(args))
+        .with_context(|| format!("suite {}", path.display()))?;
+    Ok((plans, s, absent))
+}
+
+/// The plans of `runs` (their scenes relative to the suite's folder `dir`), and the runs
+/// skipped because files they need are absent.
+pub fn plans_of_runs(
+    runs: &[suite::SuiteRun],
+    dir: &Path,
+    options: &RunOptions,
+) -> anyhow::Result<(Vec<BenchPlan>, Vec<Skipped>)> {
+    let absent = (runs.iter())
         .filter_map(|run| {
             let reason = run.missing(dir)?;
             let configuration = format!("{}: every configuration", run.name);
@@ -133,19 +168,18 @@ fn suite_plans(
             })
         })
         .collect();
-    let plans = (s.runs.iter())
+    let plans = (runs.iter())
         .filter(|run| run.missing(dir).is_none())
-        .map(|run| suite_run_plan(run, dir, args))
-        .collect::<anyhow::Result<Vec<_>>>()
-        .with_context(|| format!("suite {}", path.display()))?;
-    Ok((plans, s, absent))
+        .map(|run| suite_run_plan(run, dir, options))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok((plans, absent))
 }
 
 /// The plan of one suite run (its scene relative to the suite's folder `dir`).
 fn suite_run_plan(
     run: &suite::SuiteRun,
     dir: &Path,
-    args: &BenchArgs,
+    options: &RunOptions,
 ) -> anyhow::Result<BenchPlan> {
     let scene_path = dir.join(&run.scene);
     let mut techniques = (run.techniques.iter())
@@ -160,7 +194,7 @@ fn suite_run_plan(
         description: zoo_host::scene::read_description(&scene_path)?,
         scene_path,
         size: zoo_host::glam::UVec2::new(run.size.0, run.size.1),
-        frames: args.frames.unwrap_or(run.frames),
+        frames: options.frames.unwrap_or(run.frames),
         warmup: run.warmup,
         path: run.path,
         sweeps: (run.sweeps.iter())
@@ -168,9 +202,9 @@ fn suite_run_plan(
             .collect::<anyhow::Result<_>>()?,
         set: split_sets(&run.set, &techniques)?,
         techniques,
-        flicker: !args.no_flicker,
-        cpu_timing: args.cpu_timing,
-        reuse_unchanged: args.reuse_unchanged || run.reuse_unchanged,
+        flicker: options.flicker,
+        cpu_timing: options.cpu_timing,
+        reuse_unchanged: options.reuse_unchanged || run.reuse_unchanged,
     })
 }
 

@@ -23,6 +23,17 @@ pub enum SweepKey {
     Param { technique: String, key: String },
 }
 
+impl SweepKey {
+    /// Whether configurations of `technique` are swept over it (a technique's parameter
+    /// sweeps that technique's configurations only).
+    pub fn applies_to(&self, technique: &str) -> bool {
+        match self {
+            SweepKey::Param { technique: t, .. } => t == technique,
+            _ => true,
+        }
+    }
+}
+
 /// One sweep: a key and its values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sweep {
@@ -174,10 +185,7 @@ pub fn expand(plan: &BenchPlan) -> anyhow::Result<Vec<Configuration>> {
         let own: Vec<&Sweep> = plan
             .sweeps
             .iter()
-            .filter(|sweep| match &sweep.key {
-                SweepKey::Param { technique: t, .. } => t == technique.id,
-                _ => true,
-            })
+            .filter(|sweep| sweep.key.applies_to(technique.id))
             .collect();
         let configs = cartesian(configs, &own, |c, sweep, value| {
             match &sweep.key {

@@ -186,9 +186,9 @@ pub struct RatioRow {
 }
 
 /// Suite ratios, one row for every matching pair of configurations.
-pub fn suite_ratios(s: &suite::Suite, results: &[ConfigResult]) -> Vec<RatioRow> {
+pub fn suite_ratios(ratios: &[suite::SuiteRatio], results: &[ConfigResult]) -> Vec<RatioRow> {
     let mut out = Vec::new();
-    for ratio in &s.ratios {
+    for ratio in ratios {
         let (n, d) = (&ratio.numerator, &ratio.denominator);
         // Sweeps a measure picks a value of are not paired.
         let pinned = |key: &str| n.swept.iter().chain(&d.swept).any(|(k, _)| k == key);
@@ -443,7 +443,7 @@ fn light_costs_md(w: &mut String, results: &[ConfigResult]) {
 
 /// The suite's ratios beside the ones its seeds report, and the seeds' own figures.
 fn seeds_md(w: &mut String, suite: &suite::Suite, results: &[ConfigResult]) {
-    let ratios = suite_ratios(suite, results);
+    let ratios = suite_ratios(&suite.ratios, results);
     if !ratios.is_empty() {
         let _ = writeln!(w, "\n## This project beside the seeds\n");
         let _ = writeln!(w, "| ratio | configuration | this project | seed |");
@@ -761,7 +761,7 @@ mod tests {
             &[],
         );
         let b = result("b", &[("Volumes", 6.0, Some([0, 1000, 0, 0]))], &[], &[]);
-        let ratios = suite_ratios(&suite, &[a, b]);
+        let ratios = suite_ratios(&suite.ratios, &[a, b]);
         let values: Vec<(&str, Option<f64>)> =
             ratios.iter().map(|r| (r.label.as_str(), r.value)).collect();
         assert_eq!(
@@ -805,18 +805,18 @@ mod tests {
         // Frame by frame, both lights' samples: 300/30, 200/20 and 90/30.
         a.frame_counts = per_frame(&[[100, 200], [150, 50], [40, 50]]);
         b.frame_counts = per_frame(&[[10, 20], [10, 10], [10, 20]]);
-        let ratios = suite_ratios(&suite, &[a.clone(), b.clone()]);
+        let ratios = suite_ratios(&suite.ratios, &[a.clone(), b.clone()]);
         assert_eq!(ratios[0].frame_range, Some((3.0, 10.0)));
         // Times have no per-frame series here.
         assert_eq!(ratios[1].frame_range, None);
         // Series of different lengths, or a frame with no samples below, give no range.
         b.frame_counts = per_frame(&[[10, 20], [10, 10]]);
         assert_eq!(
-            suite_ratios(&suite, &[a.clone(), b.clone()])[0].frame_range,
+            suite_ratios(&suite.ratios, &[a.clone(), b.clone()])[0].frame_range,
             None
         );
         b.frame_counts = per_frame(&[[10, 20], [10, 10], [0, 0]]);
-        assert_eq!(suite_ratios(&suite, &[a, b])[0].frame_range, None);
+        assert_eq!(suite_ratios(&suite.ratios, &[a, b])[0].frame_range, None);
     }
 
     #[test]
@@ -843,7 +843,7 @@ mod tests {
             swept("narrow", "4", 4.0),
             swept("wide", "4", 20.0),
         ];
-        let values: Vec<Option<f64>> = (suite_ratios(&suite, &results).iter())
+        let values: Vec<Option<f64>> = (suite_ratios(&suite.ratios, &results).iter())
             .map(|r| r.value)
             .collect();
         // Each wide configuration over the narrow one with the same light count.

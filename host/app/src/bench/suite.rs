@@ -95,6 +95,13 @@ pub struct Measure {
 }
 
 impl Measure {
+    /// Whether it measures a count (a counter, shader invocations, samples), not a time.
+    pub fn is_count(&self) -> bool {
+        self.passes.starts_with("counter:")
+            || (zoo_host::gpu::PassCounts::NAMES.iter())
+                .any(|kind| (self.passes.strip_prefix(kind)).is_some_and(|p| p.starts_with(':')))
+    }
+
     /// Whether a configuration swept to `swept` is one this measure takes.
     pub fn picks(&self, swept: &[(String, String)]) -> bool {
         (self.swept.iter()).all(|(k, v)| swept.iter().any(|(k2, v2)| k2 == k && v2 == v))
@@ -179,5 +186,25 @@ mod tests {
         let plain: SuiteRun =
             ron::from_str("(name: \"r\", scene: \"s.ron\", techniques: [])").unwrap();
         assert_eq!(plain.missing(here), None);
+    }
+
+    #[test]
+    fn counts_are_told_from_times() {
+        let measure = |passes: &str| Measure {
+            run: "r".into(),
+            technique: "t".into(),
+            passes: passes.into(),
+            swept: Vec::new(),
+        };
+        for count in [
+            "counter:maps rendered",
+            "samples:Hybrid volumes",
+            "fragments:Shadow",
+        ] {
+            assert!(measure(count).is_count(), "{count}");
+        }
+        for time in ["frame", "technique", "Shadow map", "samplesShadow"] {
+            assert!(!measure(time).is_count(), "{time}");
+        }
     }
 }
