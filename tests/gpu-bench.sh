@@ -27,13 +27,17 @@ mkdir -p "$out/suites"
 started=$SECONDS
 index="$out/README.md"
 claims_started=$SECONDS
-"$bin" claims --out "$out/claims"
+if timeout "$BUDGET_SECONDS" "$bin" claims --out "$out/claims"; then
+    claims="$((SECONDS - claims_started)) s ([claims.md](claims/claims.md))"
+else
+    claims="stopped after $((SECONDS - claims_started)) s (time or failure)"
+fi
 {
     echo "# GPU benchmark"
     echo
     echo "- Date: $(date -u +%Y-%m-%d)"
-    grep -m1 '^- Adapter:' "$out/claims/claims.md"
-    echo "- claims: $((SECONDS - claims_started)) s ([claims.md](claims/claims.md))"
+    grep -m1 '^- Adapter:' "$out/claims/claims.md" 2>/dev/null || true
+    echo "- claims: $claims"
 } > "$index"
 
 for suite in "${SUITES[@]}"; do

@@ -321,10 +321,15 @@ async function checkLiveJudge(args, browser, failures) {
   cpu.forEach((row, light) => {
     const live = verdict.lights[light];
     const scores = ["false_shadow", "false_lit", "mae"];
-    const off = live ? scores.filter((k) => Math.abs(live[k] - Number(row[k])) > JUDGE_BOUND)
-      : (row.pixels === "" ? [] : ["not scored"]);
+    const unsupported = row.pixels === "";
+    let off;
+    if (!live || unsupported) {
+      off = !live === unsupported ? [] : [live ? "scored, native not" : "not scored, native is"];
+    } else {
+      off = scores.filter((k) => Math.abs(live[k] - Number(row[k])) > JUDGE_BOUND);
+    }
     const show = (m) => m ? scores.map((k) => Number(m[k]).toFixed(4)).join(" / ") : "-";
-    rows.push(`| ${light} | ${show(live)} | ${show(row.pixels === "" ? null : row)} | ` +
+    rows.push(`| ${light} | ${show(live)} | ${show(unsupported ? null : row)} | ` +
       `${off.length ? "FAIL" : "ok"} |`);
     if (off.length) failures.push(`live judge, light ${light}: ${off.join(", ")} off by > ${JUDGE_BOUND}`);
   });

@@ -123,6 +123,8 @@ pub struct RunOptions {
     pub flicker: bool,
     pub cpu_timing: bool,
     pub reuse_unchanged: bool,
+    /// Whether `unshadowed` is measured beside every run (the ratios to it in `bench.md`).
+    pub baseline: bool,
 }
 
 impl RunOptions {
@@ -133,6 +135,7 @@ impl RunOptions {
             flicker: !args.no_flicker,
             cpu_timing: args.cpu_timing,
             reuse_unchanged: args.reuse_unchanged,
+            baseline: true,
         }
     }
 }
@@ -186,7 +189,7 @@ fn suite_run_plan(
         .map(|t| zoo_host::find_technique(t).map_err(anyhow::Error::from))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let baseline = zoo_host::find_technique(zoo_host::builtin::UNSHADOWED_ID)?;
-    if !techniques.iter().any(|t| t.id == baseline.id) {
+    if options.baseline && !techniques.iter().any(|t| t.id == baseline.id) {
         techniques.insert(0, baseline);
     }
     Ok(BenchPlan {

@@ -62,8 +62,8 @@ pub fn bench_csv(results: &[ConfigResult]) -> String {
             });
             let _ = writeln!(
                 out,
-                "{},\"{}\",{},{}x{},{},\"{}\",{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{},{counts}",
-                c.run,
+                "\"{}\",\"{}\",{},{}x{},{},\"{}\",{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{},{counts}",
+                c.run.replace('"', "'"),
                 c.label().replace('"', "'"),
                 c.technique.id,
                 c.size.x,
@@ -93,8 +93,8 @@ pub fn summary_csv(results: &[ConfigResult]) -> String {
         let c = &r.config;
         let _ = writeln!(
             out,
-            "{},\"{}\",{},{}x{},{},{},{:.4},{:.4},{:.4},{},{}",
-            c.run,
+            "\"{}\",\"{}\",{},{}x{},{},{},{:.4},{:.4},{:.4},{},{}",
+            c.run.replace('"', "'"),
             c.label().replace('"', "'"),
             c.technique.id,
             c.size.x,

@@ -64,6 +64,9 @@ pub fn run(args: &ClaimsArgs) -> anyhow::Result<()> {
             args.only.as_deref().unwrap_or_default()
         );
     }
+    let dir = path.parent().unwrap_or(std::path::Path::new("."));
+    // Every claim resolves before minutes of measuring.
+    check(&claims, dir)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
     let shaders = crate::setup::shader_library(args.shaders.as_deref())?;
@@ -71,13 +74,13 @@ pub fn run(args: &ClaimsArgs) -> anyhow::Result<()> {
     let cpu_timing = times_on_cpu(&gpu);
     let bench = args.out.join("bench");
     let (mut rows, skipped) = ratios::measure(&claims.ratios, &shaders, &bench, cpu_timing)?;
-    let dir = path.parent().unwrap_or(std::path::Path::new("."));
     rows.extend(judged::measure(&claims.judged, dir, &gpu, &shaders)?);
     let adapter = gpu.describe();
     let seconds = started.elapsed().as_secs_f64();
     std::fs::write(args.out.join("claims.csv"), claims_csv(&rows, &adapter))?;
     let timing = if cpu_timing {
-        "CPU clock, each pass submitted on its own (a software adapter)"
+        "CPU clock, each pass submitted on its own (a software adapter); counts of fragments \
+         and samples from runs of their own with the GPU's statistics"
     } else {
         "GPU timestamps"
     };

@@ -48,6 +48,7 @@ pub fn plan(claims: &[RatioClaim], cpu_timing: bool) -> anyhow::Result<ClaimPlan
     for (name, needed) in needed {
         let options = RunOptions {
             cpu_timing: cpu_timing && !needed.measures.iter().any(Measure::is_count),
+            baseline: false,
             ..RunOptions::default()
         };
         let run = trimmed(needed.run, &needed.measures)?;
@@ -148,6 +149,11 @@ fn claim_ratio(
                 );
             }
             if sweeps(run, key, &measure.technique)? {
+                if let Some((_, own)) = measure.swept.iter().find(|(k, _)| k == key)
+                    && own != value
+                {
+                    bail!("`at` {key}={value}: the ratio itself takes {key}={own}");
+                }
                 measure.swept.push((key.clone(), value.clone()));
                 pinned[i] = true;
             }
@@ -188,9 +194,14 @@ fn sweeps(run: &SuiteRun, key: &str, technique: &str) -> anyhow::Result<bool> {
 }
 
 /// `run` with only the techniques `measures` divide, each sweep only at the values they pin
-/// where all the measures it sweeps pin it, and at most [`CLAIM_FRAMES`] frames after one
-/// warm-up.
+/// where all the measures it sweeps pin it, and at most [`CLAIM_FRAMES`] frames after at most
+/// two warm-up frames.
 fn trimmed(mut run: SuiteRun, measures: &[Measure]) -> anyhow::Result<SuiteRun> {
+    // The baseline is measured where a ratio divides by it, whether the run names it or not.
+    let baseline = zoo_host::builtin::UNSHADOWED_ID;
+    if !run.techniques.iter().any(|t| t == baseline) {
+        run.techniques.push(baseline.to_string());
+    }
     run.techniques
         .retain(|t| measures.iter().any(|m| &m.technique == t));
     let unchanged = run.clone();

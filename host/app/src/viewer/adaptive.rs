@@ -60,7 +60,10 @@ impl AdaptiveResolution {
         }
         let step = ((MOVING_FRAME_MS / milliseconds).sqrt() as f32).clamp(0.5, 2.0);
         let wanted = (self.rendered_scale * step).clamp(MIN_SCALE, 1.0);
-        if (wanted / self.moving_scale - 1.0).abs() > SCALE_TOLERANCE {
+        // Full size and the floor are reached whatever the tolerance, or a scale just short
+        // of them would stay there.
+        let bound = wanted == 1.0 || wanted == MIN_SCALE;
+        if bound || (wanted / self.moving_scale - 1.0).abs() > SCALE_TOLERANCE {
             self.moving_scale = wanted;
         }
     }
@@ -136,8 +139,16 @@ mod tests {
         let took = settle(&mut adaptive, 0.0, per_pixel);
         // Within the scale's tolerance of 100 ms.
         assert!((took - MOVING_FRAME_MS).abs() < 20.0, "{took} ms");
-        // A fast adapter keeps every pixel while moving.
+        // A fast adapter keeps every pixel while moving, even after one slow frame left it
+        // just short of them.
         let mut fast = AdaptiveResolution::default();
+        settle(&mut fast, 2.0, 1e-5);
+        assert_eq!(fast.size(FULL, true), FULL);
+        fast.frame_took(MOVING_FRAME_MS * 4.0);
+        fast.size(FULL, true);
+        fast.frame_took(MOVING_FRAME_MS * 0.28);
+        let short = fast.size(FULL, true);
+        assert!(short.x > FULL.x * 9 / 10 && short.x < FULL.x, "{short}");
         settle(&mut fast, 2.0, 1e-5);
         assert_eq!(fast.size(FULL, true), FULL);
     }

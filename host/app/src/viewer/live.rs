@@ -69,7 +69,7 @@ pub struct LiveReference {
     traced: Option<TracedView>,
     tracing: Option<Trace>,
     judging: Option<JudgedFrame>,
-    /// What was judged last, and against how many area rays a pixel.
+    /// What the last verdict judged, and against how many area rays a pixel.
     judged: Option<(JudgedView, u32)>,
     /// Per light: the pixels it reaches, and the colour fraction of it that arrives there from
     /// its centre.
@@ -137,10 +137,9 @@ impl LiveReference {
                 ..Default::default()
             };
             self.judging = Some(JudgedFrame {
-                view: key.0.clone(),
+                view: key.0,
                 readout: renderer.request_readout(request),
             });
-            self.judged = Some(key);
         }
         let Some(judging) = &mut self.judging else {
             return Ok(None);
@@ -154,6 +153,7 @@ impl LiveReference {
         if self.traced.as_ref() != Some(&TracedView::of(&judging.view)) {
             return Ok(None);
         }
+        self.judged = Some((judging.view.clone(), self.samples));
         Ok(Some(self.judge(renderer, judging.view, readout)))
     }
 
@@ -185,6 +185,8 @@ impl LiveReference {
             });
             return Ok(());
         }
+        // Until this trace arrives the tracer holds no view that was traced.
+        self.traced = None;
         let hard = tracer_values(1, 1)?;
         let tracer = match &mut self.tracer {
             Some(tracer) => {

@@ -269,8 +269,9 @@ impl ReferenceOverlay {
             }
             ui.checkbox(&mut self.live, "live (GPU)")
                 .on_hover_text(format!(
-                    "Judge every frame on the GPU as the view changes: hard visibility at once, \
-                 then {RAYS_PER_FRAME} area rays a pixel each frame"
+                    "Judge the view on the GPU as it changes: hard visibility first, then \
+                 {RAYS_PER_FRAME} more area rays a pixel each trace (in a browser each verdict \
+                 comes a few frames after its view)"
                 ));
             if let Some((done, all)) = self.progress() {
                 ui.add(
