@@ -146,3 +146,38 @@ fn csv_fields(line: &str) -> Vec<String> {
     }
     fields
 }
+
+/// The whole report from a clean clone: every claim has a measured figure on this adapter.
+#[test]
+#[ignore = "long check: `bash tests/run.sh --long` (CI runs it after the suite)"]
+fn every_claim_is_measured() {
+    let (list, _) = list();
+    let out = std::env::temp_dir().join(format!("zoo-claims-all-{}", std::process::id()));
+    let output = Command::new(env!("CARGO_BIN_EXE_shadow-zoo"))
+        .args(["claims", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("claims.csv")).unwrap();
+    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(csv_fields).collect();
+    let claims = list.ratios.iter().map(|c| &c.claim);
+    for claim in claims.chain(list.judged.iter().map(|c| &c.claim)) {
+        let measured: Vec<&Vec<String>> = rows.iter().filter(|r| &r[0] == claim).collect();
+        assert!(!measured.is_empty(), "{claim}: no row");
+        for row in measured {
+            assert!(
+                row[3].parse::<f64>().is_ok(),
+                "{claim}: not measured: {row:?}"
+            );
+        }
+    }
+    println!(
+        "{}",
+        std::fs::read_to_string(out.join("claims.md")).unwrap()
+    );
+}
