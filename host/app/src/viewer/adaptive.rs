@@ -15,6 +15,38 @@ pub const MIN_SCALE: f32 = 0.125;
 /// frame time must not change it (frame times within about 16 % of the aim keep it).
 pub const SCALE_TOLERANCE: f32 = 0.08;
 
+/// How long a view must stay unchanged to count as still: input arrives in bursts, and a frame
+/// that saw no change in the middle of a drag must not render every pixel (seconds of a frame
+/// on a software adapter).
+pub const STILL_AFTER_MS: f64 = 300.0;
+/// How many frames in a row must see no change for the view to count as still (where frames
+/// take longer than [`STILL_AFTER_MS`]).
+pub const STILL_AFTER_FRAMES: u32 = 2;
+
+/// Tells a moving view from a still one by when it last changed.
+#[derive(Debug, Clone, Default)]
+pub struct Motion {
+    last_change_ms: Option<f64>,
+    unchanged_frames: u32,
+}
+
+impl Motion {
+    /// Whether the view moves at `now_ms` (milliseconds on any steady clock), given whether it
+    /// `changed` since the last frame: it changed within the last [`STILL_AFTER_MS`] or the
+    /// last [`STILL_AFTER_FRAMES`] frames.
+    pub fn moving(&mut self, changed: bool, now_ms: f64) -> bool {
+        if changed {
+            self.last_change_ms = Some(now_ms);
+            self.unchanged_frames = 0;
+        } else {
+            self.unchanged_frames = self.unchanged_frames.saturating_add(1);
+        }
+        self.last_change_ms.is_some_and(|last| {
+            now_ms - last < STILL_AFTER_MS || self.unchanged_frames < STILL_AFTER_FRAMES
+        })
+    }
+}
+
 /// The scale (per side) of the view's pixels rendered, learnt from the frames' times.
 #[derive(Debug, Clone)]
 pub struct AdaptiveResolution {
@@ -151,6 +183,22 @@ mod tests {
         assert!(short.x > FULL.x * 9 / 10 && short.x < FULL.x, "{short}");
         settle(&mut fast, 2.0, 1e-5);
         assert_eq!(fast.size(FULL, true), FULL);
+    }
+
+    #[test]
+    fn a_frame_without_a_change_in_a_drag_still_moves() {
+        let mut motion = Motion::default();
+        assert!(!motion.moving(false, 0.0), "never changed: still");
+        assert!(motion.moving(true, 1000.0));
+        // A frame that saw no input 100 ms into the drag.
+        assert!(motion.moving(false, 1100.0));
+        assert!(motion.moving(true, 1200.0));
+        assert!(motion.moving(false, 1200.0 + STILL_AFTER_MS - 1.0));
+        assert!(!motion.moving(false, 1200.0 + STILL_AFTER_MS));
+        // Frames of seconds: one frame without a change is a gap, two are a stop.
+        assert!(motion.moving(true, 5000.0));
+        assert!(motion.moving(false, 8000.0));
+        assert!(!motion.moving(false, 11000.0));
     }
 
     #[test]

@@ -11,7 +11,7 @@ use web_time::Instant;
 use zoo_host::glam::UVec2;
 use zoo_host::{Camera, GpuContext, Light, Scene, ShaderLibrary, wgpu};
 
-use super::adaptive::AdaptiveResolution;
+use super::adaptive::{AdaptiveResolution, Motion};
 use super::{ViewImages, ViewerState, settings_path};
 
 /// A renderer image registered with egui, re-registered when its view changes size.
@@ -68,6 +68,10 @@ pub struct ViewerApp {
     last_view: Option<(Camera, Vec<Light>)>,
     /// When the last frame started.
     last_frame: Option<Instant>,
+    /// When the view last changed.
+    motion: Motion,
+    /// The clock `motion` reads.
+    started: Instant,
     a: NativeTexture,
     b: NativeTexture,
     difference: NativeTexture,
@@ -95,8 +99,9 @@ impl eframe::App for ViewerApp {
             self.resolution.frame_took((now - last).as_secs_f64() * 1e3);
         }
         let view = (self.state.camera.camera(), self.state.lights.clone());
-        let moving = self.last_view.as_ref().is_some_and(|last| *last != view);
+        let changed = self.last_view.as_ref().is_some_and(|last| *last != view);
         self.last_view = Some(view);
+        let moving = (self.motion).moving(changed, (now - self.started).as_secs_f64() * 1e3);
         let size = match self.fixed_size {
             Some(size) => size,
             None => self.resolution.size(full, moving),
@@ -161,6 +166,8 @@ impl ViewerApp {
             resolution: AdaptiveResolution::default(),
             last_view: None,
             last_frame: None,
+            motion: Motion::default(),
+            started: Instant::now(),
             a: NativeTexture::default(),
             b: NativeTexture::default(),
             difference: NativeTexture::default(),
