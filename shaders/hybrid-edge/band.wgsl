@@ -9,7 +9,8 @@
 //   depth image (every other pixel holds 1), so the shadow volumes drawn next are rejected
 //   outside the band by the depth test; `everywhere` puts every pixel in the band, and
 //   `tiles` also draws the volumes only in the screen tiles that hold edge pixels
-//   (`hybrid-edge/tiles.wgsl`);
+//   (`hybrid-edge/tiles.wgsl`), and `stencil` marks the band in the stencil, where the
+//   volumes are then counted (`hybrid-edge/mark.wgsl`);
 // - triangle ids (`fs_band_ids`): the light ray of an edge pixel is tested against the
 //   triangles the shadow map saw nearest the light in the pixel's neighbourhood (seed 003's
 //   future-work idea): no volumes at all.
@@ -30,14 +31,16 @@ const RESTRICTION_DEPTHBAND: u32 = 0u;
 const RESTRICTION_EVERYWHERE: u32 = 1u;
 const RESTRICTION_TRIANGLEIDS: u32 = 2u;
 const RESTRICTION_TILES: u32 = 3u;
+// The band as for the depth band; the volume passes mark it in the stencil and test that.
+const RESTRICTION_STENCIL: u32 = 4u;
 
 @group(2) @binding(0) var<uniform> edge: EdgeLight;
-// The coverage maps (laid out like the depth maps): the id of the triangle nearest the light
-// among those touching each texel (NO_TRIANGLE where none); the scene's vertices
-// (`VERTEX_FLOATS` floats each) and indices.
-@group(4) @binding(0) var coverage_ids: texture_2d_array<u32>;
-@group(4) @binding(1) var<storage, read> scene_vertices: array<f32>;
-@group(4) @binding(2) var<storage, read> scene_indices: array<u32>;
+// In the lookup group, after its bindings: the coverage maps (laid out like the depth maps):
+// the id of the triangle nearest the light among those touching each texel (NO_TRIANGLE where
+// none); the scene's vertices (`VERTEX_FLOATS` floats each) and indices.
+@group(3) @binding(6) var coverage_ids: texture_2d_array<u32>;
+@group(3) @binding(7) var<storage, read> scene_vertices: array<f32>;
+@group(3) @binding(8) var<storage, read> scene_indices: array<u32>;
 
 const CLASS_LIT: vec4<f32> = vec4<f32>(0.95, 0.9, 0.6, 1.0);
 const CLASS_SHADOWED: vec4<f32> = vec4<f32>(0.15, 0.2, 0.45, 1.0);
@@ -237,7 +240,7 @@ fn fs_band(in: FullscreenOut) -> BandOut {
 
 // Triangle ids of the shadow map's front-most triangles (NO_TRIANGLE where none), for the
 // exact test.
-@group(4) @binding(3) var triangle_ids: texture_2d_array<u32>;
+@group(3) @binding(9) var triangle_ids: texture_2d_array<u32>;
 
 // Whether triangle `id` crosses the ray origin + t·direction for t in (0, t_max)
 // (Möller–Trumbore).

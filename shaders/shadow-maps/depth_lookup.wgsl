@@ -1,7 +1,9 @@
 // Depth-map access for lookups, bound at group 3 by `ShadowMapSet::lookup_group` (depth sets):
 // the maps with linear and nearest comparison samplers, the layer cameras, and the same maps
 // as plain floats for reading stored depths. The maps appear three times because GLSL cannot
-// fetch texels of depth textures and pairs each texture with one sampler.
+// fetch texels of depth textures and pairs each texture with one sampler. A pass may add
+// variables of its own to group 3 from binding 6 on (a pipeline has four groups on WebGPU;
+// `Joinable` in the kit's Rust).
 
 #import "shadow-maps/layers.wgsl"
 

@@ -16,21 +16,21 @@
 #import "virtual-maps/tables.wgsl"
 #import "common/gbuffer.wgsl"
 
-@group(4) @binding(0) var<storage, read_write> page_table: array<u32>;
+@group(3) @binding(3) var<storage, read_write> page_table: array<u32>;
 // Per entry: 1 when a pixel needs its page this frame.
-@group(4) @binding(1) var<storage, read_write> needed: array<atomic<u32>>;
+@group(3) @binding(4) var<storage, read_write> needed: array<atomic<u32>>;
 // Per physical page: its owning entry (NO_PAGE when free), the last frame it was needed, the
 // last frame it was drawn and the last frame it was taken from another entry (the debug views).
-@group(4) @binding(2) var<storage, read_write> pool_pages: array<vec4<u32>>;
+@group(3) @binding(5) var<storage, read_write> pool_pages: array<vec4<u32>>;
 // CANDIDATE_LISTS lists of candidate pages (`pool_side`² places each), then the entries
 // whose pages are drawn this frame.
-@group(4) @binding(3) var<storage, read_write> lists: array<u32>;
-@group(4) @binding(4) var<storage, read_write> counts: array<atomic<u32>>;
-@group(4) @binding(5) var<storage, read> entry_layers: array<u32>;
+@group(3) @binding(6) var<storage, read_write> lists: array<u32>;
+@group(3) @binding(7) var<storage, read_write> counts: array<atomic<u32>>;
+@group(3) @binding(8) var<storage, read> entry_layers: array<u32>;
 // The clear draw's arguments, then one caster draw's per run.
-@group(4) @binding(6) var<storage, read_write> draw_args: array<u32>;
+@group(3) @binding(9) var<storage, read_write> draw_args: array<u32>;
 // Per caster run: its vertex count, first vertex, object count and first instance.
-@group(4) @binding(7) var<storage, read> caster_runs: array<vec4<u32>>;
+@group(3) @binding(10) var<storage, read> caster_runs: array<vec4<u32>>;
 
 // `counts`: the candidate lists' lengths, then these (`Counts` in the plugin's Rust).
 const COUNT_CURSOR: u32 = 5u;

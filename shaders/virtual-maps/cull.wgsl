@@ -6,16 +6,16 @@
 #import "virtual-maps/tables.wgsl"
 #import "virtual-maps/caster_box.wgsl"
 
-@group(4) @binding(0) var<storage, read> entry_layers: array<u32>;
+@group(3) @binding(3) var<storage, read> entry_layers: array<u32>;
 // The entries drawn this frame, after the candidate lists.
-@group(4) @binding(1) var<storage, read> lists: array<u32>;
+@group(3) @binding(4) var<storage, read> lists: array<u32>;
 // The clear draw's arguments (its instances: the pages drawn), then one caster draw's per run.
-@group(4) @binding(2) var<storage, read_write> draw_args: array<atomic<u32>>;
+@group(3) @binding(5) var<storage, read_write> draw_args: array<atomic<u32>>;
 // Per caster run: its vertex count, first vertex, object count and first instance.
-@group(4) @binding(3) var<storage, read> caster_runs: array<vec4<u32>>;
-@group(4) @binding(4) var<storage, read> caster_boxes: array<CasterBox>;
-@group(4) @binding(5) var<storage, read_write> instances: array<u32>;
-@group(4) @binding(6) var<storage, read_write> counts: array<atomic<u32>>;
+@group(3) @binding(6) var<storage, read> caster_runs: array<vec4<u32>>;
+@group(3) @binding(7) var<storage, read> caster_boxes: array<CasterBox>;
+@group(3) @binding(8) var<storage, read_write> instances: array<u32>;
+@group(3) @binding(9) var<storage, read_write> counts: array<atomic<u32>>;
 
 // `counts`: the (page, caster) instances drawn (`COUNT_INSTANCES` in the plugin's Rust; the
 // bookkeeping's counters come before it).

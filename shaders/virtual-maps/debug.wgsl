@@ -9,13 +9,13 @@
 
 #import "virtual-maps/tables.wgsl"
 
-@group(4) @binding(0) var<storage, read> page_table: array<u32>;
-@group(4) @binding(1) var<storage, read> needed: array<u32>;
+@group(3) @binding(3) var<storage, read> page_table: array<u32>;
+@group(3) @binding(4) var<storage, read> needed: array<u32>;
 // Per physical page: owner entry, last frame needed, last frame drawn, last frame it evicted
 // a page (`bookkeeping.wgsl`).
-@group(4) @binding(2) var<storage, read> pool_pages: array<vec4<u32>>;
-@group(4) @binding(3) var page_table_image: texture_storage_2d<rgba8unorm, write>;
-@group(4) @binding(4) var pool_image: texture_storage_2d<rgba8unorm, write>;
+@group(3) @binding(5) var<storage, read> pool_pages: array<vec4<u32>>;
+@group(3) @binding(6) var page_table_image: texture_storage_2d<rgba8unorm, write>;
+@group(3) @binding(7) var pool_image: texture_storage_2d<rgba8unorm, write>;
 
 const EMPTY: vec4<f32> = vec4<f32>(0.1, 0.1, 0.1, 1.0);
 const DRAWN: vec4<f32> = vec4<f32>(1.0, 0.85, 0.1, 1.0);

@@ -15,14 +15,14 @@ enable clip_distances;
 #import "common/materials.wgsl"
 
 @group(2) @binding(0) var<uniform> caster_run: CasterRun;
-@group(4) @binding(0) var<storage, read> page_table: array<u32>;
-@group(4) @binding(1) var<storage, read> entry_layers: array<u32>;
+@group(3) @binding(3) var<storage, read> page_table: array<u32>;
+@group(3) @binding(4) var<storage, read> entry_layers: array<u32>;
 // The entries whose pages are drawn this frame, after the candidate lists.
-@group(4) @binding(2) var<storage, read> lists: array<u32>;
-@group(4) @binding(3) var<storage, read> scene_vertices: array<f32>;
-@group(4) @binding(4) var<storage, read> scene_indices: array<u32>;
+@group(3) @binding(5) var<storage, read> lists: array<u32>;
+@group(3) @binding(6) var<storage, read> scene_vertices: array<f32>;
+@group(3) @binding(7) var<storage, read> scene_indices: array<u32>;
 // Each run's instances from its `instances_at`: drawn slot times its objects, plus the object.
-@group(4) @binding(5) var<storage, read> instances: array<u32>;
+@group(3) @binding(8) var<storage, read> instances: array<u32>;
 
 @vertex
 fn vs_clear(@builtin(vertex_index) vertex: u32, @builtin(instance_index) slot: u32) -> @builtin(position) vec4<f32> {

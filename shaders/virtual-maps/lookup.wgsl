@@ -11,14 +11,14 @@
 #import "shadow-maps/filters.wgsl"
 
 @group(2) @binding(0) var<uniform> virtual_lookup: VirtualLookup;
-@group(4) @binding(0) var<storage, read> page_table: array<u32>;
+@group(3) @binding(3) var<storage, read> page_table: array<u32>;
 // The pool three times over: GLSL pairs each texture with one sampler and cannot read texels
 // of depth textures.
-@group(4) @binding(1) var pool: texture_depth_2d;
-@group(4) @binding(2) var pool_linear: sampler_comparison;
-@group(4) @binding(3) var pool_nearest: texture_depth_2d;
-@group(4) @binding(4) var pool_compare: sampler_comparison;
-@group(4) @binding(5) var pool_values: texture_2d<f32>;
+@group(3) @binding(4) var pool: texture_depth_2d;
+@group(3) @binding(5) var pool_linear: sampler_comparison;
+@group(3) @binding(6) var pool_nearest: texture_depth_2d;
+@group(3) @binding(7) var pool_compare: sampler_comparison;
+@group(3) @binding(8) var pool_values: texture_2d<f32>;
 
 // The light and level the current pixel's taps read.
 var<private> tap_light: u32;

@@ -13,6 +13,9 @@
 #import "virtual-maps/virtual_layer.wgsl"
 #import "virtual-maps/virtual_light.wgsl"
 
+// Group 3 holds the tables at bindings 0 to 2 and each pass's own bindings from 3 on (WebGPU
+// gives a pipeline four groups: frame, G-buffer or materials, a per-light or per-run slot, and
+// this one).
 @group(3) @binding(0) var<uniform> virtual_frame: VirtualFrame;
 @group(3) @binding(1) var<storage, read> virtual_layers: array<VirtualLayer>;
 @group(3) @binding(2) var<storage, read> virtual_lights: array<VirtualLight>;

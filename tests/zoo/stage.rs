@@ -1,11 +1,14 @@
 //! The kit's one stage type: groups read from the WGSL, the host's groups and shared ones
 //! recognised by what they declare, own resources bound by name, and clear errors for names
-//! that are not the shader's and for groups that mix shared and own variables.
+//! that are not the shader's and for groups that mix shared and own variables (unless the
+//! shared group is joinable).
 
 use std::sync::Mutex;
 
 use glam::UVec2;
-use zoo_host::kit::{Stage, StageBindGroup};
+use zoo_host::kit::{
+    Joinable, NamedGroup, SharedGroup, Stage, StageBindGroup, bind_group_layout, storage,
+};
 use zoo_host::params::ParamValues;
 use zoo_host::test_support::{gpu, scene_path};
 use zoo_host::wgpu::{self, util::DeviceExt};
@@ -45,6 +48,20 @@ const MIXED: &str = r#"
 @compute @workgroup_size(1)
 fn cs_mixed() {
     mine[0] = u32(camera.position.x);
+}
+"#;
+
+/// Group 2 holds `levels`, a shared group's, and an own buffer: allowed where the shared group
+/// is joinable, the stage then binding both.
+const JOINED: &str = r#"
+#import "common/frame.wgsl"
+
+@group(2) @binding(0) var<storage, read> levels: array<f32>;
+@group(2) @binding(1) var<storage, read_write> mine: array<f32>;
+
+@compute @workgroup_size(1)
+fn cs_joined() {
+    mine[0] = levels[0] + f32(arrayLength(&lights));
 }
 "#;
 
@@ -100,6 +117,7 @@ impl ShadowTechnique for Levels {
             .text(MIXED)
             .build(ctx);
         errors.push(mixed.err().unwrap().to_string());
+        errors.extend(joined(ctx)?);
         Ok(())
     }
 
@@ -111,6 +129,56 @@ impl ShadowTechnique for Levels {
         }
         Ok(())
     }
+}
+
+/// A stage whose group joins a shared one's: refused while the group is not joinable, built
+/// once it is; binding it needs the shared variable too. Returns what each step said.
+fn joined(ctx: &RenderContext<'_>) -> TechniqueResult<Vec<String>> {
+    let device = &ctx.gpu.device;
+    let layout = bind_group_layout(
+        device,
+        "test levels layout",
+        &[storage(0, wgpu::ShaderStages::COMPUTE, true)],
+    );
+    let levels = NamedGroup {
+        names: &["levels"],
+        layout: &layout,
+        group: None,
+    };
+    let build = |shared: &dyn SharedGroup| {
+        Stage::compute("test/joined.wgsl", "cs_joined")
+            .text(JOINED)
+            .shared(&[shared])
+            .build(ctx)
+    };
+    let mut said = vec![build(&levels).err().unwrap().to_string()];
+    let stage = build(&Joinable(levels))?;
+    let buffer = |label| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        })
+    };
+    let (levels, mine) = (buffer("test levels"), buffer("test mine"));
+    let own_only = [("mine", mine.as_entire_binding())];
+    said.push(
+        stage
+            .bind(ctx, "test", &own_only)
+            .err()
+            .unwrap()
+            .to_string(),
+    );
+    let both = [
+        ("levels", levels.as_entire_binding()),
+        ("mine", mine.as_entire_binding()),
+    ];
+    said.push(match stage.bind(ctx, "test", &both) {
+        Ok(_) => "joined group bound".into(),
+        Err(e) => e.to_string(),
+    });
+    Ok(said)
 }
 
 zoo_host::register_technique! {
@@ -141,7 +209,7 @@ fn stages_bind_by_name_and_say_which_names_and_groups_are_wrong() {
         assert_eq!(off.count(), 0, "light {light} should read {level}");
     }
     let errors = ERRORS.lock().unwrap().clone();
-    assert_eq!(errors.len(), 2 * LEVELS.len() + 1, "{errors:?}");
+    assert_eq!(errors.len(), 2 * LEVELS.len() + 4, "{errors:?}");
     assert!(
         (errors.iter()).filter(|e| *e == "own groups: 1").count() == LEVELS.len(),
         "{errors:?}"
@@ -153,11 +221,21 @@ fn stages_bind_by_name_and_say_which_names_and_groups_are_wrong() {
         "{}",
         errors[0]
     );
-    let mixed = errors.last().unwrap();
+    let [mixed, not_joinable, not_given, joined] = &errors[errors.len() - 4..] else {
+        unreachable!("four checked above")
+    };
     assert!(
         mixed.contains("test/mixed.wgsl cs_mixed")
             && mixed.contains("`camera` belongs to a shared group")
             && mixed.contains("`mine`"),
         "{mixed}"
     );
+    assert!(
+        not_joinable.contains("test/joined.wgsl cs_joined")
+            && not_joinable.contains("`levels` belongs to a shared group")
+            && not_joinable.contains("`mine`"),
+        "{not_joinable}"
+    );
+    assert!(not_given.contains("`levels`"), "{not_given}");
+    assert_eq!(joined, "joined group bound");
 }

@@ -11,6 +11,7 @@ pub mod compare;
 pub mod contact_sheet;
 pub mod font;
 pub mod gpu_judge;
+pub mod ron_file;
 pub mod setup;
 pub mod viewer;
 

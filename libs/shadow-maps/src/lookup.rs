@@ -7,7 +7,9 @@
 //!   linear and nearest comparison samplers, the layer cameras, the maps as plain floats, and
 //!   the maps again for the nearest sampler (GLSL pairs each texture with one sampler).
 
-use zoo_host::kit::{NamedGroup, bind_group, bind_group_layout, sampler, storage, texture};
+use zoo_host::kit::{
+    Joinable, NamedGroup, bind_group, bind_group_layout, sampler, storage, texture,
+};
 use zoo_host::wgpu;
 
 use crate::maps::MapArray;
@@ -87,36 +89,54 @@ impl LookupGroup {
         }
     }
 
-    /// The group as stages share it.
-    pub(crate) fn shared(&self) -> NamedGroup<'_> {
-        NamedGroup {
-            names: if self.depth {
-                DEPTH_VARIABLES
-            } else {
-                COLOR_VARIABLES
-            },
+    /// The variables of the group, in binding order.
+    fn names(&self) -> &'static [&'static str] {
+        if self.depth {
+            DEPTH_VARIABLES
+        } else {
+            COLOR_VARIABLES
+        }
+    }
+
+    /// The group as stages share it, or join it with variables of their own.
+    pub(crate) fn shared(&self) -> Joinable<NamedGroup<'_>> {
+        Joinable(NamedGroup {
+            names: self.names(),
             layout: &self.layout,
             group: self.group.as_ref(),
-        }
+        })
+    }
+
+    /// The group's resources over `maps` and `cameras`, by variable name in binding order.
+    pub(crate) fn resources<'r>(
+        &'r self,
+        maps: &'r MapArray,
+        cameras: &'r wgpu::Buffer,
+    ) -> Vec<(&'static str, wgpu::BindingResource<'r>)> {
+        let view = || wgpu::BindingResource::TextureView(&maps.array_view);
+        let values = if self.depth {
+            vec![
+                view(),
+                wgpu::BindingResource::Sampler(&self.samplers[0]),
+                wgpu::BindingResource::Sampler(&self.samplers[1]),
+                cameras.as_entire_binding(),
+                view(),
+                view(),
+            ]
+        } else {
+            vec![view(), cameras.as_entire_binding()]
+        };
+        self.names().iter().copied().zip(values).collect()
     }
 
     /// Rebuilds the bind group over `maps` and `cameras`.
     pub(crate) fn bind(&mut self, device: &wgpu::Device, maps: &MapArray, cameras: &wgpu::Buffer) {
-        let view = wgpu::BindingResource::TextureView(&maps.array_view);
-        let resources = if self.depth {
-            vec![
-                view.clone(),
-                wgpu::BindingResource::Sampler(&self.samplers[0]),
-                wgpu::BindingResource::Sampler(&self.samplers[1]),
-                cameras.as_entire_binding(),
-                view.clone(),
-                view,
-            ]
-        } else {
-            vec![view, cameras.as_entire_binding()]
-        };
+        let resources: Vec<_> = (self.resources(maps, cameras).into_iter())
+            .map(|(_, resource)| resource)
+            .collect();
         let label = format!("{} lookup", self.label);
-        self.group = Some(bind_group(device, &label, &self.layout, &resources));
+        let group = bind_group(device, &label, &self.layout, &resources);
+        self.group = Some(group);
     }
 }
 

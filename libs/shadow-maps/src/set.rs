@@ -216,9 +216,22 @@ impl ShadowMapSet {
         self.depth_pass.camera(layer)
     }
 
-    /// The lookup group (see [`crate::lookup`]) as stages share it; bound once prepared.
-    pub fn lookup(&self) -> zoo_host::kit::NamedGroup<'_> {
+    /// The lookup group (see [`crate::lookup`]) as stages share it; bound once prepared. A
+    /// stage may join its index with variables of its own, binding [`Self::lookup_resources`]
+    /// with them.
+    pub fn lookup(&self) -> zoo_host::kit::Joinable<zoo_host::kit::NamedGroup<'_>> {
         self.lookup.shared()
+    }
+
+    /// The lookup group's resources by variable name (none before the maps are made), for
+    /// stages that join its index; their groups must be made again when [`Self::prepare`]
+    /// says the maps were replaced.
+    pub fn lookup_resources(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
+        let maps = self.color.as_ref().or(self.depth.as_ref());
+        match (maps, self.depth_pass.cameras()) {
+            (Some(maps), Some(cameras)) => self.lookup.resources(maps, cameras),
+            _ => Vec::new(),
+        }
     }
 
     fn update_bounds(&mut self, ctx: &RenderContext<'_>, changes: Changes) {

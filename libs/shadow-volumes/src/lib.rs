@@ -21,6 +21,7 @@ pub use generation::{
 };
 pub use near_clip::{NearClipVolume, zpass_is_exact};
 pub use stencil::{
-    Counting, VOLUME_BUFFERS, VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil, resolve_stage,
+    Counting, MARK_BIT, VOLUME_BUFFERS, VOLUME_VERTEX_LAYOUT, band_volume_depth_stencil,
+    mark_depth_stencil, marked_resolve_stage, marked_volume_depth_stencil, resolve_stage,
     stencil_state, stencil_test, volume_depth_stencil, volume_primitive, volume_stage,
 };

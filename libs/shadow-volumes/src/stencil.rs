@@ -77,6 +77,45 @@ pub fn band_volume_depth_stencil(bias: wgpu::DepthBiasState) -> wgpu::DepthStenc
     stencil_state(wgpu::CompareFunction::Greater, front, back, bias)
 }
 
+/// The stencil bit that marks a pixel whose volumes are counted, where a mark restricts them
+/// (seed 003's stencil restriction): the counts wrap in the seven bits below it.
+pub const MARK_BIT: u32 = 0x80;
+
+/// A full-screen mark on the G-buffer's depth-stencil (stencil reference [`MARK_BIT`]): sets
+/// the bit wherever a fragment is drawn (the marking shader discards the others), leaving
+/// depth as it is.
+pub fn mark_depth_stencil() -> wgpu::DepthStencilState {
+    let keep = wgpu::StencilOperation::Keep;
+    let face = wgpu::StencilFaceState {
+        compare: wgpu::CompareFunction::Always,
+        fail_op: keep,
+        depth_fail_op: keep,
+        pass_op: wgpu::StencilOperation::Replace,
+    };
+    let mut state = stencil_state(
+        wgpu::CompareFunction::Always,
+        face,
+        face,
+        Default::default(),
+    );
+    state.stencil.write_mask = MARK_BIT;
+    state
+}
+
+/// Counting like [`band_volume_depth_stencil`] (z-fail as a `Greater` test, so the samples
+/// that pass are the ones counted) on the G-buffer's depth, which holds every pixel's surface,
+/// but only at pixels marked with [`MARK_BIT`] (stencil reference [`MARK_BIT`]): the stencil
+/// test alone rejects the fragments elsewhere, and the counts wrap in the bits below the mark.
+pub fn marked_volume_depth_stencil(bias: wgpu::DepthBiasState) -> wgpu::DepthStencilState {
+    let mut state = band_volume_depth_stencil(bias);
+    for face in [&mut state.stencil.front, &mut state.stencil.back] {
+        face.compare = wgpu::CompareFunction::Equal;
+    }
+    state.stencil.read_mask = MARK_BIT;
+    state.stencil.write_mask = MARK_BIT - 1;
+    state
+}
+
 /// The volume vertex buffers of a draw ([`VOLUME_VERTEX_LAYOUT`]).
 pub const VOLUME_BUFFERS: &[Option<wgpu::VertexBufferLayout<'static>>] =
     &[Some(VOLUME_VERTEX_LAYOUT)];
@@ -125,6 +164,16 @@ pub fn stencil_test(compare: wgpu::CompareFunction) -> wgpu::DepthStencilState {
 pub fn resolve_stage(ctx: &RenderContext<'_>) -> TechniqueResult<Stage> {
     Stage::fullscreen(STENCIL_READ, "fs_shadowed")
         .depth_stencil(stencil_test(wgpu::CompareFunction::NotEqual))
+        .build(ctx)
+}
+
+/// The resolve of counts below a mark ([`marked_volume_depth_stencil`]; stencil reference
+/// 0): visibility 0 wherever those bits are not 0.
+pub fn marked_resolve_stage(ctx: &RenderContext<'_>) -> TechniqueResult<Stage> {
+    let mut state = stencil_test(wgpu::CompareFunction::NotEqual);
+    state.stencil.read_mask = MARK_BIT - 1;
+    Stage::fullscreen(STENCIL_READ, "fs_shadowed")
+        .depth_stencil(state)
         .build(ctx)
 }
 

@@ -21,6 +21,12 @@
 //! - `Tiles`: the depth band, with the volumes drawn only into the screen tiles that hold edge
 //!   pixels (a compute pass lists them; each tile is an instance clipped by clip distances),
 //!   so nothing is rasterised outside those tiles even where early depth tests are not;
+//! - `Stencil`: seed 003's own restriction: the band's pixels are marked in the stencil's top
+//!   bit (a triangle at depth 1 over the band's depth image passes only where it holds a
+//!   depth), and the volumes are counted by z-fail in the bits below it wherever the stencil
+//!   test finds the mark, so they are rejected outside the band by the stencil test instead
+//!   of the depth test (the seed found this "not very suitable": the rejected fragments are
+//!   still rasterised);
 //! - `Everywhere`: every pixel in the band (plain shadow volumes through the same passes), to
 //!   measure what the restriction saves.
 
@@ -39,13 +45,14 @@ use zoo_shadow_maps::{DepthState, LightMaps, LookupPass, LookupShader, MapHeader
 use casters::{CasterIdMaps, CasterIds};
 use tiles::Tiles;
 use zoo_shadow_volumes::{
-    COUNTS_FORMAT, StencilCounts, VolumeGenerator, VolumeShape, band_volume_depth_stencil,
-    piece_pass_name, resolve_stage, volume_stage,
+    COUNTS_FORMAT, MARK_BIT, StencilCounts, VolumeGenerator, VolumeShape,
+    band_volume_depth_stencil, mark_depth_stencil, marked_resolve_stage,
+    marked_volume_depth_stencil, piece_pass_name, resolve_stage, volume_stage,
 };
 
 zoo_host::param_choice! {
     /// Where shadow volumes are counted.
-    pub enum Restriction { DepthBand, Everywhere, TriangleIds, Tiles }
+    pub enum Restriction { DepthBand, Everywhere, TriangleIds, Tiles, Stencil }
 }
 
 zoo_host::technique_params! {
@@ -62,8 +69,8 @@ zoo_host::technique_params! {
         /// map's samples miss) to the exact pass, from conservatively rasterised coverage maps.
         coverage: bool = true;
         /// How edge pixels are resolved: volumes restricted to the band by a depth image (and
-        /// optionally to its screen tiles), exact tests against the map's triangle ids, or
-        /// volumes everywhere.
+        /// optionally to its screen tiles) or by a stencil mark, exact tests against the map's
+        /// triangle ids, or volumes everywhere.
         restriction: Restriction = Restriction::DepthBand;
         /// Slope-scaled depth bias of the shadow map.
         slope_bias: f32 = 1.5, range(0.0, 10.0), step(0.1), flags(rebuild);
@@ -155,6 +162,8 @@ struct Gpu {
     restriction_codes: ChoiceCodes,
     volume: Stage,
     resolve: Stage,
+    /// The stencil restriction's mark, volumes and resolve.
+    marked: [Stage; 3],
     counts: StencilCounts,
     targets: NamedTextures,
     /// The band passes' groups over the coverage maps (and the id maps), once made.
@@ -220,6 +229,7 @@ impl Gpu {
         };
         let draw = "shadow-volumes/draw.wgsl";
         let volume = volume_stage(draw, "vs_volume", band_volume_depth_stencil(bias));
+        let marked_volume = volume_stage(draw, "vs_volume", marked_volume_depth_stencil(bias));
         Ok(Gpu {
             band: band_pass("fs_band")?,
             band_ids: band_pass("fs_band_ids")?,
@@ -232,6 +242,11 @@ impl Gpu {
             restriction_codes,
             volume: volume.build(ctx)?,
             resolve: resolve_stage(ctx)?,
+            marked: [
+                mark_stage(ctx)?,
+                marked_volume.build(ctx)?,
+                marked_resolve_stage(ctx)?,
+            ],
             counts: StencilCounts::new(ctx)?,
             targets: targets(),
             band_groups: [None, None],
@@ -239,20 +254,22 @@ impl Gpu {
         })
     }
 
-    /// Makes the band passes' groups again over the current coverage and id maps.
+    /// Makes the band passes' groups again over the current maps, coverage and id maps: the
+    /// maps' lookup group with the band's own variables in its index.
     fn bind_band_groups(&mut self, ctx: &RenderContext<'_>) -> TechniqueResult {
         let Some(coverage) = self.coverage.maps() else {
             return Ok(());
         };
         let scene = ctx.scene_buffers;
-        let mut resources = vec![
+        let mut resources = self.maps.lookup_resources();
+        resources.extend([
             (
                 "coverage_ids",
                 wgpu::BindingResource::TextureView(&coverage.array_view),
             ),
             ("scene_vertices", scene.vertices.as_entire_binding()),
             ("scene_indices", scene.indices.as_entire_binding()),
-        ];
+        ]);
         let label = "hybrid band lookups (coverage)";
         self.band_groups[0] = Some(self.band.stage().bind(ctx, label, &resources)?);
         if let Some(ids) = self.ids.maps() {
@@ -263,6 +280,20 @@ impl Gpu {
         }
         Ok(())
     }
+}
+
+/// The `Stencil` restriction's mark (`hybrid-edge/mark.wgsl`): in a light pass on the G-buffer's
+/// depth-stencil whose colour attachment is the light's slot (left untouched).
+fn mark_stage(ctx: &RenderContext<'_>) -> TechniqueResult<Stage> {
+    let untouched = Some(wgpu::ColorTargetState {
+        write_mask: wgpu::ColorWrites::empty(),
+        ..zoo_host::kit::slot_target()
+    });
+    Stage::render("hybrid-edge/mark.wgsl", "fullscreen_vs")
+        .fragment("fs_mark")
+        .targets(&[untouched])
+        .depth_stencil(mark_depth_stencil())
+        .build(ctx)
 }
 
 /// The tile restriction, where the device can run it: it clips by clip distances and reads the
@@ -287,19 +318,17 @@ fn tiles_for(ctx: &RenderContext<'_>, bias: wgpu::DepthBiasState) -> TechniqueRe
     Tiles::new(ctx, bias)
 }
 
-/// Draws the stencil counts the volumes left in the band into the count view.
+/// Draws the stencil counts the volumes left in `counted` (the band's, or the G-buffer's
+/// depth-stencil) into the count view.
 fn record_counts(
     ctx: &RenderContext<'_>,
     recorder: &mut PassRecorder<'_>,
     gpu: &Gpu,
-    light: usize,
+    (light, counted): (usize, &wgpu::TextureView),
 ) -> TechniqueResult {
     let name = light_pass_name(DEBUG_PASS, light);
-    let (Some(band), Some(counts)) = (gpu.targets.view(BAND_TARGET), gpu.targets.view(COUNTS_VIEW))
-    else {
-        return Err(TechniqueError::not_prepared());
-    };
-    gpu.counts.record(ctx, recorder, (band, counts), &name)
+    let counts = (gpu.targets.view(COUNTS_VIEW)).ok_or_else(TechniqueError::not_prepared)?;
+    gpu.counts.record(ctx, recorder, (counted, counts), &name)
 }
 
 /// Counts light `light`'s volumes in its band, piece by piece into the band's stencil (only
@@ -310,8 +339,15 @@ fn record_volumes(
     recorder: &mut PassRecorder<'_>,
     gpu: &Gpu,
     (light, debug): (usize, bool),
-    tiled: bool,
+    restriction: Restriction,
 ) -> TechniqueResult {
+    let tiled = restriction == Restriction::Tiles;
+    let marked = restriction == Restriction::Stencil;
+    let [mark, marked_volume, marked_resolve] = &gpu.marked;
+    let (volume_stage, resolve) = match marked {
+        true => (marked_volume, marked_resolve),
+        false => (&gpu.volume, &gpu.resolve),
+    };
     let (Some(volume), Some(args)) = (gpu.generator.volume(), gpu.generator.args()) else {
         return Err(TechniqueError::not_prepared());
     };
@@ -326,6 +362,10 @@ fn record_volumes(
         }
     }
     let band = (gpu.targets.view(BAND_TARGET)).ok_or_else(TechniqueError::not_prepared)?;
+    let mark_group = match marked {
+        true => Some(bind_mark(ctx, gpu, mark)?),
+        false => None,
+    };
     let pieces = gpu.generator.pieces(light);
     for piece in 0..pieces {
         let generation = piece_pass_name(GENERATION_PASS, light, piece);
@@ -337,14 +377,27 @@ fn record_volumes(
             true => wgpu::StoreOp::Store,
             false => wgpu::StoreOp::Discard,
         };
+        // The stencil restriction counts on the G-buffer's depth (kept for later passes), in a
+        // stencil it clears for each light.
+        let (view, depth_store, stencil_load) = match marked {
+            true => (
+                &ctx.gbuffer.depth_view,
+                wgpu::StoreOp::Store,
+                match piece {
+                    0 => wgpu::LoadOp::Clear(0),
+                    _ => wgpu::LoadOp::Load,
+                },
+            ),
+            false => (band, keep, wgpu::LoadOp::Load),
+        };
         let depth = wgpu::RenderPassDepthStencilAttachment {
-            view: band,
+            view,
             depth_ops: Some(wgpu::Operations {
                 load: wgpu::LoadOp::Load,
-                store: keep,
+                store: depth_store,
             }),
             stencil_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Load,
+                load: stencil_load,
                 store: keep,
             }),
         };
@@ -353,23 +406,47 @@ fn record_volumes(
         }
         let name = piece_pass_name(VOLUME_PASS, light, piece);
         let mut pass = ctx.light_pass(recorder, &name, light, Some(depth));
+        if let Some(group) = &mark_group {
+            pass.set_stencil_reference(MARK_BIT);
+            if piece == 0 {
+                mark.set_on(ctx, &mut pass, &[group], &[])?;
+                pass.draw(0..3, 0..1);
+            }
+        }
         if let Some(tiles) = tiles {
             tiles.draw(ctx, &mut pass, volume)?;
         } else {
-            gpu.volume.set_on(ctx, &mut pass, &[], &[])?;
+            volume_stage.set_on(ctx, &mut pass, &[], &[])?;
             pass.set_vertex_buffer(0, volume.slice(..));
             pass.draw_indirect(args, 0);
         }
         if last {
-            gpu.resolve.set_on(ctx, &mut pass, &[], &[])?;
+            resolve.set_on(ctx, &mut pass, &[], &[])?;
             pass.set_stencil_reference(0);
             pass.draw(0..3, 0..1);
         }
     }
     if showing(COUNTS_VIEW) {
-        record_counts(ctx, recorder, gpu, light)?;
+        let counted = if marked {
+            &ctx.gbuffer.depth_view
+        } else {
+            band
+        };
+        record_counts(ctx, recorder, gpu, (light, counted))?;
     }
     Ok(())
+}
+
+/// The mark's group over the band's depth (made each frame: the band follows the screen).
+fn bind_mark(ctx: &RenderContext<'_>, gpu: &Gpu, mark: &Stage) -> TechniqueResult<StageBindGroup> {
+    let band = (gpu.targets.texture(BAND_TARGET)).ok_or_else(TechniqueError::not_prepared)?;
+    let depth = band.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("hybrid band depth (mark)"),
+        aspect: wgpu::TextureAspect::DepthOnly,
+        ..Default::default()
+    });
+    let view = wgpu::BindingResource::TextureView(&depth);
+    mark.bind(ctx, "hybrid mark", &[("band_depth", view)])
 }
 
 /// The band pass's uniform for one light's maps.
@@ -422,11 +499,13 @@ impl ShadowTechnique for Hybrid {
             // The casters each light reaches, and so its pieces, follow the lights.
             gpu.generator.plan(ctx);
         }
-        gpu.maps.prepare(ctx, changes, self.params.map_size, true);
+        let replaced = gpu.maps.prepare(ctx, changes, self.params.map_size, true);
         if let Some(depth) = gpu.maps.maps() {
-            let mut remade = gpu.coverage.prepare(ctx, depth)?;
+            let mut remade = replaced || gpu.band_groups[0].is_none();
+            remade |= gpu.coverage.prepare(ctx, depth)?;
             if self.params.restriction == Restriction::TriangleIds {
                 remade |= gpu.ids.prepare(ctx, depth)?;
+                remade |= gpu.band_groups[1].is_none();
             }
             if remade {
                 gpu.bind_band_groups(ctx)?;
@@ -509,8 +588,7 @@ impl ShadowTechnique for Hybrid {
             if exact {
                 continue;
             }
-            let tiled = p.restriction == Restriction::Tiles;
-            record_volumes(ctx, recorder, gpu, (light, lookup.debug), tiled)?;
+            record_volumes(ctx, recorder, gpu, (light, lookup.debug), p.restriction)?;
         }
         Ok(())
     }
@@ -572,7 +650,6 @@ zoo_host::register_technique! {
         // Volume generation: the frame group's lights and objects and the generation group's
         // eight buffers in one compute stage.
         max_storage_buffers_per_shader_stage: 10,
-        max_bind_groups: 5,
         ..wgpu::Limits::downlevel_defaults()
     },
     optional_features: || wgpu::Features::CLIP_DISTANCES,

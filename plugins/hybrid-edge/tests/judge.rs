@@ -53,6 +53,20 @@ fn banded_shadow_volumes_hold_the_shadow_volume_bound() {
     }
 }
 
+/// Seed 003's own restriction: the band marked in the stencil and the volumes counted where
+/// the stencil test finds the mark, the camera inside a volume included.
+#[test]
+fn stencil_marked_shadow_volumes_hold_the_shadow_volume_bound() {
+    for scene in ["planar-room.ron", "inside-shadow.ron", "curved.ron"] {
+        assert_volume_bounds(&judge(
+            scene,
+            "hybrid-edge",
+            &[("restriction", "Stencil")],
+            SIZE,
+        ));
+    }
+}
+
 /// Whether the test device clips by clip distances, which the `Tiles` restriction needs (a
 /// skip is printed where it does not).
 fn has_clip_distances() -> bool {

@@ -523,9 +523,8 @@ zoo_host::register_technique! {
     required_limits: || wgpu::Limits {
         // The page draws read the page table, the drawn list, the layers, the lights and the
         // scene's vertices, indices and objects in the vertex stage; stages bind the frame,
-        // the G-buffer or materials, a per-light or per-run slot, the tables and their own.
+        // the G-buffer or materials, a per-light or per-run slot, and the tables with their own.
         max_storage_buffers_per_shader_stage: 10,
-        max_bind_groups: 5,
         ..wgpu::Limits::downlevel_defaults()
     },
     // Bookkeeping in compute, page draws from indirect arguments, vertices pulled from storage.

@@ -434,7 +434,9 @@ impl Pages {
             16 * (runs.len().max(1) as u64 + 1),
             wgpu::BufferUsages::INDIRECT,
         );
-        let tables = [
+        // Every stage's group 3: the tables (`virtual-maps/tables.wgsl`, bindings 0 to 2),
+        // then the stage's own bindings (WebGPU gives a pipeline four groups).
+        let table_list = [
             ("virtual_frame", frame.as_entire_binding()),
             ("virtual_layers", layers.as_entire_binding()),
             ("virtual_lights", virtual_lights.as_entire_binding()),
@@ -493,10 +495,21 @@ impl Pages {
         });
         let stats = ReadbackRing::new(&ctx.gpu.device, "virtual-maps counters", 4 * COUNTS, 3);
         let bookkeeping = (stages.bookkeeping.iter())
-            .map(|stage| stage.bind_own(ctx, "virtual-maps bookkeeping", &[&tables, &own]))
+            .map(|stage| {
+                stage.bind_own(
+                    ctx,
+                    "virtual-maps bookkeeping",
+                    &[&with_tables(&table_list, &own)],
+                )
+            })
             .collect::<Result<_, _>>()?;
-        let draw_lists: [&[(&str, wgpu::BindingResource<'_>)]; 2] = [&tables, &draw_own];
-        let cull = (stages.cull).bind_own(ctx, "virtual-maps culling", &[&tables, &cull_own])?;
+        let draw_list = with_tables(&table_list, &draw_own);
+        let draw_lists: [&[(&str, wgpu::BindingResource<'_>)]; 1] = [&draw_list];
+        let cull = (stages.cull).bind_own(
+            ctx,
+            "virtual-maps culling",
+            &[&with_tables(&table_list, &cull_own)],
+        )?;
         // Faces side by side, a texel per page of a face's finest level.
         let side = layout.sizes.pages;
         let (table_image, table_view) =
@@ -516,8 +529,13 @@ impl Pages {
                 wgpu::BindingResource::TextureView(&pool_image_view),
             ),
         ];
-        let debug_group =
-            |stage: &Stage| stage.bind_own(ctx, "virtual-maps debug view", &[&tables, &debug_own]);
+        let debug_group = |stage: &Stage| {
+            stage.bind_own(
+                ctx,
+                "virtual-maps debug view",
+                &[&with_tables(&table_list, &debug_own)],
+            )
+        };
         let debug = DebugImages {
             groups: [
                 debug_group(&stages.debug[0])?,
@@ -542,8 +560,8 @@ impl Pages {
             lookup_tables: lookup.bind_own(
                 ctx,
                 "virtual-maps lookup",
-                &[
-                    &tables,
+                &[&with_tables(
+                    &table_list,
                     &[
                         ("page_table", page_table.as_entire_binding()),
                         ("pool", wgpu::BindingResource::TextureView(&pool_view)),
@@ -558,7 +576,7 @@ impl Pages {
                             wgpu::BindingResource::TextureView(&values_view),
                         ),
                     ],
-                ],
+                )],
             )?,
             layout,
             pool_side,
@@ -716,6 +734,14 @@ impl Pages {
                 .collect(),
         )
     }
+}
+
+/// A resource named as its WGSL variable.
+type Named<'a> = (&'static str, wgpu::BindingResource<'a>);
+
+/// The tables' resources, then a stage's own.
+fn with_tables<'a>(tables: &[Named<'a>], own: &[Named<'a>]) -> Vec<Named<'a>> {
+    tables.iter().chain(own).cloned().collect()
 }
 
 #[cfg(test)]

@@ -154,17 +154,7 @@ pub fn locate(name: &str) -> anyhow::Result<PathBuf> {
 
 /// Loads and parses a suite file.
 pub fn load(path: &Path) -> anyhow::Result<Suite> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    ron::from_str(&text).map_err(|e| {
-        anyhow::anyhow!(
-            "{}:{}:{}: {}",
-            path.display(),
-            e.span.start.line,
-            e.span.start.col,
-            e.code
-        )
-    })
+    crate::ron_file::load(path)
 }
 
 #[cfg(test)]

@@ -71,17 +71,7 @@ pub fn locate() -> anyhow::Result<PathBuf> {
 
 /// Loads and parses a claims file.
 pub fn load(path: &Path) -> anyhow::Result<ClaimList> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    ron::from_str(&text).map_err(|e| {
-        anyhow::anyhow!(
-            "{}:{}:{}: {}",
-            path.display(),
-            e.span.start.line,
-            e.span.start.col,
-            e.code
-        )
-    })
+    crate::ron_file::load(path)
 }
 
 impl ClaimList {

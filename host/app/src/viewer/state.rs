@@ -223,17 +223,7 @@ impl ViewerState {
     /// Reads settings written by [`Self::save_settings`] and switches to the saved technique
     /// with its parameters (out-of-range values are clamped).
     pub fn load_settings(&mut self, path: &Path) -> anyhow::Result<()> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        let file: SettingsFile = ron::from_str(&text).map_err(|e| {
-            anyhow::anyhow!(
-                "{}:{}:{}: {}",
-                path.display(),
-                e.span.start.line,
-                e.span.start.col,
-                e.code
-            )
-        })?;
+        let file: SettingsFile = crate::ron_file::load(path)?;
         self.settings = file
             .techniques
             .into_iter()

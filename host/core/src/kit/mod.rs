@@ -13,7 +13,8 @@
 //!   listed and viewed from their declarations.
 //! - [`stage`]: the one way to write a pass: a compute, full-screen or raster pipeline whose
 //!   groups, layouts and workgroup size are read from the WGSL ([`reflect`]), its own
-//!   resources bound by name and shared groups recognised by what they declare.
+//!   resources bound by name and shared groups recognised by what they declare (a
+//!   [`Joinable`] one's index may hold a stage's own variables too).
 //!
 //! Shader modules from inline WGSL with `#import`s come from
 //! [`ShaderLibrary::create_module_from_source`](crate::ShaderLibrary::create_module_from_source).
@@ -32,5 +33,5 @@ pub use lazy::LazyGpu;
 pub use light_pass::{FullscreenLightPass, light_pass_name};
 pub use resources::{NamedTextures, TextureSize, TextureSpec};
 pub use slot::{LightSlot, slot_target};
-pub use stage::{NamedGroup, SharedGroup, Stage, StageBindGroup, StageBuilder};
+pub use stage::{Joinable, NamedGroup, SharedGroup, Stage, StageBindGroup, StageBuilder};
 pub use uniforms::{UniformSlot, UniformSlots, UniformValue};

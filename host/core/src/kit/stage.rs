@@ -20,6 +20,33 @@ pub trait SharedGroup {
     fn layout(&self) -> &wgpu::BindGroupLayout;
     /// The group to bind and its dynamic offsets (none before its owner has made it).
     fn bound(&self) -> Option<(&wgpu::BindGroup, &[u32])>;
+    /// Whether a stage may declare variables of its own in the group's index beside the
+    /// group's (see [`Joinable`]).
+    fn joinable(&self) -> bool {
+        false
+    }
+}
+
+/// A shared group whose index a stage may join with variables of its own: WebGPU gives a
+/// pipeline four groups, and a technique that reads the frame, the G-buffer, a per-light
+/// uniform and a library's group has none left. Such a stage's group is its own: it binds the
+/// owner's resources by name with its own ([`Stage::bind`]), and its variables take binding
+/// numbers after the owner's. Stages that declare only the group's variables share it.
+pub struct Joinable<G>(pub G);
+
+impl<G: SharedGroup> SharedGroup for Joinable<G> {
+    fn declares(&self, binding: &ReflectedBinding) -> bool {
+        self.0.declares(binding)
+    }
+    fn layout(&self) -> &wgpu::BindGroupLayout {
+        self.0.layout()
+    }
+    fn bound(&self) -> Option<(&wgpu::BindGroup, &[u32])> {
+        self.0.bound()
+    }
+    fn joinable(&self) -> bool {
+        true
+    }
 }
 
 /// A shared group known by the names of the WGSL variables it declares.
@@ -285,7 +312,7 @@ impl StageGroup {
         }
         if let Some(b) = bindings
             .iter()
-            .find(|b| shared.iter().any(|s| s.declares(b)))
+            .find(|b| shared.iter().any(|s| s.declares(b) && !s.joinable()))
         {
             return Err(format!(
                 "`{}` belongs to a shared group, but its group also holds {}",
@@ -293,6 +320,7 @@ impl StageGroup {
                 names(bindings)
             ));
         }
+        // Own variables, and perhaps a joinable group's, which the stage binds itself.
         let entries: Vec<_> = bindings.iter().map(|b| b.entry).collect();
         Ok(StageGroup::Own {
             layout: device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
