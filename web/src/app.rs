@@ -170,6 +170,10 @@ impl WebApp {
 }
 
 impl eframe::App for WebApp {
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        shadow_zoo::viewer::clear_color(visuals)
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         self.open_picked();
         self.viewer.ui(ui, frame);
@@ -210,7 +214,12 @@ fn set_params(state: &mut ViewerState, assignments: &[(String, String)]) -> anyh
 
 /// Runs the viewer in `canvas` on the browser's WebGPU.
 pub async fn start(canvas: web_sys::HtmlCanvasElement, query: Query) -> Result<(), JsValue> {
-    let mut options = eframe::WebOptions::default();
+    let mut options = eframe::WebOptions {
+        // Dithering costs every pixel of the window a noise function, dear on software
+        // adapters; the view's images are 8-bit sRGB already.
+        dithering: false,
+        ..Default::default()
+    };
     if let egui_wgpu::WgpuSetup::CreateNew(create) = &mut options.wgpu_options.wgpu_setup {
         create.instance_descriptor.backends = wgpu::Backends::BROWSER_WEBGPU;
         create.device_descriptor = Arc::new(device_descriptor);

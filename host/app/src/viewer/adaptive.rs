@@ -5,7 +5,7 @@
 
 use zoo_host::glam::UVec2;
 
-/// The frame time aimed at while the view moves: ten frames a second.
+/// The longest frame a moving view should take: ten frames a second.
 pub const MOVING_FRAME_MS: f64 = 100.0;
 /// The smallest share of the view's side rendered while it moves: software adapters take
 /// seconds a frame at full size (SwiftShader in a browser four, for shadow maps).
@@ -14,6 +14,14 @@ pub const MIN_SCALE: f32 = 0.125;
 /// size reallocates the renderer's targets and restarts techniques' histories, so a noisy
 /// frame time must not change it (frame times within about 16 % of the aim keep it).
 pub const SCALE_TOLERANCE: f32 = 0.08;
+
+/// The frame time aimed at while the view moves: below [`MOVING_FRAME_MS`] by the tolerance, so
+/// that the slowest frames a scale keeps stay within it. Window drawing that does not shrink
+/// with the view (a browser's panels on SwiftShader: about 80 ms a frame) makes the frame time
+/// follow the scale less than the model assumes, and the scale then rests anywhere in the
+/// tolerance's band.
+pub const AIM_MS: f64 =
+    MOVING_FRAME_MS * (1.0 - SCALE_TOLERANCE as f64) * (1.0 - SCALE_TOLERANCE as f64);
 
 /// How long a view must stay unchanged to count as still: input arrives in bursts, and a frame
 /// that saw no change in the middle of a drag must not render every pixel (seconds of a frame
@@ -82,7 +90,7 @@ impl AdaptiveResolution {
     /// [`Self::size`] took, if that frame moved (still frames render every pixel whatever
     /// they cost). A frame's cost grows about as its pixels, the square of the scale; each
     /// frame moves the scale at most by half or double toward the one that would take
-    /// [`MOVING_FRAME_MS`], so one slow frame (a shader compiled, a map resized, the window
+    /// [`AIM_MS`], so one slow frame (a shader compiled, a map resized, the window
     /// hidden) does not throw it to the floor, and only by more than [`SCALE_TOLERANCE`].
     /// Frames of seconds teach too: that is what software adapters take at full size.
     pub fn frame_took(&mut self, milliseconds: f64) {
@@ -90,7 +98,7 @@ impl AdaptiveResolution {
         if !(self.moving && valid) {
             return;
         }
-        let step = ((MOVING_FRAME_MS / milliseconds).sqrt() as f32).clamp(0.5, 2.0);
+        let step = ((AIM_MS / milliseconds).sqrt() as f32).clamp(0.5, 2.0);
         let wanted = (self.rendered_scale * step).clamp(MIN_SCALE, 1.0);
         // Full size and the floor are reached whatever the tolerance, or a scale just short
         // of them would stay there.
@@ -144,7 +152,7 @@ mod tests {
         let size = adaptive.size(FULL, true);
         // Frame times a few per cent off the aim keep the size.
         for jitter in [0.97, 1.03, 0.95, 1.05] {
-            adaptive.frame_took(MOVING_FRAME_MS * jitter);
+            adaptive.frame_took(AIM_MS * jitter);
             assert_eq!(adaptive.size(FULL, true), size);
         }
         adaptive.frame_took(60_000.0);
@@ -160,7 +168,7 @@ mod tests {
         let mut adaptive = AdaptiveResolution::default();
         let per_pixel = 4000.0 / f64::from(FULL.x * FULL.y);
         let took = settle(&mut adaptive, 0.0, per_pixel);
-        assert!((took - MOVING_FRAME_MS).abs() < 20.0, "{took} ms");
+        assert!(took <= MOVING_FRAME_MS && took > 0.8 * AIM_MS, "{took} ms");
     }
 
     #[test]
@@ -169,16 +177,16 @@ mod tests {
         let mut adaptive = AdaptiveResolution::default();
         let per_pixel = 1200.0 / f64::from(FULL.x * FULL.y);
         let took = settle(&mut adaptive, 0.0, per_pixel);
-        // Within the scale's tolerance of 100 ms.
-        assert!((took - MOVING_FRAME_MS).abs() < 20.0, "{took} ms");
+        // Within the scale's tolerance of the aim, under 100 ms.
+        assert!(took <= MOVING_FRAME_MS && took > 0.8 * AIM_MS, "{took} ms");
         // A fast adapter keeps every pixel while moving, even after one slow frame left it
         // just short of them.
         let mut fast = AdaptiveResolution::default();
         settle(&mut fast, 2.0, 1e-5);
         assert_eq!(fast.size(FULL, true), FULL);
-        fast.frame_took(MOVING_FRAME_MS * 4.0);
+        fast.frame_took(AIM_MS * 4.0);
         fast.size(FULL, true);
-        fast.frame_took(MOVING_FRAME_MS * 0.28);
+        fast.frame_took(AIM_MS * 0.28);
         let short = fast.size(FULL, true);
         assert!(short.x > FULL.x * 9 / 10 && short.x < FULL.x, "{short}");
         settle(&mut fast, 2.0, 1e-5);
@@ -199,6 +207,20 @@ mod tests {
         assert!(motion.moving(true, 5000.0));
         assert!(motion.moving(false, 8000.0));
         assert!(!motion.moving(false, 11000.0));
+    }
+
+    #[test]
+    fn a_fixed_cost_under_the_aim_keeps_ten_frames_a_second() {
+        // A browser on SwiftShader: 77 ms of window drawing whatever the view's size.
+        for full_ms in [300.0, 600.0, 1200.0] {
+            let mut adaptive = AdaptiveResolution::default();
+            let per_pixel = (full_ms - 77.0) / f64::from(FULL.x * FULL.y);
+            let took = settle(&mut adaptive, 77.0, per_pixel);
+            assert!(
+                took <= MOVING_FRAME_MS,
+                "{took} ms ({full_ms} ms at full size)"
+            );
+        }
     }
 
     #[test]

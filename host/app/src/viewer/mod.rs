@@ -25,7 +25,7 @@ mod window;
 use std::path::Path;
 
 pub use state::ViewerState;
-pub use view::ViewImages;
+pub use view::{ViewImages, clear_color};
 #[cfg(all(feature = "window", not(target_arch = "wasm32")))]
 pub use window::run;
 #[cfg(feature = "window")]

@@ -27,22 +27,38 @@ fn vec2(v: egui::Vec2) -> Vec2 {
     Vec2::new(v.x, v.y)
 }
 
+/// The colour the window is cleared to each frame: the panels' (which paint no fill of their
+/// own).
+pub fn clear_color(visuals: &egui::Visuals) -> [f32; 4] {
+    visuals.panel_fill.to_normalized_gamma_f32()
+}
+
 impl ViewerState {
     /// The whole window: controls left, tools right, timings at the bottom, the view in the
     /// middle.
     pub fn ui(&mut self, ui: &mut egui::Ui, images: ViewImages) {
+        // No panel fills: the window is cleared to the panels' colour ([`clear_color`]) and the
+        // view's images cover the middle. On software adapters the window's own drawing bounds
+        // the frame rate, and each fill paints its pixels once more.
+        let side = egui::Frame::side_top_panel(ui.style()).fill(egui::Color32::TRANSPARENT);
         egui::Panel::left("controls")
             .default_size(280.0)
+            .frame(side)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.controls(ui));
             });
         egui::Panel::right("tools")
             .default_size(300.0)
+            .frame(side)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.tools(ui));
             });
-        egui::Panel::bottom("timings").show(ui, |ui| self.timing_panel(ui));
-        egui::CentralPanel::default().show(ui, |ui| self.central_view(ui, images));
+        egui::Panel::bottom("timings")
+            .frame(side)
+            .show(ui, |ui| self.timing_panel(ui));
+        egui::CentralPanel::default()
+            .frame(egui::Frame::central_panel(ui.style()).fill(egui::Color32::TRANSPARENT))
+            .show(ui, |ui| self.central_view(ui, images));
         if ui.input(|i| i.key_pressed(egui::Key::F12))
             && let Err(e) = self.screenshot()
         {
@@ -60,7 +76,9 @@ impl ViewerState {
         self.view_size = size;
         let (rect, response) = ui.allocate_exact_size(size, egui::Sense::click_and_drag());
         let painter = ui.painter_at(rect);
-        painter.rect_filled(rect, 0.0, egui::Color32::BLACK);
+        if images.a.is_none() {
+            painter.rect_filled(rect, 0.0, egui::Color32::BLACK);
+        }
         self.paint_images(ui, &painter, rect, images);
         // A stale error map would hide the live image; the metrics stay in the panel.
         let fresh = !self.reference.is_stale(&self.renderer);
