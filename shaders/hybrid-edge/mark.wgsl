@@ -5,11 +5,12 @@
 
 #import "common/fullscreen.wgsl"
 
-@group(2) @binding(0) var band_depth: texture_depth_2d;
+// The band's depth bound as unfilterable float (GLSL cannot fetch texels of depth textures).
+@group(2) @binding(0) var band_depth: texture_2d<f32>;
 
 @fragment
 fn fs_mark(in: FullscreenOut) -> @location(0) vec4<f32> {
-    if textureLoad(band_depth, vec2<i32>(in.position.xy), 0) >= 1.0 {
+    if textureLoad(band_depth, vec2<i32>(in.position.xy), 0).r >= 1.0 {
         discard;
     }
     return vec4<f32>(0.0);

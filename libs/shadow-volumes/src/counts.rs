@@ -26,11 +26,19 @@ pub struct StencilCounts {
 impl StencilCounts {
     /// Builds the two stages.
     pub fn new(ctx: &RenderContext<'_>) -> TechniqueResult<StencilCounts> {
+        Self::reading(ctx, 0xff)
+    }
+
+    /// Builds the two stages for counts in the stencil's bits `mask` (below a mark,
+    /// [`crate::MARK_BIT`]).
+    pub fn reading(ctx: &RenderContext<'_>, mask: u32) -> TechniqueResult<StencilCounts> {
         let stage = |compare| {
+            let mut state = stencil_test(compare);
+            state.stencil.read_mask = mask;
             Stage::render(STENCIL_READ, "vs_count")
                 .fragment("fs_count")
                 .targets(&[Some(COUNTS_FORMAT.into())])
-                .depth_stencil(stencil_test(compare))
+                .depth_stencil(state)
                 .build(ctx)
         };
         Ok(StencilCounts {

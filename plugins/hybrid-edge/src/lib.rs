@@ -21,12 +21,12 @@
 //! - `Tiles`: the depth band, with the volumes drawn only into the screen tiles that hold edge
 //!   pixels (a compute pass lists them; each tile is an instance clipped by clip distances),
 //!   so nothing is rasterised outside those tiles even where early depth tests are not;
-//! - `Stencil`: seed 003's own restriction: the band's pixels are marked in the stencil's top
-//!   bit (a triangle at depth 1 over the band's depth image passes only where it holds a
-//!   depth), and the volumes are counted by z-fail in the bits below it wherever the stencil
-//!   test finds the mark, so they are rejected outside the band by the stencil test instead
-//!   of the depth test (the seed found this "not very suitable": the rejected fragments are
-//!   still rasterised);
+//! - `Stencil`: seed 003's own restriction: a full-screen pass marks the band's pixels (those
+//!   the band's depth image holds a depth at) in the top bit of the G-buffer's stencil, and the
+//!   volumes are counted against the G-buffer's depth, which holds every pixel's surface, in
+//!   the bits below it wherever the stencil test finds the mark: they are rejected outside the
+//!   band by the stencil test alone (the seed found this "not very suitable": the rejected
+//!   fragments are still rasterised);
 //! - `Everywhere`: every pixel in the band (plain shadow volumes through the same passes), to
 //!   measure what the restriction saves.
 
@@ -162,14 +162,23 @@ struct Gpu {
     restriction_codes: ChoiceCodes,
     volume: Stage,
     resolve: Stage,
-    /// The stencil restriction's mark, volumes and resolve.
-    marked: [Stage; 3],
+    /// The stencil restriction's passes.
+    marked: Marked,
     counts: StencilCounts,
     targets: NamedTextures,
     /// The band passes' groups over the coverage maps (and the id maps), once made.
     band_groups: [Option<StageBindGroup>; 2],
     /// Lights the volume buffers were made for.
     lights: usize,
+}
+
+/// The `Stencil` restriction's passes: the mark, the volumes counted where it is, the resolve
+/// and the count view of the bits below the mark.
+struct Marked {
+    mark: Stage,
+    volume: Stage,
+    resolve: Stage,
+    counts: StencilCounts,
 }
 
 /// Writes the band's depth (compare always), leaves the stencil for the volumes.
@@ -242,11 +251,12 @@ impl Gpu {
             restriction_codes,
             volume: volume.build(ctx)?,
             resolve: resolve_stage(ctx)?,
-            marked: [
-                mark_stage(ctx)?,
-                marked_volume.build(ctx)?,
-                marked_resolve_stage(ctx)?,
-            ],
+            marked: Marked {
+                mark: mark_stage(ctx)?,
+                volume: marked_volume.build(ctx)?,
+                resolve: marked_resolve_stage(ctx)?,
+                counts: StencilCounts::reading(ctx, MARK_BIT - 1)?,
+            },
             counts: StencilCounts::new(ctx)?,
             targets: targets(),
             band_groups: [None, None],
@@ -318,22 +328,10 @@ fn tiles_for(ctx: &RenderContext<'_>, bias: wgpu::DepthBiasState) -> TechniqueRe
     Tiles::new(ctx, bias)
 }
 
-/// Draws the stencil counts the volumes left in `counted` (the band's, or the G-buffer's
-/// depth-stencil) into the count view.
-fn record_counts(
-    ctx: &RenderContext<'_>,
-    recorder: &mut PassRecorder<'_>,
-    gpu: &Gpu,
-    (light, counted): (usize, &wgpu::TextureView),
-) -> TechniqueResult {
-    let name = light_pass_name(DEBUG_PASS, light);
-    let counts = (gpu.targets.view(COUNTS_VIEW)).ok_or_else(TechniqueError::not_prepared)?;
-    gpu.counts.record(ctx, recorder, (counted, counts), &name)
-}
-
 /// Counts light `light`'s volumes in its band, piece by piece into the band's stencil (only
-/// into the listed edge tiles where `tiled`), and shadows the band pixels with a non-zero
-/// count; `debug`: the light the debug views show.
+/// into the listed edge tiles with `Tiles`; with `Stencil`, into the G-buffer's stencil where
+/// the mark is), and shadows the band pixels with a non-zero count; `debug`: the light the
+/// debug views show.
 fn record_volumes(
     ctx: &RenderContext<'_>,
     recorder: &mut PassRecorder<'_>,
@@ -343,9 +341,8 @@ fn record_volumes(
 ) -> TechniqueResult {
     let tiled = restriction == Restriction::Tiles;
     let marked = restriction == Restriction::Stencil;
-    let [mark, marked_volume, marked_resolve] = &gpu.marked;
     let (volume_stage, resolve) = match marked {
-        true => (marked_volume, marked_resolve),
+        true => (&gpu.marked.volume, &gpu.marked.resolve),
         false => (&gpu.volume, &gpu.resolve),
     };
     let (Some(volume), Some(args)) = (gpu.generator.volume(), gpu.generator.args()) else {
@@ -363,7 +360,7 @@ fn record_volumes(
     }
     let band = (gpu.targets.view(BAND_TARGET)).ok_or_else(TechniqueError::not_prepared)?;
     let mark_group = match marked {
-        true => Some(bind_mark(ctx, gpu, mark)?),
+        true => Some(bind_mark(ctx, gpu)?),
         false => None,
     };
     let pieces = gpu.generator.pieces(light);
@@ -377,25 +374,29 @@ fn record_volumes(
             true => wgpu::StoreOp::Store,
             false => wgpu::StoreOp::Discard,
         };
-        // The stencil restriction counts on the G-buffer's depth (kept for later passes), in a
+        // The stencil restriction counts against the G-buffer's depth (read only), in a
         // stencil it clears for each light.
-        let (view, depth_store, stencil_load) = match marked {
+        let (view, depth_ops, stencil_load) = match marked {
             true => (
                 &ctx.gbuffer.depth_view,
-                wgpu::StoreOp::Store,
+                None,
                 match piece {
                     0 => wgpu::LoadOp::Clear(0),
                     _ => wgpu::LoadOp::Load,
                 },
             ),
-            false => (band, keep, wgpu::LoadOp::Load),
+            false => (
+                band,
+                Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: keep,
+                }),
+                wgpu::LoadOp::Load,
+            ),
         };
         let depth = wgpu::RenderPassDepthStencilAttachment {
             view,
-            depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Load,
-                store: depth_store,
-            }),
+            depth_ops,
             stencil_ops: Some(wgpu::Operations {
                 load: stencil_load,
                 store: keep,
@@ -409,7 +410,7 @@ fn record_volumes(
         if let Some(group) = &mark_group {
             pass.set_stencil_reference(MARK_BIT);
             if piece == 0 {
-                mark.set_on(ctx, &mut pass, &[group], &[])?;
+                gpu.marked.mark.set_on(ctx, &mut pass, &[group], &[])?;
                 pass.draw(0..3, 0..1);
             }
         }
@@ -427,18 +428,19 @@ fn record_volumes(
         }
     }
     if showing(COUNTS_VIEW) {
-        let counted = if marked {
-            &ctx.gbuffer.depth_view
-        } else {
-            band
+        let name = light_pass_name(DEBUG_PASS, light);
+        let view = (gpu.targets.view(COUNTS_VIEW)).ok_or_else(TechniqueError::not_prepared)?;
+        let (counts, stencil) = match marked {
+            true => (&gpu.marked.counts, &ctx.gbuffer.depth_view),
+            false => (&gpu.counts, band),
         };
-        record_counts(ctx, recorder, gpu, (light, counted))?;
+        counts.record(ctx, recorder, (stencil, view), &name)?;
     }
     Ok(())
 }
 
 /// The mark's group over the band's depth (made each frame: the band follows the screen).
-fn bind_mark(ctx: &RenderContext<'_>, gpu: &Gpu, mark: &Stage) -> TechniqueResult<StageBindGroup> {
+fn bind_mark(ctx: &RenderContext<'_>, gpu: &Gpu) -> TechniqueResult<StageBindGroup> {
     let band = (gpu.targets.texture(BAND_TARGET)).ok_or_else(TechniqueError::not_prepared)?;
     let depth = band.create_view(&wgpu::TextureViewDescriptor {
         label: Some("hybrid band depth (mark)"),
@@ -446,7 +448,7 @@ fn bind_mark(ctx: &RenderContext<'_>, gpu: &Gpu, mark: &Stage) -> TechniqueResul
         ..Default::default()
     });
     let view = wgpu::BindingResource::TextureView(&depth);
-    mark.bind(ctx, "hybrid mark", &[("band_depth", view)])
+    (gpu.marked.mark).bind(ctx, "hybrid mark", &[("band_depth", view)])
 }
 
 /// The band pass's uniform for one light's maps.
